@@ -1,0 +1,291 @@
+"""The quarter-car model of the seed paper as a ``control.StateSpace``.
+
+Two masses, the sprung body ``ms`` and the unsprung wheel ``mu``, joined by
+the suspension spring ``ks`` and damper ``cs``; the wheel stands on the road
+through the tire spring ``ku``. With the seed's state vector
+``x = [xs', xu', xs, xu]`` the equations of motion (seed, section 4.1)
+
+.. math::
+
+    m_s \\ddot x_s + c_s(\\dot x_s - \\dot x_u) + k_s(x_s - x_u) = f_a
+
+    m_u \\ddot x_u + c_s(\\dot x_u - \\dot x_s) + k_s(x_u - x_s)
+        + k_u (x_u - z_r) = -f_a
+
+become ``dx/dt = A x + B u`` with the seed's matrix ``A`` (section 4.2).
+All quantities are SI: kg, N/m, N·s/m, m, s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import Any, Mapping
+
+import control
+import numpy as np
+
+try:  # Python >= 3.11
+    import tomllib
+except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+__all__ = ["QuarterCarParams", "quarter_car", "STATES", "OUTPUTS", "load_config", "read_config"]
+
+#: State names: the seed's ``[xs', xu', xs, xu]``.
+STATES = ("vs", "vu", "xs", "xu")
+#: Output names, in order.
+OUTPUTS = ("xs", "xu", "susp_travel", "tire_defl", "body_acc")
+
+_UNITS = {"ms": "kg", "mu": "kg", "ks": "N/m", "ku": "N/m", "zeta": "-", "cs": "N·s/m"}
+_DESCRIPTIONS = {
+    "ms": "sprung mass",
+    "mu": "unsprung mass",
+    "ks": "suspension stiffness",
+    "ku": "tire stiffness",
+    "zeta": "nominal damping ratio cs/(2√(ks·ms))",
+    "cs": "suspension damping",
+}
+
+
+@dataclass(frozen=True)
+class QuarterCarParams:
+    """Physical parameters of the quarter car, in SI units.
+
+    Defaults are the seed paper's Table 1.
+
+    Parameters
+    ----------
+    ms : float
+        Sprung (body) mass [kg], > 0. Default 301.2.
+    mu : float
+        Unsprung (wheel) mass [kg], > 0. Default 100.
+    ks : float
+        Suspension stiffness [N/m], > 0. Default 30000.
+    ku : float
+        Tire stiffness [N/m], > 0. Default 29530.
+    zeta : float, optional
+        Nominal damping ratio [-], >= 0. Default 0.25 when ``cs`` is not
+        given; derived from ``cs`` when only ``cs`` is given.
+    cs : float, optional
+        Suspension damping [N·s/m], >= 0. Derived from ``zeta`` when not
+        given (seed, Table 1):
+
+        .. math:: c_s = 2 \\zeta \\sqrt{k_s m_s}
+
+    Raises
+    ------
+    ValueError
+        If a value is not finite, a mass or stiffness is not > 0, a damping
+        value is < 0, or ``zeta`` and ``cs`` are both given and disagree.
+        The message names the field and the value.
+
+    Notes
+    -----
+    The nominal ``zeta`` is the damping ratio the body would have on a
+    rigid tire. On a soft tire the body mode's modal damping is lower; see
+    `qc_control.modal_analysis`.
+
+    Examples
+    --------
+    >>> p = QuarterCarParams()
+    >>> round(p.cs, 3)
+    1502.997
+    >>> QuarterCarParams(cs=1000.0).cs
+    1000.0
+    """
+
+    ms: float = 301.2
+    mu: float = 100.0
+    ks: float = 30000.0
+    ku: float = 29530.0
+    zeta: float | None = None
+    cs: float | None = None
+
+    def __post_init__(self):
+        for name in ("ms", "mu", "ks", "ku", "zeta", "cs"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+                raise ValueError(f"{name} must be a number, got {value!r}")
+            value = float(value)
+            if not math.isfinite(value):
+                raise ValueError(f"{name} must be finite, got {value!r}")
+            if name in ("zeta", "cs"):
+                if value < 0:
+                    raise ValueError(f"{name} must be >= 0, got {value!r}")
+            elif value <= 0:
+                raise ValueError(
+                    f"{name} ({_DESCRIPTIONS[name]}) must be > 0 {_UNITS[name]}, got {value!r}"
+                )
+            object.__setattr__(self, name, value)
+        critical = 2.0 * math.sqrt(self.ks * self.ms)
+        if self.cs is None:
+            zeta = 0.25 if self.zeta is None else self.zeta
+            object.__setattr__(self, "zeta", zeta)
+            object.__setattr__(self, "cs", zeta * critical)
+        elif self.zeta is None:
+            object.__setattr__(self, "zeta", self.cs / critical)
+        elif not math.isclose(self.cs, self.zeta * critical, rel_tol=1e-9, abs_tol=1e-12):
+            raise ValueError(
+                f"cs={self.cs!r} and zeta={self.zeta!r} disagree: "
+                f"cs = 2*zeta*sqrt(ks*ms) = {self.zeta * critical!r}; give only one"
+            )
+
+    @classmethod
+    def from_mapping(cls, values: Mapping[str, Any]) -> "QuarterCarParams":
+        """Build from a dict; an unknown key raises ``ValueError`` naming it."""
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(values) - known)
+        if unknown:
+            raise ValueError(
+                f"unknown parameter {unknown[0]!r}; expected one of {sorted(known)}"
+            )
+        return cls(**dict(values))
+
+    def to_dict(self) -> dict[str, float]:
+        """The six values as a plain dict (``cs`` and ``zeta`` both resolved)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def table(self) -> list[tuple[str, str, float, str]]:
+        """Rows ``(symbol, description, value, unit)`` for reports."""
+        return [(n, _DESCRIPTIONS[n], getattr(self, n), _UNITS[n]) for n in _UNITS]
+
+
+def read_config(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Read a TOML file into ``(parameter values, scenario table)``, unresolved.
+
+    Parameter keys (``ms``, ``mu``, ``ks``, ``ku``, ``zeta``, ``cs``) stand at
+    the top level; an optional ``[scenario]`` table is returned as it is
+    (its reader checks it). Any other top-level key, or a bad value, raises
+    ``ValueError`` naming the file and the key or value.
+    """
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            data = tomllib.load(fh)
+    except OSError as exc:
+        raise ValueError(f"config file {str(path)!r} cannot be read: {exc.strerror}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
+    scenario = data.pop("scenario", {})
+    if not isinstance(scenario, dict):
+        raise ValueError(f"config file {str(path)!r}: 'scenario' must be a table")
+    try:
+        QuarterCarParams.from_mapping(data)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"config file {str(path)!r}: {exc}") from None
+    return data, scenario
+
+
+def load_config(path: str | Path) -> tuple[QuarterCarParams, dict[str, Any]]:
+    """Read a TOML config: ``(QuarterCarParams, scenario table)``.
+
+    See `read_config` for the file's layout and errors.
+
+    Examples
+    --------
+    A file holding ``ms = 350.0`` and ``zeta = 0.3`` gives
+    ``QuarterCarParams(ms=350.0, zeta=0.3)`` and ``{}``.
+    """
+    values, scenario = read_config(path)
+    return QuarterCarParams(**values), scenario
+
+
+def _as_params(params) -> QuarterCarParams:
+    if params is None:
+        return QuarterCarParams()
+    if isinstance(params, QuarterCarParams):
+        return params
+    if isinstance(params, Mapping):
+        return QuarterCarParams.from_mapping(params)
+    raise TypeError(
+        f"params must be a QuarterCarParams, a dict or None, got {type(params).__name__}"
+    )
+
+
+def system_matrices(params=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The seed's ``A`` with the road and actuator columns of ``B``.
+
+    Returns ``(A, b_road, b_act)``: ``b_road = [0, ku/mu, 0, 0]`` and
+    ``b_act = [1/ms, -1/mu, 0, 0]``.
+    """
+    p = _as_params(params)
+    ms, mu, ks, ku, cs = p.ms, p.mu, p.ks, p.ku, p.cs
+    A = np.array(
+        [
+            [-cs / ms, cs / ms, -ks / ms, ks / ms],
+            [cs / mu, -cs / mu, ks / mu, -(ks + ku) / mu],
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+        ]
+    )
+    b_road = np.array([0.0, ku / mu, 0.0, 0.0])
+    b_act = np.array([1.0 / ms, -1.0 / mu, 0.0, 0.0])
+    return A, b_road, b_act
+
+
+def quarter_car(params=None, *, road: bool = False, actuator: bool = False,
+                name: str = "quarter_car") -> control.StateSpace:
+    """The quarter car as a continuous-time ``control.StateSpace``.
+
+    Parameters
+    ----------
+    params : QuarterCarParams or dict, optional
+        Vehicle parameters; the seed's Table 1 when omitted.
+    road : bool, default False
+        Add the input ``'zr'`` [m], the road height under the tire,
+        with ``B`` column ``[0, ku/mu, 0, 0]``.
+    actuator : bool, default False
+        Add the input ``'fa'`` [N], a force between the masses that pushes
+        them apart, with ``B`` column ``[1/ms, -1/mu, 0, 0]``.
+    name : str, default ``'quarter_car'``
+        The system's name.
+
+    Returns
+    -------
+    control.StateSpace
+        States ``['vs', 'vu', 'xs', 'xu']`` (seed: ``[xs', xu', xs, xu]``);
+        inputs ``[]``, ``['zr']``, ``['fa']`` or ``['zr', 'fa']``; outputs
+
+        - ``xs``, ``xu`` [m]: body and wheel displacement;
+        - ``susp_travel = xs - xu`` [m];
+        - ``tire_defl = xu - zr`` [m] (compression is negative);
+        - ``body_acc = xs''`` [m/s²], the first row of ``A x + B u``,
+          exact (no finite differences).
+
+    Examples
+    --------
+    >>> import control
+    >>> sys = quarter_car(road=True)
+    >>> sys.input_labels, sys.nstates
+    (['zr'], 4)
+    >>> round(float(control.dcgain(sys)[0, 0]), 12)   # zr -> xs: the body follows the road
+    1.0
+    """
+    A, b_road, b_act = system_matrices(params)
+    columns, inputs = [], []
+    if road:
+        columns.append(b_road)
+        inputs.append("zr")
+    if actuator:
+        columns.append(b_act)
+        inputs.append("fa")
+    B = np.column_stack(columns) if columns else np.zeros((4, 0))
+    C = np.array(
+        [
+            [0.0, 0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+            [0.0, 0.0, 1.0, -1.0],
+            [0.0, 0.0, 0.0, 1.0],
+            A[0],
+        ]
+    )
+    D = np.zeros((5, len(inputs)))
+    if road:
+        D[3, inputs.index("zr")] = -1.0
+    D[4] = B[0]
+    return control.ss(A, B, C, D, states=list(STATES), inputs=inputs,
+                      outputs=list(OUTPUTS), name=name)

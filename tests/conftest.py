@@ -1,0 +1,37 @@
+"""Shared fixtures and strategies."""
+import os
+
+import matplotlib
+import pytest
+from hypothesis import strategies as st
+
+matplotlib.use("Agg")  # no screen on CI
+
+from qc_control import QuarterCarParams  # noqa: E402
+
+#: Physically plausible vehicles, from a kart to a truck axle (SI units).
+#: Damping is kept > 0 so every mode decays; cs = 0 is tested separately.
+valid_params = st.builds(
+    QuarterCarParams,
+    ms=st.floats(50.0, 5000.0),
+    mu=st.floats(10.0, 1000.0),
+    ks=st.floats(5e3, 5e5),
+    ku=st.floats(5e4, 5e6),
+    zeta=st.floats(0.01, 2.0),
+)
+
+
+@pytest.fixture
+def seed_params():
+    return QuarterCarParams()
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    yield
+    import matplotlib.pyplot as plt
+    plt.close("all")
+
+
+def pytest_configure(config):
+    os.environ.setdefault("MPLBACKEND", "Agg")
