@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 report: $(STAMP)
-	$(BIN)/qc-control modes
+	$(BIN)/qc-control report --out report
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

@@ -11,6 +11,7 @@ from .modal import ModalAnalysis, Mode, modal_analysis
 from .model import OUTPUTS, STATES, QuarterCarParams, load_config, quarter_car, read_config
 from .response import FixedStepResponse, forced_response, initial_response
 from .stability import max_stable_step, numerical_modes, stability_function
+from .compare import MethodComparison, compare_methods
 
 __version__ = "0.1.0"
 __all__ = [
@@ -20,4 +21,5 @@ __all__ = [
     "integrate", "Solution", "DivergenceWarning",
     "initial_response", "forced_response", "FixedStepResponse",
     "stability_function", "max_stable_step", "numerical_modes",
+    "compare_methods", "MethodComparison",
 ]

@@ -1,0 +1,122 @@
+"""compare_methods' numbers against independent calculations."""
+import math
+
+import control
+import numpy as np
+import pytest
+
+import qc_control as qc
+from qc_control.compare import TOLERANCES
+
+ORDERS = {"euler": 1, "midpoint": 2, "heun": 2, "rk4": 4}
+X0 = np.array([0.0, 0.0, 0.05, 0.0])
+
+
+@pytest.fixture(scope="module")
+def seed_cmp():
+    """The default scenario, shortened to 0-4 s to keep the suite quick."""
+    return qc.compare_methods(qc.QuarterCarParams(), np.linspace(0, 4, 401), X0, repeats=1)
+
+
+def taylor_map(A, h, p):
+    term, total = np.eye(4), np.eye(4)
+    for k in range(1, p + 1):
+        term = term @ (h * A) / k
+        total = total + term
+    return total
+
+
+def test_errors_against_an_independent_trajectory(seed_cmp):
+    """For s = p methods the trajectory is x_{k+1} = T_p(hA) x_k (no stepper involved)."""
+    sys = seed_cmp.system
+    A, C = np.asarray(sys.A), np.asarray(sys.C)
+    T = seed_cmp.T
+    exact = control.initial_response(sys, T, X0).outputs
+    for name, p in ORDERS.items():
+        M = taylor_map(A, 0.01, p)
+        x = np.empty((4, T.size))
+        x[:, 0] = X0
+        for k in range(T.size - 1):
+            x[:, k + 1] = M @ x[:, k]
+        err = C @ x - exact
+        row = seed_cmp.table.loc[name]
+        # two evaluations of the same map: agree to rounding, 1e-12 relative
+        assert row["max |xs err| [m]"] == pytest.approx(np.max(abs(err[0])), rel=1e-9)
+        assert row["rms xu err [m]"] == pytest.approx(np.sqrt(np.mean(err[1] ** 2)), rel=1e-9)
+        assert row["max |body_acc err| [m/s²]"] == pytest.approx(np.max(abs(err[4])), rel=1e-9)
+        assert row["final |xs err| [m]"] == pytest.approx(abs(err[0, -1]), rel=1e-6, abs=1e-15)
+        assert row["RHS evals"] == p * 400 and row["steps"] == 400
+
+
+def test_step_limits_and_modes_from_eigenvalues(seed_cmp):
+    lam = np.linalg.eigvals(np.asarray(seed_cmp.system.A))
+    euler = min(-2 * l.real / abs(l) ** 2 for l in lam)     # |1 + h lambda| = 1
+    assert seed_cmp.table.loc["euler", "h_max [s]"] == pytest.approx(euler, rel=1e-12)
+    assert seed_cmp.table.loc["euler", "limited by"] == "body bounce"
+    wn, zeta, _ = control.damp(seed_cmp.system, doprint=False)
+    assert seed_cmp.modes.body.zeta == pytest.approx(min(zeta), rel=1e-12)
+    nm = qc.numerical_modes("euler", 0.01, seed_cmp.system)
+    assert seed_cmp.table.loc["euler", "wheel hop freq err [%]"] == nm.loc["wheel hop", "freq error [%]"]
+
+
+def test_observed_orders_in_the_asymptotic_range():
+    cmp = qc.compare_methods(None, np.linspace(0, 2, 1001), X0, repeats=1)   # h = 2 ms
+    for name, p in ORDERS.items():
+        assert cmp.table.loc[name, "observed order"] == pytest.approx(p, abs=0.15)
+
+
+def test_reference_accuracy_is_stated_and_tiny(seed_cmp):
+    # python-control's expm recurrence against the modal closed form: rounding only
+    assert seed_cmp.reference_error < 1e-14
+    assert "closed form" in seed_cmp.reference_description
+
+
+def test_cost_to_reach_brackets_the_measurements(seed_cmp):
+    conv = seed_cmp.convergence
+    for name in ORDERS:
+        rows = conv[conv["method"] == name].sort_values("nfev")
+        for tol in TOLERANCES:
+            n, kind = seed_cmp.cost.loc[tol, name], seed_cmp.cost_kind.loc[tol, name]
+            if kind == "interpolated":
+                above = rows[rows["error"] > tol]["nfev"].max()
+                below = rows[rows["error"] <= tol]["nfev"].min()
+                assert above <= n <= below
+            else:
+                assert kind == "extrapolated" and n > 0
+
+
+def test_midpoint_heun_recorded_as_coincident(seed_cmp):
+    assert ("midpoint", "heun") in seed_cmp.coincident
+    assert seed_cmp.coincident[("midpoint", "heun")] < 1e-12
+
+
+def test_forced_comparison_uses_forced_reference():
+    T = np.linspace(0, 2, 201)
+    U = np.where(T >= 0.5, 0.05, 0.0)
+    cmp = qc.compare_methods(qc.quarter_car(road=True), T, np.zeros(4), U=U,
+                             methods=("heun", "rk4"), repeats=1)
+    exact = control.forced_response(qc.quarter_car(road=True), T, U, 0).outputs
+    ours = qc.forced_response(qc.quarter_car(road=True), T, U, method="rk4").outputs
+    assert cmp.table.loc["rk4", "max |xs err| [m]"] == pytest.approx(np.max(abs(ours[0] - exact[0])))
+    assert "lsim" in cmp.reference_description and cmp.reference_error < 1e-12
+
+
+@pytest.mark.parametrize("kwargs, error, words", [
+    (dict(h=0.003), ValueError, "must divide the grid spacing"),
+    (dict(h=-1.0), ValueError, "h must be a finite step"),
+    (dict(methods=()), ValueError, "at least one method"),
+    (dict(methods=("rk4", "rk4")), ValueError, "distinct"),
+    (dict(methods=("rk5",)), ValueError, "unknown method"),
+    (dict(X0=[0, 0, 0.05]), ValueError, "X0 must have shape"),
+    (dict(U=np.zeros(7)), ValueError, "system has no inputs|U must have shape"),
+])
+def test_bad_input(kwargs, error, words):
+    args = dict(T=np.linspace(0, 1, 101), X0=X0)
+    args.update(kwargs)
+    with pytest.raises(error, match=words):
+        qc.compare_methods(qc.quarter_car(), args.pop("T"), args.pop("X0"), repeats=1, **args)
+
+
+def test_non_uniform_grid_rejected():
+    with pytest.raises(ValueError, match="uniformly spaced"):
+        qc.compare_methods(None, [0, 0.1, 0.3], X0)
