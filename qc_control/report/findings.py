@@ -1,0 +1,119 @@
+"""Findings written from the numbers of a MethodComparison (no fixed verdicts)."""
+
+from __future__ import annotations
+
+import math
+
+from .document import fmt
+
+__all__ = ["findings"]
+
+_KIND = {"interpolated": "interpolated", "extrapolated": "extrapolated from its order",
+         "unreached": "not reached"}
+
+
+def _cheapest(cmp) -> list[str]:
+    out = []
+    for tol in cmp.cost.index:
+        costs = cmp.cost.loc[tol].dropna().sort_values()
+        if costs.empty:
+            continue
+        best = costs.index[0]
+        others = ", ".join(f"{m} {fmt(int(v))}" for m, v in costs.iloc[1:].items())
+        tied = [m for m, v in costs.items() if v == costs.iloc[0]]
+        who = " and ".join(tied) if len(tied) > 1 else best
+        out.append(
+            f"Cheapest to reach {fmt(tol)} m (max |xs error|): {who}, about "
+            f"{fmt(int(costs.iloc[0]))} RHS evaluations "
+            f"({_KIND[cmp.cost_kind.loc[tol, best]]})"
+            + (f"; the others need {others}." if others else "."))
+    return out
+
+
+def _step_limits(cmp) -> list[str]:
+    t = cmp.table
+    out = []
+    if "euler" in t.index:
+        row = t.loc["euler"]
+        out.append(
+            f"Euler's step limit is h = {fmt(row['h_max [s]'])} s, set by the "
+            f"{row['limited by']} mode (|1 + hλ| ≤ 1, i.e. h ≤ −2·Re λ/|λ|²); the chosen "
+            f"h = {fmt(cmp.h)} s is {fmt(100 * cmp.h / row['h_max [s]'])}% of it.")
+    others = [f"{m} {fmt(r['h_max [s]'])} s" for m, r in t.iterrows() if m != "euler"]
+    if others:
+        out.append("The other limits: " + ", ".join(others) + ".")
+    unstable = [m for m, r in t.iterrows() if not r["stable"]]
+    if unstable:
+        out.append(f"At h = {fmt(cmp.h)} s {', '.join(unstable)} "
+                   f"{'is' if len(unstable) == 1 else 'are'} beyond the stability limit: "
+                   "the response grows instead of decaying, and its errors mean nothing.")
+    return out
+
+
+def _groups(pairs) -> list[list[str]]:
+    """Connected groups of coincident methods, in first-seen order."""
+    groups: list[list[str]] = []
+    for a, b in pairs:
+        hit = [g for g in groups if a in g or b in g]
+        merged = [m for g in hit for m in g]
+        merged += [m for m in (a, b) if m not in merged]
+        groups = [g for g in groups if g not in hit] + [merged]
+    return groups
+
+
+def _coincidence(cmp) -> list[str]:
+    out = []
+    orders = cmp.table["order"]
+    for group in _groups(cmp.coincident):
+        gap = max(v for k, v in cmp.coincident.items() if set(k) <= set(group))
+        names = ", ".join(group[:-1]) + " and " + group[-1]
+        p = int(orders[group[0]])
+        out.append(
+            f"{names} give the same trajectory (largest state difference {fmt(gap)} m, which "
+            f"is rounding). On a linear system the free step of every method with as many "
+            f"stages as its order p is the Taylor polynomial T_{p}(hA)·x"
+            + (", and an input linear within each step enters them alike (Midpoint's "
+               "u(t + h/2) is Heun's (u(t) + u(t + h))/2)" if {"midpoint", "heun"} <= set(group)
+               else "")
+            + ". They can differ on nonlinear systems or inputs that curve within a step.")
+    names = set(cmp.table.index)
+    if {"midpoint", "heun"} <= names and not any({"midpoint", "heun"} <= set(g)
+                                                  for g in _groups(cmp.coincident)):
+        out.append("midpoint and heun differ here by more than 1e-12 m.")
+    return out
+
+
+def _damping(cmp) -> list[str]:
+    body, wheel = cmp.modes.body, cmp.modes.wheel
+    text = (f"Nominal against modal damping: the nominal ratio cs/(2·√(ks·ms)) = "
+            f"{fmt(body.zeta_nominal)}, but the modes have ζ = {fmt(body.zeta)} (body bounce, "
+            f"{fmt(body.fn)} Hz) and ζ = {fmt(wheel.zeta)} (wheel hop, {fmt(wheel.fn)} Hz).")
+    out = [text]
+    for m, nm in cmp.numerical_modes.items():
+        b = nm.loc["body bounce"]
+        worst = nm["freq error [%]"].abs().idxmax()
+        sign = "adds" if b["zeta error"] > 0 else "removes"
+        out.append(
+            f"{m} at h = {fmt(cmp.h)} s {sign} damping: body-bounce ζ {fmt(b['zeta'])} → "
+            f"{fmt(b['zeta_h'])} (Δζ = {b['zeta error']:+.2g}); its largest frequency error is "
+            f"{fmt(nm.loc[worst, 'freq error [%]'])}% ({worst}).")
+    return out
+
+
+def _orders(cmp) -> list[str]:
+    t = cmp.table
+    parts = [f"{m} {fmt(r['observed order'])} (theory {r['order']})" for m, r in t.iterrows()]
+    out = ["Observed orders from h, h/2, h/4: " + ", ".join(parts) + "."]
+    off = [m for m, r in t.iterrows()
+           if math.isfinite(r["observed order"]) and abs(r["observed order"] - r["order"]) > 0.15]
+    if off:
+        out.append(f"{', '.join(off)}: more than 0.15 from theory, so h = {fmt(cmp.h)} s is not "
+                   "yet in the asymptotic range there; the convergence table shows the slope "
+                   "settling at finer steps.")
+    return out
+
+
+def findings(cmp) -> list[str]:
+    """Sentences that state what the numbers of ``cmp`` show."""
+    return (_cheapest(cmp) + _step_limits(cmp) + _coincidence(cmp) + _damping(cmp)
+            + _orders(cmp))
