@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import math
+import functools
 import warnings
 from dataclasses import dataclass
 
@@ -12,8 +12,8 @@ from .methods import ButcherTableau, get_method
 
 __all__ = ["Solution", "DivergenceWarning", "integrate", "check_time_grid", "check_substeps"]
 
-#: Steps between checks for a non-finite state. Checking every step would cost
-#: about as much as a stage; a blow-up is still cut at its first bad sample.
+#: Intervals between checks for a non-finite state. Checking every step would
+#: cost about as much as a stage; a blow-up is still cut at its first bad sample.
 _CHECK_EVERY = 64
 
 
@@ -71,6 +71,62 @@ def check_time_grid(t, name: str = "T") -> np.ndarray:
     return t
 
 
+def _loop_source(tab: ButcherTableau, substeps: bool) -> str:
+    """Python source of the stepping loop for one tableau, stages unrolled.
+
+    The coefficients are data, but a loop over them per step costs as much
+    as a stage; writing them into the code once gives the loop a hand-written
+    one would have. Stages of equal weight share one multiplication.
+    """
+    s = tab.stages
+    a, b, c = tab.a.tolist(), tab.b.tolist(), tab.c.tolist()
+    coef = []
+    lines = ["def run(f, tt, x, out, start, stop, substeps):",
+             "    h_prev = None",
+             "    for n in range(start, stop):",
+             "        t = tt[n]",
+             "        h = (tt[n + 1] - t) / substeps" if substeps else "        h = tt[n + 1] - t",
+             "        if h != h_prev:",
+             "            h_prev = h"]
+    for i in range(s):
+        if c[i] not in (0.0, 1.0):
+            coef.append(f"            hc{i} = h * {c[i]!r}")
+        for j in range(i):
+            if a[i][j]:
+                coef.append(f"            ha{i}_{j} = h * {a[i][j]!r}")
+    weights: dict[float, list[int]] = {}
+    for i in range(s):
+        if b[i]:
+            weights.setdefault(b[i], []).append(i)
+    for g, w in enumerate(weights):
+        coef.append(f"            hb{g} = h * {w!r}")
+    lines += coef
+    body = []
+    if substeps:
+        body += ["        t0 = t", "        for sub in range(substeps):",
+                 "            t = t0 + sub * h"]
+    pad = "            " if substeps else "        "
+    for i in range(s):
+        ti = "t" if c[i] == 0.0 else "t + h" if c[i] == 1.0 else f"t + hc{i}"
+        xi = "x" + "".join(f" + ha{i}_{j} * k{j}" for j in range(i) if a[i][j])
+        body.append(f"{pad}k{i} = f({ti}, {xi})")
+    terms = []
+    for g, idx in enumerate(weights.values()):
+        ks = " + ".join(f"k{i}" for i in idx)
+        terms.append(f"hb{g} * ({ks})" if len(idx) > 1 else f"hb{g} * {ks}")
+    body.append(f"{pad}x = x + " + " + ".join(terms))
+    lines += body + ["        out[n + 1] = x", "    return x", ""]
+    return "\n".join(lines)
+
+
+@functools.lru_cache(maxsize=64)
+def _compiled_loop(tab: ButcherTableau, substeps: bool):
+    namespace: dict = {}
+    exec(compile(_loop_source(tab, substeps), f"<qc_control loop: {tab.name}>", "exec"),
+         namespace)
+    return namespace["run"]
+
+
 def check_substeps(substeps) -> int:
     """``substeps`` as an int >= 1, or a ValueError naming it."""
     if isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
@@ -126,53 +182,30 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     if not np.all(np.isfinite(x)):
         raise ValueError("x0 must be finite")
 
-    s, c = tab.stages, tab.c.tolist()
-    a_rows = [[(j, a) for j, a in enumerate(tab.a[i, :i].tolist()) if a != 0] for i in range(s)]
-    b_terms = [(i, b) for i, b in enumerate(tab.b.tolist()) if b != 0]
+    run = _compiled_loop(tab, substeps > 1)
     out = np.empty((t.size,) + x.shape)
     out[0] = x
-    k = [None] * s
-    h_cached, ha_rows, hb_terms = math.nan, None, None
-    n_last, status, message = t.size - 1, "success", ""
     tt = t.tolist()
-
+    n_last, n_computed, status, message = t.size - 1, t.size - 1, "success", ""
     with np.errstate(over="ignore", invalid="ignore"):
-        for n in range(t.size - 1):
-            t0 = tt[n]
-            h = (tt[n + 1] - t0) / substeps
-            if h != h_cached:  # uniform grids rescale once
-                h_cached = h
-                ha_rows = [[(j, h * a) for j, a in row] for row in a_rows]
-                hb_terms = [(i, h * b) for i, b in b_terms]
-            for sub in range(substeps):
-                ts = t0 + sub * h if sub else t0
-                for i in range(s):
-                    xi = x
-                    for j, ha in ha_rows[i]:
-                        xi = xi + ha * k[j]
-                    k[i] = f(ts + c[i] * h, xi)
-                for i, hb in hb_terms:
-                    x = x + hb * k[i]
-            out[n + 1] = x
-            if (n + 1) % _CHECK_EVERY == 0 or n + 1 == t.size - 1:
-                block = out[max(n + 2 - _CHECK_EVERY, 1):n + 2]
-                bad = ~np.isfinite(block.reshape(block.shape[0], -1)).all(axis=1)
-                if bad.any():
-                    n_last = max(n + 2 - _CHECK_EVERY, 1) + int(np.argmax(bad)) - 1
-                    status = "diverged"
-                    message = (f"{tab.name}: the state became non-finite after t = "
-                               f"{t[n_last]:.6g}; stopped after {n_last} of {t.size - 1} "
-                               f"intervals")
-                    warnings.warn(message, DivergenceWarning, stacklevel=2)
-                    n_computed = n + 1
-                    break
-        else:
-            n_computed = t.size - 1
+        for start in range(0, t.size - 1, _CHECK_EVERY):
+            stop = min(start + _CHECK_EVERY, t.size - 1)
+            x = run(f, tt, x, out, start, stop, substeps)
+            block = out[start + 1:stop + 1]
+            bad = ~np.isfinite(block.reshape(block.shape[0], -1)).all(axis=1)
+            if bad.any():
+                n_last = start + int(np.argmax(bad))
+                n_computed = stop
+                status = "diverged"
+                message = (f"{tab.name}: the state became non-finite after t = "
+                           f"{t[n_last]:.6g}; stopped after {n_last} of {t.size - 1} intervals")
+                warnings.warn(message, DivergenceWarning, stacklevel=2)
+                break
     steps = n_computed * substeps
     return Solution(
         t=t[:n_last + 1],
         x=np.moveaxis(out[:n_last + 1], 0, -1),
-        nfev=s * steps,
+        nfev=tab.stages * steps,
         steps=steps,
         method=tab,
         status=status,

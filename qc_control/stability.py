@@ -10,6 +10,7 @@ ODEs II*, §IV.2).
 
 from __future__ import annotations
 
+import functools
 import math
 
 import control
@@ -20,7 +21,8 @@ from numpy.polynomial import Polynomial
 from .methods import get_method
 from .model import QuarterCarParams, quarter_car
 
-__all__ = ["stability_function", "max_stable_step", "numerical_modes", "eigenvalues_of"]
+__all__ = ["stability_function", "stability_coefficients", "amplification", "max_stable_step",
+           "numerical_modes", "eigenvalues_of"]
 
 
 def stability_function(method) -> Polynomial:
@@ -51,6 +53,28 @@ def stability_function(method) -> Polynomial:
     return Polynomial(coef)
 
 
+@functools.lru_cache(maxsize=64)
+def _coefficients(method) -> np.ndarray:
+    coef = stability_function(method).coef
+    coef.flags.writeable = False
+    return coef
+
+
+def stability_coefficients(method) -> np.ndarray:
+    """R(z)'s coefficients, lowest power first (cached per tableau; read-only)."""
+    return _coefficients(get_method(method))
+
+
+def amplification(method, h: float, eigenvalues) -> float:
+    """``max |R(hλ)|``: the spectral radius of the step map ``R(hA)``.
+
+    Above 1 the method's trajectory grows along some mode at this h.
+    """
+    coef = stability_coefficients(method)
+    z = h * np.asarray(eigenvalues, dtype=complex)
+    return float(np.max(np.abs(np.polynomial.polynomial.polyval(z, coef))))
+
+
 def eigenvalues_of(sys_or_eigenvalues) -> np.ndarray:
     """Eigenvalues from a continuous-time StateSpace, parameters, or a list."""
     if isinstance(sys_or_eigenvalues, (QuarterCarParams, dict)):
@@ -66,20 +90,49 @@ def eigenvalues_of(sys_or_eigenvalues) -> np.ndarray:
     return lam
 
 
-def _max_step_one(R: Polynomial, lam: complex) -> float:
-    """Smallest h > 0 where |R(hλ)| crosses 1; 0 if unstable for every h > 0."""
-    if lam == 0:
-        return math.inf
-    # |R(hλ)|² - 1 is a real polynomial in h that vanishes at h = 0; divide by h.
-    r_h = Polynomial(R.coef * lam ** np.arange(R.degree() + 1))  # R(hλ) in h
-    q = (r_h * Polynomial(np.conj(r_h.coef))).coef.real
-    q[0] -= 1.0
-    g = Polynomial(q[1:])
-    if g(0.0) > 0 or (g(0.0) == 0 and abs(R(1e-6 / abs(lam) * lam)) > 1):
-        return 0.0
-    roots = g.roots()
-    positive = [r.real for r in roots if abs(r.imag) <= 1e-9 * abs(r) and r.real > 0]
-    return min(positive) if positive else math.inf
+def _max_steps(R: Polynomial, lams: np.ndarray) -> np.ndarray:
+    """For each λ, the smallest h > 0 where |R(hλ)| crosses 1.
+
+    ``|R(hλ)|² - 1`` is a real polynomial in h with a root at h = 0; the
+    step limit is the smallest positive real root of the quotient by h.
+    All eigenvalues' quotients are solved in one batched eigenvalue call
+    on their companion matrices. ``inf`` when no root bounds the step,
+    ``0`` when the method is unstable for every small h.
+    """
+    coef = R.coef
+    deg = coef.size - 1
+    out = np.full(lams.size, np.inf)
+    nz = lams != 0
+    lam = lams[nz]
+    if not lam.size or deg == 0:
+        return out
+    r = coef[None, :] * lam[:, None] ** np.arange(deg + 1)          # R(hλ) in powers of h
+    q = np.zeros((lam.size, 2 * deg + 1))
+    for a in range(deg + 1):
+        q[:, a:a + deg + 1] += (r[:, a:a + 1] * np.conj(r)).real
+    g = q[:, 1:]                                                     # (|R|² - 1) / h
+    d = g.shape[1] - 1
+    result = np.full(lam.size, np.inf)
+    if d == 0:
+        roots = np.full((lam.size, 1), np.inf + 0j)
+    else:
+        comp = np.zeros((lam.size, d, d))
+        comp[:, 0, :] = -g[:, -2::-1] / g[:, -1:]
+        comp[:, np.arange(1, d), np.arange(d - 1)] = 1.0
+        roots = np.linalg.eigvals(comp)
+    scale = np.abs(roots)
+    ok = (np.abs(roots.imag) <= 1e-9 * np.maximum(scale, 1e-300)) & (roots.real > 0)
+    result = np.where(ok, roots.real, np.inf).min(axis=1)
+    # unstable for every small h: |R|² grows from h = 0 (g(0) > 0), or g(0) = 0
+    # (λ on the imaginary axis) and |R| > 1 just off the origin
+    grows = g[:, 0] > 0
+    flat = g[:, 0] == 0
+    if flat.any():
+        probe = np.abs(R(1e-6 * lam[flat] / np.abs(lam[flat]))) > 1
+        grows[np.flatnonzero(flat)[probe]] = True
+    result[grows] = 0.0
+    out[nz] = result
+    return out
 
 
 def max_stable_step(method, sys_or_eigenvalues) -> float:
@@ -109,8 +162,9 @@ def max_stable_step(method, sys_or_eigenvalues) -> float:
     >>> round(max_stable_step("rk4", QuarterCarParams()), 4)
     0.1085
     """
-    R = stability_function(method)
-    return float(min(_max_step_one(R, complex(lam)) for lam in eigenvalues_of(sys_or_eigenvalues)))
+    lam = eigenvalues_of(sys_or_eigenvalues)
+    lam = np.unique(np.where(lam.imag < 0, lam.conj(), lam))   # a conjugate has the same limit
+    return float(_max_steps(stability_function(method), lam).min())
 
 
 def numerical_modes(method, h: float, sys_or_params=None) -> pd.DataFrame:
