@@ -33,7 +33,7 @@ __all__ = ["step_matrices", "affine_scan", "lti_trajectory"]
 
 def step_matrices(method: ButcherTableau, A: np.ndarray, B: np.ndarray, H: float,
                   substeps: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Φ, Γ₀, Γ₁ of one interval of length H split into ``substeps`` steps.
+    r"""Φ, Γ₀, Γ₁ of one interval of length H split into ``substeps`` steps.
 
     Works on a batch: ``A`` of shape ``(..., n, n)`` and ``B`` of shape
     ``(..., n, m)`` give ``Φ (..., n, n)`` and ``Γ (..., n, m)``.
@@ -77,6 +77,8 @@ def _powers(phi: np.ndarray, L: int) -> np.ndarray:
     n = phi.shape[-1]
     P = np.empty(phi.shape[:-2] + (L + 1, n, n))
     P[..., 0, :, :] = np.eye(n)
+    if L == 0:
+        return P
     P[..., 1, :, :] = phi
     k = 1
     while k < L:
@@ -95,9 +97,30 @@ def _scan(V: np.ndarray, Q: np.ndarray) -> None:
         d *= 2
 
 
+def _free_response(phi, x0, N, C, time_last):
+    """``x_k = Φ^k x0`` with no recurrence: ``x_{j·nb+b} = (Φ^nb)^j Φ^b x0``.
+
+    Two power tables of ~√N entries and one product, whose result is laid
+    out (signal, j, b), i.e. time-last in time order.
+    """
+    n = phi.shape[-1]
+    batch = phi.shape[:-2]
+    nb = max(1, math.ceil(math.sqrt(N)))
+    L = math.ceil(N / nb)
+    Pb = _powers(phi, nb)
+    xb = (Pb[..., :nb, :, :] @ x0[..., None, :, None])[..., 0]      # (..., b, a): Φ^b x0
+    Pj = _powers(Pb[..., nb, :, :], L - 1)                           # (Φ^nb)^j
+    obs = Pj if C is None else C[..., None, :, :] @ Pj               # (..., j, r, a)
+    p = obs.shape[-2]
+    lhs = np.swapaxes(obs, -3, -2).reshape(batch + (p * L, n))       # rows (r, j)
+    out = (lhs @ np.swapaxes(xb, -1, -2)).reshape(batch + (p, L * nb))[..., :N]
+    return out if time_last else np.swapaxes(out, -1, -2)
+
+
 def affine_scan(phi: np.ndarray, x0: np.ndarray, W: np.ndarray | None, N: int,
-                block: int = 16) -> np.ndarray:
-    """Solve ``x_0 = x0``, ``x_{k+1} = Φ x_k + W_k`` for k < N-1.
+                block: int = 16, C: np.ndarray | None = None,
+                time_last: bool = False) -> np.ndarray:
+    r"""Solve ``x_0 = x0``, ``x_{k+1} = Φ x_k + W_k`` for k < N-1; return x or C x.
 
     Parameters
     ----------
@@ -108,14 +131,22 @@ def affine_scan(phi: np.ndarray, x0: np.ndarray, W: np.ndarray | None, N: int,
         Number of samples.
     block : int, default 16
         Block length L.
+    C : array, shape (..., p, n), optional
+        Return ``y_k = C x_k`` instead of the states, computed without
+        forming them (``C Φ^j`` is folded into the last product).
+    time_last : bool, default False
+        Return ``(..., p, N)`` (time last, contiguous per signal) instead
+        of ``(..., N, p)``, without a separate transposing copy.
 
     Returns
     -------
-    array, shape (..., N, n)
+    array, shape (..., N, p): p = n, or the rows of ``C``
 
     Notes
     -----
-    With ``c_b`` the state at the start of block ``b``,
+    Without input (``W = None``) there is no recurrence to solve:
+    ``x_{j·nb+b} = (Φ^nb)^j Φ^b x0`` with ``nb ≈ √N``. With input, and
+    ``c_b`` the state at the start of block ``b``,
 
     .. math::
 
@@ -132,33 +163,42 @@ def affine_scan(phi: np.ndarray, x0: np.ndarray, W: np.ndarray | None, N: int,
     x0 = np.broadcast_to(np.asarray(x0, dtype=float), batch + (n,))
     if N == 1:
         return x0[..., None, :].copy()
+    if W is None:
+        return _free_response(phi, x0, N, C, time_last)
     L = max(1, min(block, N - 1))
     nb = -(-(N - 1) // L)
     P = _powers(phi, L)
-    # V: the carries' scan input; V_0 = x0, V_{b+1} = Y_{b,L}
-    V = np.zeros(batch + (nb + 1, n))
+    # Y_{b, q+1} for every block: one product with the block-Toeplitz matrix
+    # M[(i, a), (q, c)] = (Φ^{q-i})[c, a] for i <= q (row block i feeds Y_{b, q+1})
+    Wb = np.zeros(batch + (nb * L, n))
+    Wb[..., :N - 1, :] = W
+    lag = np.arange(L)[None, :] - np.arange(L)[:, None]              # q - i
+    M = np.swapaxes(P[..., np.clip(lag, 0, L), :, :], -1, -2)         # (..., i, q, a, c)
+    M = np.swapaxes(M * (lag >= 0)[:, :, None, None], -3, -2).reshape(batch + (L * n, L * n))
+    Y = (Wb.reshape(batch + (nb, L * n)) @ M).reshape(batch + (nb, L, n))
+    # the carries c_b: V_0 = x0, V_{b+1} = Y_{b,L}, scanned with powers of Φ^L
+    V = np.empty(batch + (nb + 1, n))
     V[..., 0, :] = x0
-    if W is not None:
-        Wb = np.zeros(batch + (nb * L, n))
-        Wb[..., :N - 1, :] = W
-        Wb = Wb.reshape(batch + (nb, L * n))
-        # M[(i, a), (q, c)] = (Φ^{q-i})[c, a] for i <= q: row block i feeds Y_{b, q+1}
-        lag = np.arange(L)[None, :] - np.arange(L)[:, None]          # q - i
-        M = np.swapaxes(P[..., np.clip(lag, 0, L), :, :], -1, -2)     # (..., i, q, a, c)
-        M = M * (lag >= 0)[:, :, None, None]
-        M = np.swapaxes(M, -3, -2).reshape(batch + (L * n, L * n))    # (..., (i,a), (q,c))
-        Y = (Wb @ M).reshape(batch + (nb, L, n))                      # Y_{b, q+1}
-        V[..., 1:, :] = Y[..., :, L - 1, :]
+    V[..., 1:, :] = Y[..., :, L - 1, :]
     _scan(V, P[..., L, :, :])
-    # x_{bL+j} = Φ^j c_b: one product with [Φ^0ᵀ ... Φ^{L-1}ᵀ]
-    stacked = np.swapaxes(np.swapaxes(P[..., :L, :, :], -1, -2), -3, -2)  # (..., a, j, c)
-    body = (V[..., :nb, :] @ stacked.reshape(batch + (n, L * n))).reshape(batch + (nb, L, n))
-    if W is not None:
-        body[..., :, 1:, :] += Y[..., :, :L - 1, :]
-    X = np.empty(batch + (nb * L + 1, n))
-    X[..., :nb * L, :] = body.reshape(batch + (nb * L, n))
-    X[..., nb * L, :] = V[..., nb, :]
-    return X[..., :N, :]
+    # x_{bL+j} = Φ^j c_b + Y_{b,j}: one product with [Φ^0ᵀ ... Φ^{L-1}ᵀ] (or [(CΦ^j)ᵀ])
+    obs = P[..., :L, :, :] if C is None else C[..., None, :, :] @ P[..., :L, :, :]
+    p = obs.shape[-2]
+    stacked = np.swapaxes(np.swapaxes(obs, -1, -2), -3, -2)           # (..., a, j, r)
+    body = (V[..., :nb, :] @ stacked.reshape(batch + (n, L * p))).reshape(batch + (nb, L, p))
+    body[..., :, 1:, :] += (Y if C is None else
+                            Y @ np.swapaxes(C, -1, -2)[..., None, :, :])[..., :, :L - 1, :]
+    last = V[..., nb, :]
+    last = last if C is None else (C @ last[..., None])[..., 0]
+    if time_last:
+        out = np.empty(batch + (p, nb * L + 1))
+        out[..., :nb * L].reshape(batch + (p, nb, L))[...] = np.moveaxis(body, -1, -3)
+        out[..., nb * L] = last
+        return out[..., :N]
+    out = np.empty(batch + (nb * L + 1, p))
+    out[..., :nb * L, :] = body.reshape(batch + (nb * L, p))
+    out[..., nb * L, :] = last
+    return out[..., :N, :]
 
 
 def lti_trajectory(method: ButcherTableau, A, B, T: np.ndarray, U: np.ndarray | None,
