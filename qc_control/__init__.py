@@ -12,6 +12,7 @@ from .model import OUTPUTS, STATES, QuarterCarParams, load_config, quarter_car, 
 from .response import FixedStepResponse, forced_response, initial_response
 from .stability import max_stable_step, numerical_modes, stability_function
 from .compare import MethodComparison, compare_methods
+from .sweeps import METRICS, SweepResult, design_grid, sweep
 
 __version__ = "0.1.0"
 __all__ = [
@@ -22,4 +23,5 @@ __all__ = [
     "initial_response", "forced_response", "FixedStepResponse",
     "stability_function", "max_stable_step", "numerical_modes",
     "compare_methods", "MethodComparison",
+    "sweep", "SweepResult", "design_grid", "METRICS",
 ]

@@ -1,0 +1,153 @@
+"""sweep(): equal to single runs, independent of executor and chunking, robust to bad designs."""
+import warnings
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+
+import control
+import numpy as np
+import pytest
+
+import qc_control as qc
+from qc_control.sweeps import METRICS, design_grid, sweep
+
+T = np.linspace(0, 5, 2001)          # h = 2.5 ms
+X0 = [0.0, 0.0, 0.05, 0.0]
+GRID = {"ks": [2e4, 3e4, 4.5e4], "zeta": [0.1, 0.3, 0.6], "mu": [40.0, 100.0]}
+
+
+def independent_metrics(y, T):
+    """The four metrics written plainly, on (5, N) outputs of one run."""
+    xs = y[0]
+    dev = np.abs(xs - xs[-1])
+    outside = np.flatnonzero(dev > 0.02 * dev.max())
+    settle = T[min(outside[-1] + 1, T.size - 1)] if outside.size else T[0]
+    return {"peak_travel [m]": np.max(np.abs(y[2])),
+            "rms_body_acc [m/s²]": np.sqrt(np.trapezoid(y[4] ** 2, T) / (T[-1] - T[0])),
+            "settling_time [s]": settle,
+            "peak_tire_defl [m]": np.max(np.abs(y[3]))}
+
+
+@pytest.fixture(scope="module")
+def grid_result():
+    return sweep(GRID, T, X0, states=True, progress=False)
+
+
+def test_grid_is_the_cartesian_product(grid_result):
+    assert len(grid_result.metrics) == 18
+    assert list(grid_result.metrics[["ks", "zeta", "mu"]].iloc[1]) == [2e4, 0.1, 100.0]
+    # zeta sets cs along the grid: cs = 2 zeta sqrt(ks ms)
+    row = grid_result.metrics.iloc[5]
+    assert row["cs"] == pytest.approx(2 * row["zeta"] * np.sqrt(row["ks"] * row["ms"]))
+
+
+def test_equal_to_single_runs(grid_result):
+    for i, d in enumerate(design_grid(GRID)):
+        sys = qc.quarter_car(qc.QuarterCarParams(**d))
+        single = qc.initial_response(sys, T, X0, method="rk4", engine="generic")
+        # the same method computed two ways: rounding only (1e-12 of the 5 cm scale)
+        np.testing.assert_allclose(grid_result.states[i], single.states, rtol=0, atol=1e-12)
+        expected = independent_metrics(single.outputs, T)
+        for name, value in expected.items():
+            assert grid_result.metrics.loc[i, name] == pytest.approx(value, rel=1e-9, abs=1e-12)
+
+
+def test_rk4_sweep_against_control_exact():
+    """RK4 at h = 1 ms: peak travel within 1e-8 m of the exact response's."""
+    T1 = np.linspace(0, 5, 5001)
+    r = sweep([qc.QuarterCarParams(), qc.QuarterCarParams(ks=4e4, zeta=0.4)], T1, X0,
+              progress=False)
+    for i, p in enumerate([qc.QuarterCarParams(), qc.QuarterCarParams(ks=4e4, zeta=0.4)]):
+        exact = control.initial_response(qc.quarter_car(p), T1, X0).outputs
+        assert abs(r.metrics.loc[i, "peak_travel [m]"] - np.max(np.abs(exact[2]))) < 1e-8
+
+
+def test_road_sweep_equals_forced_response():
+    U = np.where(T >= 0.5, 0.05, 0.0)
+    designs = [qc.QuarterCarParams(), qc.QuarterCarParams(zeta=0.5, ku=2e5)]
+    r = sweep(designs, T, np.zeros(4), U=U, method="heun", states=True, progress=False)
+    for i, p in enumerate(designs):
+        single = qc.forced_response(qc.quarter_car(p, road=True), T, U, method="heun",
+                                    engine="generic")
+        np.testing.assert_allclose(r.states[i], single.states, rtol=0, atol=1e-12)
+        expected = independent_metrics(single.outputs, T)
+        assert r.metrics.loc[i, "peak_tire_defl [m]"] == pytest.approx(
+            expected["peak_tire_defl [m]"], rel=1e-9)
+
+
+def test_chunking_and_executors_do_not_change_results(grid_result):
+    ref = grid_result.metrics
+    cols = list(METRICS)
+    for kwargs in (dict(chunk_size=1), dict(chunk_size=7), dict(chunk_size=1000),
+                   dict(executor=ThreadPoolExecutor(2), chunk_size=4)):
+        other = sweep(GRID, T, X0, progress=False, **kwargs).metrics
+        # each design's arithmetic is the same whatever its chunk: agree to 1e-13
+        np.testing.assert_allclose(other[cols].to_numpy(), ref[cols].to_numpy(), rtol=1e-13)
+    with ProcessPoolExecutor(2) as pool:
+        other = sweep(GRID, T, X0, executor=pool, chunk_size=5, progress=False).metrics
+    np.testing.assert_allclose(other[cols].to_numpy(), ref[cols].to_numpy(), rtol=1e-13)
+
+
+def test_dask_local_cluster(grid_result):
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        other = sweep(GRID, T, X0, executor=client.get_executor(), chunk_size=4,
+                      progress=False).metrics
+    cols = list(METRICS)
+    np.testing.assert_allclose(other[cols].to_numpy(), grid_result.metrics[cols].to_numpy(),
+                               rtol=1e-13)
+
+
+def test_bad_designs_are_reported_and_nothing_else_is_lost(grid_result):
+    # designs in order: (300, ok) (300, nan) (-5, ok) (-5, nan) (400, ok) (400, nan)
+    grid = {"ms": [300.0, -5.0, 400.0], "ku": [29530.0, float("nan")]}
+    with pytest.warns(RuntimeWarning, match="4 of 6 designs were rejected"):
+        r = sweep(grid, T, X0, progress=False)
+    assert list(r.errors["index"]) == [1, 2, 3, 5]
+    assert "ku must be finite, got nan" in r.errors.loc[0, "error"]
+    assert "ms (sprung mass) must be > 0 kg, got -5.0" in r.errors.loc[1, "error"]
+    assert r.errors.loc[1, "value"]["ms"] == -5.0
+    good = r.metrics[r.metrics["error"] == ""]
+    assert list(good.index) == [0, 4] and good[list(METRICS)].notna().all().all()
+    assert r.metrics.loc[1, list(METRICS)].isna().all()
+    alone = sweep([qc.QuarterCarParams(ms=400.0)], T, X0, progress=False).metrics
+    assert r.metrics.loc[4, "peak_travel [m]"] == pytest.approx(alone.loc[0, "peak_travel [m]"],
+                                                                 rel=1e-13)
+
+
+def test_unstable_designs_are_flagged():
+    r = sweep([qc.QuarterCarParams(), qc.QuarterCarParams(ku=3e6)], np.linspace(0, 1, 101), X0,
+              method="euler", progress=False)
+    # h = 10 ms: fine for the seed (limit 19.8 ms), not for a 3e6 N/m tire
+    assert list(r.metrics["stable"]) == [True, False]
+
+
+def test_progress_bar_when_asked(capsys):
+    sweep([qc.QuarterCarParams()] * 3, T, X0, progress=True, chunk_size=1)
+    assert "sweep" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("kwargs, error, words", [
+    (dict(designs={"kt": [1.0]}), ValueError, "unknown parameter 'kt' in the grid"),
+    (dict(designs=[]), ValueError, "designs is empty"),
+    (dict(T=[0, 0.1, 0.3]), ValueError, "uniformly spaced"),
+    (dict(X0=[0, 0.05]), ValueError, "X0 must be 4 finite numbers"),
+    (dict(U=np.zeros(5)), ValueError, "U must be 2001 finite road heights"),
+    (dict(chunk_size=0), ValueError, "chunk_size must be a positive integer"),
+    (dict(metrics=["comfort"]), ValueError, "unknown metric 'comfort'"),
+    (dict(executor="pool"), TypeError, "executor must be a concurrent.futures.Executor"),
+    (dict(method="rk5"), ValueError, "unknown method"),
+])
+def test_bad_input(kwargs, error, words):
+    args = dict(designs=[qc.QuarterCarParams()], T=T, X0=X0)
+    args.update(kwargs)
+    with pytest.raises(error, match=words):
+        sweep(args.pop("designs"), args.pop("T"), args.pop("X0"), progress=False, **args)
+
+
+def test_custom_metric_and_states_off():
+    r = sweep([qc.QuarterCarParams()], T, X0, metrics={"final xs [m]": lambda T, y: y[:, 0, -1]},
+              progress=False)
+    assert r.states is None and list(r.metrics.columns)[-2] == "final xs [m]"
+    exact = control.initial_response(qc.quarter_car(), T, X0).outputs[0, -1]
+    assert r.metrics.loc[0, "final xs [m]"] == pytest.approx(exact, abs=1e-8)
