@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import datetime as dt
-import math
 import platform
 import sys
 import time
@@ -25,21 +24,15 @@ import scipy
 from scipy.integrate import solve_ivp
 
 import qc_control as qc
+from qc_control.compare import best_time
 from qc_control.sweeps import design_grid, sweep
 
 X0 = np.array([0.0, 0.0, 0.05, 0.0])
 
 
 def best_of(fn, repeats: int) -> float:
-    """Best wall time [s] of ``repeats`` calls (the least disturbed one), after one
-    untimed warm-up call (first-call costs: caches, fresh memory pages)."""
-    fn()
-    best = math.inf
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - start)
-    return best
+    """Best of ``repeats`` timed calls after one untimed warm-up call."""
+    return best_time(fn, repeats, warmup=True)
 
 
 # -- hand-written loops: what a student writes, the yardstick for the generic stepper

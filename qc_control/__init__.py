@@ -1,9 +1,9 @@
 """qc_control: quarter-car suspension models on python-control.
 
 The quarter car of the seed paper as a `control.StateSpace`, its modal
-analysis, and the seed's four fixed-step methods (Euler, Midpoint, Heun,
-RK4) as python-control-compatible responses, measured against the exact
-response.
+analysis, the seed's four fixed-step methods (Euler, Midpoint, Heun, RK4)
+as python-control-compatible responses measured against the exact response,
+fast LTI and sweep engines, ISO 8608 roads and ISO 2631-1 ride metrics.
 """
 from .integrate import DivergenceWarning, Solution, integrate
 from .methods import METHODS, ButcherTableau, get_method
@@ -13,6 +13,9 @@ from .response import FixedStepResponse, forced_response, initial_response
 from .stability import max_stable_step, numerical_modes, stability_function
 from .compare import MethodComparison, compare_methods
 from .sweeps import METRICS, SweepResult, design_grid, sweep
+from . import road
+from .ride import (Transmissibility, ride_metrics, ride_metrics_spectral, transmissibility,
+                   wk_filter)
 
 __version__ = "0.1.0"
 __all__ = [
@@ -24,4 +27,6 @@ __all__ = [
     "stability_function", "max_stable_step", "numerical_modes",
     "compare_methods", "MethodComparison",
     "sweep", "SweepResult", "design_grid", "METRICS",
+    "road", "transmissibility", "Transmissibility", "ride_metrics", "ride_metrics_spectral",
+    "wk_filter",
 ]

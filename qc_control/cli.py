@@ -56,7 +56,10 @@ def _cmd_modes(args) -> int:
     return 0
 
 
-_SCENARIO_KEYS = {"h", "t_end", "x0", "methods"}
+_SCENARIO_KEYS = {"h", "t_end", "x0", "methods", "road", "road_class", "speed", "seed"}
+_ROADS = ("step", "bump", "sine", "iso8608")
+#: Default steps tried, largest first, when an ISO 8608 road needs a finer one.
+_NICE_STEPS = (0.01, 0.005, 0.002, 0.001, 5e-4, 2e-4, 1e-4)
 
 
 def _floats(text: str, name: str, count: int) -> tuple[float, ...]:
@@ -79,8 +82,25 @@ def _scenario(args, table: dict) -> dict:
     if unknown:
         raise UsageError(f"unknown [scenario] key {unknown[0]!r}; expected one of "
                          f"{sorted(_SCENARIO_KEYS)}")
-    h = args.h if args.h is not None else table.get("h", DEFAULT_H)
-    t_end = args.t_end if args.t_end is not None else table.get("t_end", DEFAULT_T_END)
+    pick = lambda name, default: (getattr(args, name) if getattr(args, name) is not None  # noqa
+                                  else table.get(name, default))
+    road = pick("road", None)
+    if road is not None and road not in _ROADS:
+        raise UsageError(f"--road must be one of {', '.join(_ROADS)}, got {road!r}")
+    road_class, speed, seed = pick("road_class", "C"), pick("speed", 20.0), pick("seed", 0)
+    if road != "iso8608" and (args.road_class is not None or args.seed is not None):
+        raise UsageError("--road-class and --seed apply to --road iso8608 only")
+    if isinstance(speed, bool) or not isinstance(speed, (int, float)) \
+            or not math.isfinite(speed) or speed <= 0:
+        raise UsageError(f"--speed must be a finite number > 0 m/s, got {speed!r}")
+    h = pick("h", None)
+    if h is None:
+        h = DEFAULT_H
+        if road == "iso8608":
+            from .road import largest_step
+            limit = largest_step(speed)
+            h = next((c for c in _NICE_STEPS if c <= limit), _NICE_STEPS[-1])
+    t_end = pick("t_end", DEFAULT_T_END)
     for name, value in (("h", h), ("t-end", t_end)):
         if isinstance(value, bool) or not isinstance(value, (int, float)) \
                 or not math.isfinite(value) or value <= 0:
@@ -89,18 +109,38 @@ def _scenario(args, table: dict) -> dict:
     if steps < 2 or abs(steps * h - t_end) > 1e-9 * t_end:
         raise UsageError(f"--t-end {t_end!r} s must be a whole number (>= 2) of steps "
                          f"--h {h!r} s")
-    x0 = args.x0 if args.x0 is not None else table.get("x0", DEFAULT_X0)
+    x0 = pick("x0", DEFAULT_X0 if road is None else (0.0, 0.0, 0.0, 0.0))
     x0 = _floats(x0 if isinstance(x0, str) else ",".join(map(str, x0)), "--x0", 4)
     if not all(math.isfinite(v) for v in x0):
         raise UsageError(f"--x0 must be finite, got {x0!r}")
-    methods = args.methods if args.methods is not None else table.get("methods", DEFAULT_METHODS)
+    methods = pick("methods", DEFAULT_METHODS)
     if isinstance(methods, str):
         methods = [m.strip() for m in methods.split(",") if m.strip()]
     tabs = [get_method(m) for m in methods]
     if not tabs:
         raise UsageError("--methods must name at least one method")
     return {"h": float(h), "t_end": float(t_end), "steps": int(steps), "x0": x0,
-            "methods": tuple(t.name for t in tabs)}
+            "methods": tuple(t.name for t in tabs), "road": road, "road_class": road_class,
+            "speed": float(speed), "seed": seed}
+
+
+def _road_input(sc: dict, T):
+    """(zr samples, description) for the scenario's road, or (None, '')."""
+    from . import road
+
+    kind = sc["road"]
+    if kind is None:
+        return None, ""
+    if kind == "step":
+        return road.step(T), "a 5 cm road step at t = 0.5 s"
+    if kind == "bump":
+        return (road.bump(T, speed=sc["speed"]),
+                f"a 5 cm, 1 m long 1 − cos bump at t = 0.5 s, at {sc['speed']:g} m/s")
+    if kind == "sine":
+        return road.sine(T), "a sinusoidal road, 1 cm amplitude at 1 Hz"
+    return (road.iso8608(T, sc["road_class"], sc["speed"], sc["seed"]),
+            f"an ISO 8608 class {str(sc['road_class']).upper()} road at {sc['speed']:g} m/s "
+            f"(seed {sc['seed']})")
 
 
 def _cmd_report(args) -> int:
@@ -123,13 +163,16 @@ def _cmd_report(args) -> int:
         raise ReportError(f"refusing to overwrite {out!r}: it is not a qc-control report "
                           f"(no {MARKER} file); choose another --out")
     T = np.linspace(0.0, sc["t_end"], sc["steps"] + 1)
+    U, description = _road_input(sc, T)        # validated before any output
 
     def progress(message):
         print(f"  {message}", file=sys.stderr, flush=True)
 
     print(f"qc-control report: comparing {', '.join(sc['methods'])} at h = {sc['h']:g} s "
-          f"over 0-{sc['t_end']:g} s", file=sys.stderr, flush=True)
-    cmp = compare_methods(params, T, sc["x0"], methods=sc["methods"], progress=progress)
+          f"over 0-{sc['t_end']:g} s" + (f" on {description}" if description else ""),
+          file=sys.stderr, flush=True)
+    cmp = compare_methods(params, T, sc["x0"], U=U, methods=sc["methods"], progress=progress,
+                          input_description=description)
     command = "qc-control " + shlex.join(args.argv)
     path = write_report(cmp, out, command=command)
     with pd.option_context("display.width", 160, "display.max_columns", 20,
@@ -157,6 +200,13 @@ def build_parser() -> argparse.ArgumentParser:
                                                        "(default 0,0,0.05,0)")
     sc.add_argument("--methods", metavar="A,B,...",
                     help="methods to compare (default euler,midpoint,heun,rk4)")
+    rd = report.add_argument_group("road input (default: none, the free response)")
+    rd.add_argument("--road", metavar="KIND", help="step, bump, sine or iso8608; the car "
+                    "then starts at rest unless --x0 is given")
+    rd.add_argument("--road-class", metavar="A-H", help="ISO 8608 class (default C)")
+    rd.add_argument("--speed", type=float, metavar="M/S",
+                    help="vehicle speed for bump and iso8608 [m/s] (default 20)")
+    rd.add_argument("--seed", type=int, metavar="N", help="ISO 8608 road seed (default 0)")
     report.add_argument("--out", default="report", metavar="DIR",
                         help="report directory (default report/); replaced only if it "
                              "holds an earlier report")

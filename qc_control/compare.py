@@ -73,6 +73,11 @@ class MethodComparison:
         independent exact evaluation (see `compare_methods`).
     responses : dict[str, FixedStepResponse]
         Each method's response at the chosen h.
+    ride : pandas.DataFrame or None
+        Under a road input: `qc_control.ride_metrics` of the reference
+        (first row) and of each method.
+    transmissibility : Transmissibility or None
+        Under a road input: the road-to-ride frequency responses.
     """
 
     system: control.StateSpace
@@ -98,6 +103,8 @@ class MethodComparison:
     responses: dict
     eigenvalues: np.ndarray
     input_description: str = ""
+    ride: pd.DataFrame | None = None
+    transmissibility: object | None = None
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""
@@ -114,7 +121,13 @@ class MethodComparison:
                             overwrite=overwrite)
 
 
-def _best_time(fn: Callable[[], object], repeats: int) -> float:
+def best_time(fn: Callable[[], object], repeats: int, warmup: bool = False) -> float:
+    """Best wall time [s] of ``repeats`` calls of ``fn``: the least disturbed one.
+
+    ``warmup`` makes one untimed call first (caches, fresh memory pages).
+    """
+    if warmup:
+        fn()
     best = math.inf
     for _ in range(repeats):
         start = time.perf_counter()
@@ -249,7 +262,9 @@ def _limiting_mode(method, modes: ModalAnalysis) -> str:
 
 def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = DEFAULT_METHODS,
                     h: float | None = None, repeats: int = 5,
-                    progress: Callable[[str], None] | None = None) -> MethodComparison:
+                    progress: Callable[[str], None] | None = None,
+                    input_description: str = "",
+                    params: QuarterCarParams | None = None) -> MethodComparison:
     """Compare fixed-step methods with python-control's exact response.
 
     Parameters
@@ -271,6 +286,12 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
         Wall times are the best of this many runs.
     progress : callable, optional
         Called with a short message as each method starts.
+    input_description : str, optional
+        What the input is (e.g. "ISO 8608 class C road at 20 m/s"), for
+        the report.
+    params : QuarterCarParams, optional
+        The vehicle behind ``sys`` when ``sys`` is a system: the ride
+        metrics need its masses for the static wheel load.
 
     Returns
     -------
@@ -284,9 +305,10 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
     (``rms``) differences over ``T``, and the difference at the last time.
     The observed order is the least-squares slope of log max-error against
     log h over h, h/2 and h/4, leaving out errors below 1e-13 m (rounding).
-    Each mode's error is ``numerical_modes`` at the chosen h.
+    Each mode's error is ``numerical_modes`` at the chosen h. Under a road
+    input (``'zr'``) the comparison also holds `qc_control.ride_metrics`
+    of the reference and of each method, and the transmissibility.
     """
-    params = None
     if sys is None or isinstance(sys, (QuarterCarParams, dict)):
         params = sys if isinstance(sys, QuarterCarParams) else QuarterCarParams(**(sys or {}))
         sys = quarter_car(params, road=U is not None)
@@ -310,7 +332,7 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
     modes = modal_analysis(sys)
     eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
     reference = _exact(sys, T, X0, U)
-    reference_time = _best_time(lambda: _exact(sys, T, X0, U), repeats)
+    reference_time = best_time(lambda: _exact(sys, T, X0, U), repeats)
     reference_error, how = _reference_accuracy(sys, T, X0, U, reference)
     exact_levels = {lvl: _exact(sys, _refined(T, lvl), X0, _refined_input(T, U, lvl)).outputs
                     for lvl in range(_LEVELS + 1)}
@@ -323,7 +345,7 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
         h_max = max_stable_step(tab, eig)
         resp = _simulate(sys, T, X0, U, tab, substeps)
         responses[tab.name] = resp
-        wall = _best_time(lambda: _simulate(sys, T, X0, U, tab, substeps), repeats)
+        wall = best_time(lambda: _simulate(sys, T, X0, U, tab, substeps), repeats)
         n = resp.time.size
         err = resp.outputs - reference.outputs[:, :n]
         if n < T.size:  # diverged: the missing samples count as infinitely wrong
@@ -333,7 +355,7 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
             Tl = _refined(T, lvl)
             r = resp if lvl == 0 else _simulate(sys, Tl, X0, _refined_input(T, U, lvl), tab,
                                                  substeps)
-            t_run = wall if lvl == 0 else _best_time(
+            t_run = wall if lvl == 0 else best_time(
                 lambda: _simulate(sys, Tl, X0, _refined_input(T, U, lvl), tab, substeps), 1)
             e = r.outputs[0] - exact_levels[lvl][0, :r.time.size]
             error = float(np.max(np.abs(e))) if r.time.size == Tl.size else math.inf
@@ -365,6 +387,14 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
     table = pd.DataFrame.from_dict(rows, orient="index")
     table.index.name = "method"
     convergence = pd.DataFrame(conv_rows)
+    ride, trans = None, None
+    if U is not None and "zr" in sys.input_labels and sys.ninputs == 1 and params is not None:
+        from .ride import ride_metrics, transmissibility
+
+        ride = pd.DataFrame({"reference": ride_metrics(reference, params),
+                             **{m: ride_metrics(r, params) for m, r in responses.items()}}).T
+        ride.index.name = "response"
+        trans = transmissibility(sys)
     reach = {tab.name: _cost_to_reach(convergence, tab, span, rows[tab.name]["h_max [s]"])
              for tab in tabs}
     cost = pd.DataFrame({m: {tol: v[0] for tol, v in r.items()} for m, r in reach.items()})
@@ -378,4 +408,5 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
         reference_description=how, responses=responses, eigenvalues=eig,
         reference_name=(f"control.{'initial' if U is None else 'forced'}_response "
                         f"(python-control {control.__version__})"),
+        input_description=input_description, ride=ride, transmissibility=trans,
     )

@@ -176,3 +176,28 @@ def test_cli_refuses_foreign_directory(tmp_path, capsys):
     (tmp_path / "notes.txt").write_text("x")
     assert main(["report", "--out", str(tmp_path)]) == 2
     assert "refusing to overwrite" in capsys.readouterr().err
+
+
+def test_road_report_has_the_ride_section(tmp_path, capsys):
+    out = tmp_path / "road"
+    assert main(["report", "--road", "iso8608", "--road-class", "B", "--speed", "15",
+                 "--t-end", "4", "--methods", "heun,rk4", "--out", str(out)]) == 0
+    text = (out / "report.md").read_text()
+    assert "## Road and ride" in text and "class B road at 15 m/s" in text
+    assert (out / "transmissibility.png").exists() and (out / "road.png").exists()
+    assert "rms body_acc Wk" in text and "On this road the exact Wk-weighted" in text
+    # 15 m/s: the band needs h <= 1/(2*15*2.83) = 11.8 ms, so the default 10 ms stands
+    assert "h = 0.01 s" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--road", "gravel"], "--road must be one of step, bump, sine, iso8608"),
+    (["--road", "iso8608", "--road-class", "Z"], "unknown ISO 8608 road class 'Z'"),
+    (["--road", "iso8608", "--speed", "-3"], "--speed must be a finite number > 0 m/s"),
+    (["--road", "iso8608", "--h", "0.01"], "too coarse for an ISO 8608 road at 20 m/s"),
+    (["--road", "step", "--road-class", "B"], "apply to --road iso8608 only"),
+])
+def test_road_cli_bad_input(args, words, tmp_path, capsys):
+    assert main(["report", "--out", str(tmp_path / "r"), *args]) == 2
+    err = capsys.readouterr().err
+    assert words in err and err.count("\n") == 1

@@ -20,7 +20,7 @@ import pandas as pd
 
 from .document import Code, Heading, Image, Paragraph, Table, fmt, to_html, to_markdown
 from .figures import (convergence_figure, error_figure, method_figure, overlay_figure,
-                      stability_figure, work_precision_figure)
+                      road_figure, stability_figure, work_precision_figure)
 from .findings import findings
 
 __all__ = ["write_report", "build_blocks", "ReportError", "MARKER", "FORMATS"]
@@ -76,6 +76,14 @@ def _figures(cmp) -> list[tuple[str, str, object]]:
         ("stability.png", "Stability regions |R(z)| ≤ 1 with hλ of each mode",
          lambda: stability_figure(cmp)),
     ]
+    if cmp.ride is not None:
+        figs += [
+            ("road.png", "The road input and the body's exact response",
+             lambda: road_figure(cmp)),
+            ("transmissibility.png", "Transmissibility from the road height zr (magnitude "
+             "and phase); the circle is the invariant point √(ku/mu), where |body_acc/zr| = "
+             "ku/ms for every damper", lambda: cmp.transmissibility.figure()),
+        ]
     return figs
 
 
@@ -150,6 +158,18 @@ def build_blocks(cmp, command: str | None = None) -> list:
                         f"Step limit and each mode as the method sees it at h = {fmt(cmp.h)} s "
                         "(frequency error of the damped frequency; zeta err = ζ_h − ζ)"))
 
+    if cmp.ride is not None:
+        blocks += [Heading("Road and ride"), Image(*figs["road.png"]),
+                   Image(*figs["transmissibility.png"]),
+                   Table(cmp.ride, "Ride metrics of each method and of the exact reference "
+                                   "(ISO 2631-1 Wk weighting; tire load over the static "
+                                   "wheel load (ms + mu)·g)")]
+        numeric = cmp.ride.drop(columns=["lift-off"]).astype(float)
+        ref = numeric.loc["reference"]
+        rel = 100 * (numeric.drop(index="reference") - ref) / ref.where(ref != 0)
+        rel = rel.drop(columns=["lift-off time [s]"])
+        rel.columns = [c.split(" [")[0] + " [% off]" for c in rel.columns]
+        blocks.append(Table(rel, "Each method's ride metrics against the reference [%]"))
     blocks.append(Heading("Findings"))
     blocks += [Paragraph(text) for text in findings(cmp)]
 

@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 from ..stability import stability_function
 
 __all__ = ["method_figure", "overlay_figure", "error_figure", "convergence_figure",
-           "work_precision_figure", "stability_figure"]
+           "work_precision_figure", "stability_figure", "road_figure"]
 
 _MM = 1e3
 
@@ -153,4 +153,18 @@ def stability_figure(cmp) -> Figure:
            title=f"Stability regions; modes at h = {cmp.h:g} s")
     ax.legend([h for h, _ in handles], [t for _, t in handles], fontsize="small",
               loc="upper left")
+    return fig
+
+
+def road_figure(cmp) -> Figure:
+    """The road input zr against time, and the body's exact response to it."""
+    ref = cmp.reference
+    fig = Figure(figsize=(7.5, 3.6), layout="constrained")
+    ax = fig.subplots()
+    ax.plot(cmp.T, cmp.U[0] * _MM, color="0.3", lw=1, label="road zr")
+    ax.plot(ref.time, ref.outputs[0] * _MM, "r-", lw=1, label="body xs (exact)")
+    ax.set(xlabel="time [s]", ylabel="height [mm]",
+           title=cmp.input_description or "Road input")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small")
     return fig

@@ -113,7 +113,26 @@ def _orders(cmp) -> list[str]:
     return out
 
 
+def _ride(cmp) -> list[str]:
+    if cmp.ride is None:
+        return []
+    key = "rms body_acc Wk [m/s²]"
+    ref = float(cmp.ride.loc["reference", key])
+    parts = []
+    for m in cmp.ride.index.drop("reference"):
+        off = 100 * (float(cmp.ride.loc[m, key]) - ref) / ref
+        parts.append(f"{m} {off:+.2g}%")
+    lift = bool(cmp.ride.loc["reference", "lift-off"])
+    return [f"On this road the exact Wk-weighted body acceleration is {fmt(ref)} m/s² RMS "
+            f"(ISO 2631-1); at h = {fmt(cmp.h)} s the methods give it " + ", ".join(parts)
+            + ". " + ("The dynamic tire load exceeds the static wheel load: the wheel would "
+                      "lift off, which this linear model does not represent." if lift else
+                      f"The RMS dynamic tire load is "
+                      f"{fmt(float(cmp.ride.loc['reference', 'rms tire load / static [-]']))} "
+                      "of the static wheel load, and the wheel never lifts off.")]
+
+
 def findings(cmp) -> list[str]:
     """Sentences that state what the numbers of ``cmp`` show."""
     return (_cheapest(cmp) + _step_limits(cmp) + _coincidence(cmp) + _damping(cmp)
-            + _orders(cmp))
+            + _orders(cmp) + _ride(cmp))

@@ -1,0 +1,198 @@
+"""Road inputs for ``quarter_car(road=True)``: samples of the road height zr [m].
+
+Every function returns ``zr`` on a given time grid ``T`` [s]; the random
+road is deterministic for a given seed. A road is an input linear between
+samples (python-control's assumption), so ``control.forced_response``
+stays the exact reference.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["step", "bump", "sine", "iso8608", "iso8608_profile", "iso8608_psd",
+           "ISO8608_CLASSES", "ISO8608_N0", "ISO8608_BAND", "largest_step"]
+
+#: Reference spatial frequency n0 [cycles/m] of ISO 8608.
+ISO8608_N0 = 0.1
+#: Gd(n0) [m³] of road classes A–H: the geometric mean of each class,
+#: 16e-6 · 4^k (ISO 8608:2016, Table 1).
+ISO8608_CLASSES = {c: 16e-6 * 4.0 ** k for k, c in enumerate("ABCDEFGH")}
+#: The band of spatial frequencies [cycles/m] the standard classifies,
+#: wavelengths from 91 m down to 0.35 m (ISO 8608, 0.011 <= n <= 2.83).
+ISO8608_BAND = (0.011, 2.83)
+
+
+def _grid(T) -> np.ndarray:
+    from .integrate import check_time_grid
+
+    return check_time_grid(T, "T")
+
+
+def _positive(name: str, value, unit: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) \
+            or not math.isfinite(value) or value <= 0:
+        raise ValueError(f"{name} must be a finite number > 0 {unit}, got {value!r}")
+    return float(value)
+
+
+def _finite(name: str, value, unit: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) \
+            or not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite number [{unit}], got {value!r}")
+    return float(value)
+
+
+def step(T, height: float = 0.05, t0: float = 0.5) -> np.ndarray:
+    """A road step of ``height`` [m] at time ``t0`` [s] (a kerb).
+
+    ``zr = height`` for ``t >= t0``, else 0. Between the two samples around
+    ``t0`` the input is a ramp, as python-control interpolates it.
+    """
+    T = _grid(T)
+    return np.where(T >= _finite("t0", t0, "s"), _finite("height", height, "m"), 0.0)
+
+
+def bump(T, height: float = 0.05, length: float = 1.0, speed: float = 10.0,
+         t0: float = 0.5) -> np.ndarray:
+    """A 1 − cos bump of ``height`` [m] and ``length`` [m] met at ``t0`` [s].
+
+    .. math:: z_r = \\frac{h}{2}\\Big(1 - \\cos\\frac{2\\pi x}{\\ell}\\Big),
+              \\quad 0 \\le x = v (t - t_0) \\le \\ell
+    """
+    T = _grid(T)
+    height, t0 = _finite("height", height, "m"), _finite("t0", t0, "s")
+    length, speed = _positive("length", length, "m"), _positive("speed", speed, "m/s")
+    x = speed * (T - t0)
+    inside = (x >= 0) & (x <= length)
+    return np.where(inside, 0.5 * height * (1 - np.cos(2 * np.pi * x / length)), 0.0)
+
+
+def sine(T, amplitude: float = 0.01, frequency: float = 1.0) -> np.ndarray:
+    """A sinusoidal road ``zr = amplitude · sin(2π f t)`` [m], f in Hz."""
+    T = _grid(T)
+    return _finite("amplitude", amplitude, "m") * np.sin(
+        2 * np.pi * _positive("frequency", frequency, "Hz") * T)
+
+
+def _road_class(road_class: str) -> float:
+    key = str(road_class).strip().upper()
+    if key not in ISO8608_CLASSES:
+        raise ValueError(f"unknown ISO 8608 road class {road_class!r}; expected one of "
+                         f"{', '.join(ISO8608_CLASSES)}")
+    return ISO8608_CLASSES[key]
+
+
+def _band(band) -> tuple[float, float]:
+    lo, hi = (float(b) for b in band)
+    if not (0 < lo < hi and math.isfinite(hi)):
+        raise ValueError(f"band must be (n_min, n_max) with 0 < n_min < n_max cycles/m, "
+                         f"got {band!r}")
+    return lo, hi
+
+
+def iso8608_psd(n, road_class: str = "C") -> np.ndarray:
+    """ISO 8608 displacement PSD [m³] at spatial frequencies ``n`` [cycles/m].
+
+    .. math:: G_d(n) = G_d(n_0) \\left(\\frac{n}{n_0}\\right)^{-2}, \\quad n_0 = 0.1
+
+    with ``Gd(n0)`` the class's geometric mean, `ISO8608_CLASSES`.
+    """
+    return _road_class(road_class) * (np.asarray(n, dtype=float) / ISO8608_N0) ** -2.0
+
+
+def largest_step(speed: float, band=ISO8608_BAND) -> float:
+    """The largest time step [s] that samples the band at ``speed``: 1/(2 v n_max)."""
+    return 1.0 / (2.0 * _positive("speed", speed, "m/s") * _band(band)[1])
+
+
+def iso8608_profile(length: float, dx: float, road_class: str = "C", seed: int = 0,
+                    band=ISO8608_BAND) -> tuple[np.ndarray, np.ndarray]:
+    """A random ISO 8608 road profile in the distance domain.
+
+    Parameters
+    ----------
+    length : float
+        Profile length [m].
+    dx : float
+        Sample spacing [m]; at most ``1/(2 n_max)`` (0.177 m for the
+        standard band) so that the band's shortest wavelength is resolved.
+    road_class : {'A', ..., 'H'}
+    seed : int
+        Seed of the random phases: the same seed gives the same road.
+    band : (n_min, n_max), default ``(0.011, 2.83)`` cycles/m
+
+    Returns
+    -------
+    x, z : ndarray
+        Distance [m] from 0 and road height [m].
+
+    Notes
+    -----
+    The spectral method (sum of harmonics, evaluated by inverse FFT): with
+    ``Δn = 1/P`` for a period ``P >= max(length, 10/n_min)``,
+
+    .. math:: z(x) = \\sum_k \\sqrt{2 G_d(n_k) Δn}\\, \\cos(2\\pi n_k x + φ_k),
+              \\quad n_k = kΔn \\in [n_{min}, n_{max}]
+
+    with phases φ_k uniform on [0, 2π). Its one-sided PSD is ``Gd`` on the
+    band (ISO 8608:2016, Annex F; Cebon, *Handbook of Vehicle-Road
+    Interaction*, ch. 3) and zero outside it. The period is at least ten
+    of the longest wavelengths, so the band's low end holds ten harmonics.
+    """
+    length, dx = _positive("length", length, "m"), _positive("dx", dx, "m")
+    lo, hi = _band(band)
+    g0 = _road_class(road_class)
+    if dx > 1 / (2 * hi):
+        raise ValueError(f"dx = {dx!r} m is too coarse for the band up to {hi!r} cycles/m: "
+                         f"it must be <= 1/(2 n_max) = {1 / (2 * hi):.4g} m")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise ValueError(f"seed must be an integer, got {seed!r}")
+    N = int(math.ceil(max(length, 10.0 / lo) / dx)) + 1     # (N - 1) dx >= length
+    N += N % 2
+    dn = 1.0 / (N * dx)
+    n = np.arange(N // 2 + 1) * dn
+    # the Nyquist bin is left out: irfft would halve its amplitude
+    inside = (n >= lo) & (n <= hi) & (np.arange(n.size) < N // 2)
+    amplitude = np.zeros_like(n)
+    amplitude[inside] = np.sqrt(2 * g0 * (n[inside] / ISO8608_N0) ** -2.0 * dn)
+    phase = np.random.default_rng(seed).uniform(0, 2 * np.pi, n.size)
+    z = np.fft.irfft(0.5 * N * amplitude * np.exp(1j * phase), n=N)
+    x = np.arange(N) * dx
+    keep = x <= length + 1e-9 * length
+    return x[keep], z[keep]
+
+
+def iso8608(T, road_class: str = "C", speed: float = 20.0, seed: int = 0,
+            band=ISO8608_BAND) -> np.ndarray:
+    """A random ISO 8608 road driven at ``speed`` [m/s], sampled at ``T`` [s].
+
+    The profile of `iso8608_profile` with ``x = speed · (t - T[0])``. The
+    time grid must resolve the band at this speed: every step of ``T`` at
+    most `largest_step` ``= 1/(2 v n_max)`` (8.8 ms at 20 m/s for the
+    standard band). Narrow ``band`` to use a coarser grid.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> T = np.linspace(0, 10, 2001)
+    >>> zr = iso8608(T, "C", speed=20.0, seed=1)
+    >>> zr.shape, bool(np.all(zr == iso8608(T, "C", speed=20.0, seed=1)))
+    ((2001,), True)
+    """
+    T = _grid(T)
+    speed = _positive("speed", speed, "m/s")
+    lo, hi = _band(band)
+    dt = float(np.max(np.diff(T)))
+    limit = largest_step(speed, (lo, hi))
+    if dt > limit * (1 + 1e-12):
+        raise ValueError(
+            f"T's step {dt:.4g} s is too coarse for an ISO 8608 road at {speed:g} m/s: it "
+            f"samples the road every {speed * dt:.4g} m, but the band up to {hi:g} cycles/m "
+            f"needs a step <= {limit:.4g} s (or a narrower band)")
+    x = speed * (T - T[0])
+    dx = speed * float(np.min(np.diff(T)))
+    xp, zp = iso8608_profile(max(x[-1], dx), dx, road_class, seed, (lo, hi))
+    return np.interp(x, xp, zp)
