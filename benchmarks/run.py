@@ -15,7 +15,6 @@ import argparse
 import datetime as dt
 import platform
 import sys
-import time
 from pathlib import Path
 
 import control
@@ -106,7 +105,6 @@ def main(argv=None) -> int:
 
     # -- the problem and its reference
     exact_free = control.initial_response(sys_free, T, X0)
-    exact_road = control.forced_response(sys_road, T, U, X0)
     lam, V = np.linalg.eig(A)
     closed = (V @ (np.linalg.solve(V, X0.astype(complex))[:, None]
                    * np.exp(np.outer(lam, T)))).real

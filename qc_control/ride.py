@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from .model import QuarterCarParams, _as_params, quarter_car
+from .model import _as_params, quarter_car
 from .road import ISO8608_BAND, ISO8608_N0, _band, _positive, _road_class
 
 __all__ = ["wk_filter", "transmissibility", "Transmissibility", "ride_metrics",

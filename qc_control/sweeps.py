@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import itertools
-import math
 import warnings
 from concurrent.futures import Executor
 from dataclasses import dataclass, fields
@@ -16,7 +15,7 @@ from .compare import DEFAULT_X0
 from .integrate import check_substeps, check_time_grid
 from .lti import affine_scan, step_matrices
 from .methods import ButcherTableau, get_method
-from .model import OUTPUTS, QuarterCarParams
+from .model import QuarterCarParams
 from .stability import stability_coefficients
 
 __all__ = ["sweep", "SweepResult", "METRICS", "design_grid"]

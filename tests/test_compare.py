@@ -1,5 +1,4 @@
 """compare_methods' numbers against independent calculations."""
-import math
 
 import control
 import numpy as np

@@ -1,5 +1,4 @@
 """The generic stepper: batches, counts, grids, divergence, bad input."""
-import warnings
 
 import numpy as np
 import pytest

@@ -1,5 +1,4 @@
 """The LTI engine equals the generic stepper, for every method, with and without input."""
-import math
 
 import numpy as np
 import pytest
@@ -52,7 +51,7 @@ def test_step_matrices_against_the_stages():
     sys = qc.quarter_car(road=True)
     A, B = np.asarray(sys.A), np.asarray(sys.B)
     h = 0.01
-    for name, tab in METHODS.items():
+    for tab in METHODS.values():
         phi, g0, g1 = step_matrices(tab, A, B, h)
         R = qc.stability_function(tab)
         expected = sum(c * np.linalg.matrix_power(h * A, k) for k, c in enumerate(R.coef))

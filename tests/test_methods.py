@@ -1,4 +1,5 @@
 """ButcherTableau checks and the seed's four formulas."""
+import dataclasses
 import numpy as np
 import pytest
 
@@ -61,7 +62,7 @@ def test_bad_tableaus_fail_when_built(kwargs, words):
 def test_tableau_is_immutable():
     with pytest.raises(ValueError):
         METHODS["rk4"].b[0] = 1.0
-    with pytest.raises(Exception):
+    with pytest.raises(dataclasses.FrozenInstanceError):
         METHODS["rk4"].order = 3
 
 

@@ -1,4 +1,5 @@
 """QuarterCarParams and quarter_car against the seed paper and closed forms."""
+import dataclasses
 import math
 
 import control
@@ -35,7 +36,7 @@ def test_cs_given_is_kept_and_zeta_follows():
 
 
 def test_params_are_immutable():
-    with pytest.raises(Exception):
+    with pytest.raises(dataclasses.FrozenInstanceError):
         QuarterCarParams().ms = 1.0
 
 

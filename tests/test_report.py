@@ -1,7 +1,6 @@
 """The written report: files, links, HTML images, atomic writes, section order."""
 import re
 from html.parser import HTMLParser
-from pathlib import Path
 
 import numpy as np
 import pytest

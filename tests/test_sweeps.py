@@ -1,5 +1,4 @@
 """sweep(): equal to single runs, independent of executor and chunking, robust to bad designs."""
-import warnings
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 import control

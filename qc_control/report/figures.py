@@ -118,7 +118,7 @@ def work_precision_figure(cmp) -> Figure:
                      label=tab.name)
     left.set(xlabel="right-hand-side evaluations", ylabel="max |xs error| [m]",
              title="Error against work")
-    right.set(xlabel="wall time [ms]", title="Error against time")
+    right.set(xlabel="wall time, step by step [ms]", title="Error against time")
     for ax in (left, right):
         ax.grid(alpha=0.3, which="both")
     left.legend(fontsize="small")
