@@ -76,6 +76,8 @@ class MethodComparison:
     ride : pandas.DataFrame or None
         Under a road input: `qc_control.ride_metrics` of the reference
         (first row) and of each method.
+    ride_error : pandas.DataFrame or None
+        Each method's ride metrics against the reference's [%].
     transmissibility : Transmissibility or None
         Under a road input: the road-to-ride frequency responses.
     """
@@ -104,6 +106,7 @@ class MethodComparison:
     eigenvalues: np.ndarray
     input_description: str = ""
     ride: pd.DataFrame | None = None
+    ride_error: pd.DataFrame | None = None
     transmissibility: object | None = None
 
     def summary(self) -> pd.DataFrame:
@@ -377,7 +380,7 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
         row = {
             "order": tab.order, "stages": tab.stages, "h [s]": h, "steps": resp.steps,
             "RHS evals": resp.nfev, "wall time [ms]": 1e3 * wall,
-            "LTI engine [ms]": 1e3 * wall_lti,
+            "LTI engine [ms]": 1e3 * wall_lti, "time / control": wall / reference_time,
         }
         for i, name, unit in ((0, "xs", "m"), (1, "xu", "m"), (4, "body_acc", "m/s²")):
             row[f"max |{name} err| [{unit}]"] = float(np.max(np.abs(err[i])))
@@ -395,7 +398,7 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
     table = pd.DataFrame.from_dict(rows, orient="index")
     table.index.name = "method"
     convergence = pd.DataFrame(conv_rows)
-    ride, trans = None, None
+    ride, ride_error, trans = None, None, None
     if U is not None and "zr" in sys.input_labels and sys.ninputs == 1 and params is not None:
         from .ride import ride_metrics, transmissibility
 
@@ -403,6 +406,10 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
                              **{m: ride_metrics(r, params) for m, r in responses.items()}}).T
         ride.index.name = "response"
         trans = transmissibility(sys)
+        numeric = ride.drop(columns=["lift-off", "lift-off time [s]"]).astype(float)
+        ref = numeric.loc["reference"]
+        ride_error = 100 * (numeric.drop(index="reference") - ref) / ref.where(ref != 0)
+        ride_error.columns = [c.split(" [")[0] + " [% off]" for c in ride_error.columns]
     reach = {tab.name: _cost_to_reach(convergence, tab, span, rows[tab.name]["h_max [s]"])
              for tab in tabs}
     cost = pd.DataFrame({m: {tol: v[0] for tol, v in r.items()} for m, r in reach.items()})
@@ -416,5 +423,6 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
         reference_description=how, responses=responses, eigenvalues=eig,
         reference_name=(f"control.{'initial' if U is None else 'forced'}_response "
                         f"(python-control {control.__version__})"),
-        input_description=input_description, ride=ride, transmissibility=trans,
+        input_description=input_description, ride=ride, ride_error=ride_error,
+        transmissibility=trans,
     )

@@ -118,10 +118,8 @@ def _ride(cmp) -> list[str]:
         return []
     key = "rms body_acc Wk [m/s²]"
     ref = float(cmp.ride.loc["reference", key])
-    parts = []
-    for m in cmp.ride.index.drop("reference"):
-        off = 100 * (float(cmp.ride.loc[m, key]) - ref) / ref
-        parts.append(f"{m} {off:+.2g}%")
+    off = cmp.ride_error["rms body_acc Wk [% off]"]
+    parts = [f"{m} {v:+.2g}%" for m, v in off.items()]
     lift = bool(cmp.ride.loc["reference", "lift-off"])
     return [f"On this road the exact Wk-weighted body acceleration is {fmt(ref)} m/s² RMS "
             f"(ISO 2631-1); at h = {fmt(cmp.h)} s the methods give it " + ", ".join(parts)
