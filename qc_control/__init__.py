@@ -12,10 +12,10 @@ from .model import OUTPUTS, STATES, QuarterCarParams, load_config, quarter_car, 
 from .response import FixedStepResponse, forced_response, initial_response
 from .stability import max_stable_step, numerical_modes, stability_function
 from .compare import MethodComparison, compare_methods
-from .sweeps import METRICS, SweepResult, design_grid, sweep
+from .sweeps import DEFAULT_METRICS, METRICS, SweepChunk, SweepResult, design_grid, sweep
 from . import road
 from .ride import (Transmissibility, ride_metrics, ride_metrics_spectral, transmissibility,
-                   wk_filter)
+                   wk_filter, wk_weighted)
 
 __version__ = "0.1.0"
 __all__ = [
@@ -26,7 +26,7 @@ __all__ = [
     "initial_response", "forced_response", "FixedStepResponse",
     "stability_function", "max_stable_step", "numerical_modes",
     "compare_methods", "MethodComparison",
-    "sweep", "SweepResult", "design_grid", "METRICS",
+    "sweep", "SweepResult", "SweepChunk", "design_grid", "METRICS", "DEFAULT_METRICS",
     "road", "transmissibility", "Transmissibility", "ride_metrics", "ride_metrics_spectral",
-    "wk_filter",
+    "wk_filter", "wk_weighted",
 ]

@@ -6,15 +6,17 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control.sweeps import METRICS, design_grid, sweep
+from qc_control import road
+from qc_control.ride import ride_metrics
+from qc_control.sweeps import DEFAULT_METRICS, METRICS, design_grid, sweep
 
 T = np.linspace(0, 5, 2001)          # h = 2.5 ms
 X0 = [0.0, 0.0, 0.05, 0.0]
 GRID = {"ks": [2e4, 3e4, 4.5e4], "zeta": [0.1, 0.3, 0.6], "mu": [40.0, 100.0]}
 
 
-def independent_metrics(y, T):
-    """The four metrics written plainly, on (5, N) outputs of one run."""
+def independent_metrics(y, T, p=qc.QuarterCarParams()):
+    """The default metrics written plainly, on (5, N) outputs of one run."""
     xs = y[0]
     dev = np.abs(xs - xs[-1])
     outside = np.flatnonzero(dev > 0.02 * dev.max())
@@ -22,7 +24,10 @@ def independent_metrics(y, T):
     return {"peak_travel [m]": np.max(np.abs(y[2])),
             "rms_body_acc [m/s²]": np.sqrt(np.trapezoid(y[4] ** 2, T) / (T[-1] - T[0])),
             "settling_time [s]": settle,
-            "peak_tire_defl [m]": np.max(np.abs(y[3]))}
+            "peak_tire_defl [m]": np.max(np.abs(y[3])),
+            "rms_tire_load / static [-]": p.ku * np.sqrt(np.trapezoid(y[3] ** 2, T)
+                                                          / (T[-1] - T[0]))
+            / ((p.ms + p.mu) * 9.80665)}
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +49,7 @@ def test_equal_to_single_runs(grid_result):
         single = qc.initial_response(sys, T, X0, method="rk4", engine="generic")
         # the same method computed two ways: rounding only (1e-12 of the 5 cm scale)
         np.testing.assert_allclose(grid_result.states[i], single.states, rtol=0, atol=1e-12)
-        expected = independent_metrics(single.outputs, T)
+        expected = independent_metrics(single.outputs, T, qc.QuarterCarParams(**d))
         for name, value in expected.items():
             assert grid_result.metrics.loc[i, name] == pytest.approx(value, rel=1e-9, abs=1e-12)
 
@@ -74,7 +79,7 @@ def test_road_sweep_equals_forced_response():
 
 def test_chunking_and_executors_do_not_change_results(grid_result):
     ref = grid_result.metrics
-    cols = list(METRICS)
+    cols = list(DEFAULT_METRICS)
     for kwargs in (dict(chunk_size=1), dict(chunk_size=7), dict(chunk_size=1000),
                    dict(executor=ThreadPoolExecutor(2), chunk_size=4)):
         other = sweep(GRID, T, X0, progress=False, **kwargs).metrics
@@ -92,7 +97,7 @@ def test_dask_local_cluster(grid_result):
             distributed.Client(cluster) as client:
         other = sweep(GRID, T, X0, executor=client.get_executor(), chunk_size=4,
                       progress=False).metrics
-    cols = list(METRICS)
+    cols = list(DEFAULT_METRICS)
     np.testing.assert_allclose(other[cols].to_numpy(), grid_result.metrics[cols].to_numpy(),
                                rtol=1e-13)
 
@@ -107,8 +112,8 @@ def test_bad_designs_are_reported_and_nothing_else_is_lost(grid_result):
     assert "ms (sprung mass) must be > 0 kg, got -5.0" in r.errors.loc[1, "error"]
     assert r.errors.loc[1, "value"]["ms"] == -5.0
     good = r.metrics[r.metrics["error"] == ""]
-    assert list(good.index) == [0, 4] and good[list(METRICS)].notna().all().all()
-    assert r.metrics.loc[1, list(METRICS)].isna().all()
+    assert list(good.index) == [0, 4] and good[list(DEFAULT_METRICS)].notna().all().all()
+    assert r.metrics.loc[1, list(DEFAULT_METRICS)].isna().all()
     alone = sweep([qc.QuarterCarParams(ms=400.0)], T, X0, progress=False).metrics
     assert r.metrics.loc[4, "peak_travel [m]"] == pytest.approx(alone.loc[0, "peak_travel [m]"],
                                                                  rel=1e-13)
@@ -145,8 +150,27 @@ def test_bad_input(kwargs, error, words):
 
 
 def test_custom_metric_and_states_off():
-    r = sweep([qc.QuarterCarParams()], T, X0, metrics={"final xs [m]": lambda T, y: y[:, 0, -1]},
+    r = sweep([qc.QuarterCarParams()], T, X0, metrics={"final xs [m]": lambda c: c.y[:, 0, -1]},
               progress=False)
     assert r.states is None and list(r.metrics.columns)[-2] == "final xs [m]"
     exact = control.initial_response(qc.quarter_car(), T, X0).outputs[0, -1]
     assert r.metrics.loc[0, "final xs [m]"] == pytest.approx(exact, abs=1e-8)
+
+
+def test_ride_metrics_in_a_road_sweep_equal_ride_metrics():
+    """Every ride metric of the sweep against qc.ride_metrics of the single run."""
+    Tr = np.linspace(0, 4, 2001)
+    U = road.iso8608(Tr, "D", 15.0, seed=2)
+    designs = [qc.QuarterCarParams(), qc.QuarterCarParams(ku=1.5e5, zeta=0.15)]
+    r = sweep(designs, Tr, np.zeros(4), U=U, metrics=list(METRICS), progress=False).metrics
+    names = {"rms_body_acc [m/s²]": "rms body_acc [m/s²]",
+             "rms_body_acc_wk [m/s²]": "rms body_acc Wk [m/s²]",
+             "vdv [m/s^1.75]": "VDV [m/s^1.75]",
+             "rms_tire_load / static [-]": "rms tire load / static [-]",
+             "lift_off_time [s]": "lift-off time [s]"}
+    for i, p in enumerate(designs):
+        single = qc.forced_response(qc.quarter_car(p, road=True), Tr, U, method="rk4")
+        expected = ride_metrics(single, p)
+        for ours, theirs in names.items():
+            # same formulas on trajectories equal to rounding: 1e-9 relative
+            assert r.loc[i, ours] == pytest.approx(expected[theirs], rel=1e-9, abs=1e-12), ours
