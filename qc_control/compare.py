@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 import scipy.signal
 
-from .integrate import DivergenceWarning, check_time_grid
+from .integrate import DivergenceWarning, check_time_grid, uniform_step
 from .methods import ButcherTableau, get_method
 from .modal import ModalAnalysis, modal_analysis
 from .model import QuarterCarParams, quarter_car
@@ -141,9 +141,8 @@ def best_time(fn: Callable[[], object], repeats: int, warmup: bool = False) -> f
 
 def _grid(T: np.ndarray, h: float | None) -> tuple[float, int]:
     """The step h and the substeps per interval of the uniform grid T."""
-    spacing = np.diff(T)
-    dt = float(spacing.mean())
-    if np.max(np.abs(spacing - dt)) > 1e-9 * dt:
+    dt = uniform_step(T)
+    if dt is None:
         raise ValueError("T must be uniformly spaced for a method comparison")
     if h is None:
         return dt, 1

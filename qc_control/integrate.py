@@ -10,7 +10,8 @@ import numpy as np
 
 from .methods import ButcherTableau, get_method
 
-__all__ = ["Solution", "DivergenceWarning", "integrate", "check_time_grid", "check_substeps"]
+__all__ = ["Solution", "DivergenceWarning", "integrate", "check_time_grid", "check_substeps",
+           "uniform_step"]
 
 #: Intervals between checks for a non-finite state. Checking every step would
 #: cost about as much as a stage; a blow-up is still cut at its first bad sample.
@@ -125,6 +126,13 @@ def _compiled_loop(tab: ButcherTableau, substeps: bool):
     exec(compile(_loop_source(tab, substeps), f"<qc_control loop: {tab.name}>", "exec"),
          namespace)
     return namespace["run"]
+
+
+def uniform_step(T: np.ndarray, rtol: float = 1e-9, atol: float = 0.0) -> float | None:
+    """The step of an evenly spaced grid T, or None if a step departs from
+    the mean ``(T[-1] - T[0])/(N - 1)`` by more than ``atol + rtol·dt``."""
+    dt = (T[-1] - T[0]) / (T.size - 1)
+    return float(dt) if np.max(np.abs(np.diff(T) - dt)) <= atol + rtol * abs(dt) else None
 
 
 def check_substeps(substeps) -> int:

@@ -206,25 +206,31 @@ def _as_params(params) -> QuarterCarParams:
     )
 
 
-def system_matrices(params=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The seed's ``A`` with the road and actuator columns of ``B``.
+def seed_matrices(ms, mu, ks, ku, cs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The seed's ``A`` (section 4.2) and the road and actuator columns of ``B``.
 
-    Returns ``(A, b_road, b_act)``: ``b_road = [0, ku/mu, 0, 0]`` and
-    ``b_act = [1/ms, -1/mu, 0, 0]``.
+    Takes numbers or equal-shaped arrays (a batch of designs) and returns
+    ``A (..., 4, 4)``, ``b_road = [0, ku/mu, 0, 0]`` and
+    ``b_act = [1/ms, -1/mu, 0, 0]``, each ``(..., 4)``.
     """
-    p = _as_params(params)
-    ms, mu, ks, ku, cs = p.ms, p.mu, p.ks, p.ku, p.cs
-    A = np.array(
-        [
-            [-cs / ms, cs / ms, -ks / ms, ks / ms],
-            [cs / mu, -cs / mu, ks / mu, -(ks + ku) / mu],
-            [1.0, 0.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0, 0.0],
-        ]
-    )
-    b_road = np.array([0.0, ku / mu, 0.0, 0.0])
-    b_act = np.array([1.0 / ms, -1.0 / mu, 0.0, 0.0])
+    ms, mu, ks, ku, cs = np.broadcast_arrays(*(np.asarray(v, dtype=float)
+                                              for v in (ms, mu, ks, ku, cs)))
+    zero, one = np.zeros_like(ms), np.ones_like(ms)
+    A = np.stack([
+        np.stack([-cs / ms, cs / ms, -ks / ms, ks / ms], axis=-1),
+        np.stack([cs / mu, -cs / mu, ks / mu, -(ks + ku) / mu], axis=-1),
+        np.stack([one, zero, zero, zero], axis=-1),
+        np.stack([zero, one, zero, zero], axis=-1),
+    ], axis=-2)
+    b_road = np.stack([zero, ku / mu, zero, zero], axis=-1)
+    b_act = np.stack([1.0 / ms, -1.0 / mu, zero, zero], axis=-1)
     return A, b_road, b_act
+
+
+def system_matrices(params=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """`seed_matrices` of one vehicle: ``(A, b_road, b_act)``."""
+    p = _as_params(params)
+    return seed_matrices(p.ms, p.mu, p.ks, p.ku, p.cs)
 
 
 def quarter_car(params=None, *, road: bool = False, actuator: bool = False,

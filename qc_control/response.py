@@ -14,7 +14,8 @@ import warnings
 import control
 import numpy as np
 
-from .integrate import DivergenceWarning, Solution, check_substeps, check_time_grid, integrate
+from .integrate import (DivergenceWarning, Solution, check_substeps, check_time_grid, integrate,
+                        uniform_step)
 from .lti import lti_trajectory
 from .methods import ButcherTableau, get_method
 from .stability import amplification, max_stable_step
@@ -120,12 +121,6 @@ def linear_input(T: np.ndarray, U: np.ndarray):
     return u
 
 
-def _is_uniform(T: np.ndarray, steps: np.ndarray) -> bool:
-    """Evenly spaced by python-control's own test, np.allclose(np.diff(T), dt)."""
-    dt = (T[-1] - T[0]) / (T.size - 1)
-    return bool(np.max(np.abs(steps - dt)) <= 1e-8 + 1e-5 * abs(dt))
-
-
 def _generic(A, B, T, u_samples, x0, tab, substeps, warn):
     """The generic stepper on ``f(t, x) = A x + B u(t)``."""
     AT, BT = A.T.copy(), B.T.copy()
@@ -166,7 +161,8 @@ def _simulate(sys, T, U, X0, method, substeps, kind, transpose, return_x, squeez
         message = (f"h = {h:.6g} s exceeds the stability limit {h_max:.6g} s of "
                    f"{tab.name} for system {sys.name!r}: the response grows")
         warnings.warn(message, DivergenceWarning, stacklevel=3)
-    uniform = _is_uniform(T, steps)
+    # python-control's own test of an even grid: np.allclose(np.diff(T), dt)
+    uniform = uniform_step(T, rtol=1e-5, atol=1e-8) is not None
     if engine not in ("auto", "lti", "generic"):
         raise ValueError(f"engine must be 'auto', 'lti' or 'generic', got {engine!r}")
     if engine == "lti" and not uniform:

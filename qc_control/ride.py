@@ -18,6 +18,7 @@ import scipy.linalg
 import scipy.signal
 from matplotlib.figure import Figure
 
+from .integrate import uniform_step
 from .model import _as_params, quarter_car
 from .road import ISO8608_BAND, ISO8608_N0, _band, _positive, _road_class
 
@@ -207,8 +208,8 @@ def transmissibility(sys_or_params=None, freqs_hz=None) -> Transmissibility:
 
 
 def _uniform(T: np.ndarray) -> float:
-    dt = (T[-1] - T[0]) / (T.size - 1)
-    if np.max(np.abs(np.diff(T) - dt)) > 1e-9 * dt:
+    dt = uniform_step(T)
+    if dt is None:
         raise ValueError("the response's time grid must be uniform for the ISO 2631 weighting")
     return dt
 

@@ -65,14 +65,17 @@ def stability_coefficients(method) -> np.ndarray:
     return _coefficients(get_method(method))
 
 
-def amplification(method, h: float, eigenvalues) -> float:
+def amplification(method, h: float, eigenvalues):
     """``max |R(hλ)|``: the spectral radius of the step map ``R(hA)``.
 
     Above 1 the method's trajectory grows along some mode at this h.
+    ``eigenvalues`` of shape ``(..., n)`` give one radius per system: a
+    float for one system, an array for a batch.
     """
     coef = stability_coefficients(method)
     z = h * np.asarray(eigenvalues, dtype=complex)
-    return float(np.max(np.abs(np.polynomial.polynomial.polyval(z, coef))))
+    radius = np.max(np.abs(np.polynomial.polynomial.polyval(z, coef)), axis=-1)
+    return float(radius) if radius.ndim == 0 else radius
 
 
 def eigenvalues_of(sys_or_eigenvalues) -> np.ndarray:
@@ -112,7 +115,6 @@ def _max_steps(R: Polynomial, lams: np.ndarray) -> np.ndarray:
         q[:, a:a + deg + 1] += (r[:, a:a + 1] * np.conj(r)).real
     g = q[:, 1:]                                                     # (|R|² - 1) / h
     d = g.shape[1] - 1
-    result = np.full(lam.size, np.inf)
     if d == 0:
         roots = np.full((lam.size, 1), np.inf + 0j)
     else:

@@ -12,11 +12,11 @@ import numpy as np
 import pandas as pd
 
 from .compare import DEFAULT_X0
-from .integrate import check_substeps, check_time_grid
+from .integrate import check_substeps, check_time_grid, uniform_step
 from .lti import affine_scan, step_matrices
 from .methods import ButcherTableau, get_method
-from .model import QuarterCarParams
-from .stability import stability_coefficients
+from .model import QuarterCarParams, seed_matrices
+from .stability import amplification
 
 __all__ = ["sweep", "SweepResult", "SweepChunk", "METRICS", "DEFAULT_METRICS", "design_grid"]
 
@@ -197,15 +197,8 @@ def _validate(designs) -> tuple[list, list]:
 
 def _matrices(values: np.ndarray, road: bool):
     """Batched A (m,4,4) and B (m,4,k) from rows of ms, mu, ks, ku, cs."""
-    ms, mu, ks, ku, cs = values.T
-    m = values.shape[0]
-    A = np.zeros((m, 4, 4))
-    A[:, 0] = np.stack([-cs / ms, cs / ms, -ks / ms, ks / ms], axis=-1)
-    A[:, 1] = np.stack([cs / mu, -cs / mu, ks / mu, -(ks + ku) / mu], axis=-1)
-    A[:, 2, 0] = A[:, 3, 1] = 1.0
-    B = np.zeros((m, 4, 1 if road else 0))
-    if road:
-        B[:, 1, 0] = ku / mu
+    A, b_road, _ = seed_matrices(*values.T)
+    B = b_road[:, :, None] if road else np.zeros((values.shape[0], 4, 0))
     return A, B
 
 
@@ -234,10 +227,7 @@ def _run_chunk(values: np.ndarray, T: np.ndarray, X0: np.ndarray, U: np.ndarray 
         y = y[:, 4:] if keep_states else y
         if U is not None:
             y[:, 3] -= U[None, :]
-        eig = np.linalg.eigvals(A)
-        R = np.polynomial.polynomial.polyval((H / substeps) * eig,
-                                             stability_coefficients(method))
-        stable = np.max(np.abs(R), axis=-1) <= 1 + 1e-12
+        stable = amplification(method, H / substeps, np.linalg.eigvals(A)) <= 1 + 1e-12
         result = {"stable": stable}
         chunk = SweepChunk(T, y, dict(zip(("ms", "mu", "ks", "ku", "cs"), values.T)))
         for name, fn in metric_items:
@@ -300,8 +290,7 @@ def sweep(designs, T, X0=DEFAULT_X0, U=None, method="rk4", metrics=None, executo
         raise ValueError("designs is empty")
     tab = get_method(method)
     T = check_time_grid(T, "T")
-    steps = np.diff(T)
-    if np.max(np.abs(steps - steps.mean())) > 1e-9 * steps.mean():
+    if uniform_step(T) is None:
         raise ValueError("T must be uniformly spaced for a sweep")
     substeps = check_substeps(substeps)
     X0 = np.asarray(X0, dtype=float)
