@@ -36,33 +36,60 @@ def best_of(fn, repeats: int) -> float:
 
 # -- hand-written loops: what a student writes, the yardstick for the generic stepper
 def hand_euler(f, T, x):
-    out = np.empty((T.size, x.size)); out[0] = x; h = T[1] - T[0]; t = T[0]
+    out = np.empty((T.size, x.size))
+    out[0] = x
+    h = T[1] - T[0]
+    t = T[0]
     for i in range(T.size - 1):
-        x = x + h * f(t, x); t += h; out[i + 1] = x
+        x = x + h * f(t, x)
+        t += h
+        out[i + 1] = x
     return out
 
 
 def hand_midpoint(f, T, x):
-    out = np.empty((T.size, x.size)); out[0] = x; h = T[1] - T[0]; h2 = h / 2; t = T[0]
+    out = np.empty((T.size, x.size))
+    out[0] = x
+    h = T[1] - T[0]
+    h2 = h / 2
+    t = T[0]
     for i in range(T.size - 1):
-        x = x + h * f(t + h2, x + h2 * f(t, x)); t += h; out[i + 1] = x
+        x = x + h * f(t + h2, x + h2 * f(t, x))
+        t += h
+        out[i + 1] = x
     return out
 
 
 def hand_heun(f, T, x):
-    out = np.empty((T.size, x.size)); out[0] = x; h = T[1] - T[0]; h2 = h / 2; t = T[0]
+    out = np.empty((T.size, x.size))
+    out[0] = x
+    h = T[1] - T[0]
+    h2 = h / 2
+    t = T[0]
     for i in range(T.size - 1):
-        k1 = f(t, x); k2 = f(t + h, x + h * k1); x = x + h2 * (k1 + k2); t += h; out[i + 1] = x
+        k1 = f(t, x)
+        k2 = f(t + h, x + h * k1)
+        x = x + h2 * (k1 + k2)
+        t += h
+        out[i + 1] = x
     return out
 
 
 def hand_rk4(f, T, x):
-    out = np.empty((T.size, x.size)); out[0] = x; h = T[1] - T[0]; h2 = h / 2; h6 = h / 6
+    out = np.empty((T.size, x.size))
+    out[0] = x
+    h = T[1] - T[0]
+    h2 = h / 2
+    h6 = h / 6
     t = T[0]
     for i in range(T.size - 1):
-        k1 = f(t, x); k2 = f(t + h2, x + h2 * k1); k3 = f(t + h2, x + h2 * k2)
+        k1 = f(t, x)
+        k2 = f(t + h2, x + h2 * k1)
+        k3 = f(t + h2, x + h2 * k2)
         k4 = f(t + h, x + h * k3)
-        x = x + h6 * (k1 + 2 * k2 + 2 * k3 + k4); t += h; out[i + 1] = x
+        x = x + h6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        t += h
+        out[i + 1] = x
     return out
 
 
@@ -71,8 +98,10 @@ HAND = {"euler": hand_euler, "midpoint": hand_midpoint, "heun": hand_heun, "rk4"
 
 def table(headers, rows) -> str:
     """A Markdown table; a '|' inside a cell is escaped."""
+
     def line(cells):
         return "| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |"
+
     out = [line(headers), "|" + "|".join("---" for _ in headers) + "|"]
     return "\n".join(out + [line(r) for r in rows])
 
@@ -84,39 +113,50 @@ def g(x, digits=3):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smoke mode: small sizes, 1 repeat")
-    ap.add_argument("--out", default=None, help="where to write RESULTS.md "
-                    "(default benchmarks/RESULTS.md; --quick writes nothing unless given)")
+    ap.add_argument(
+        "--out",
+        default=None,
+        help="where to write RESULTS.md "
+        "(default benchmarks/RESULTS.md; --quick writes nothing unless given)",
+    )
     args = ap.parse_args(argv)
     quick = args.quick
     repeats = 1 if quick else 7
-    n_samples = 1001 if quick else 10001          # the issue's default grid: 0-10 s at 1 ms
+    n_samples = 1001 if quick else 10001  # the issue's default grid: 0-10 s at 1 ms
     T = np.linspace(0.0, 10.0, n_samples)
     h = T[1] - T[0]
     sys_free = qc.quarter_car()
     sys_road = qc.quarter_car(road=True)
-    U = np.where(T >= 0.5, 0.05, 0.0)              # a 5 cm road step at 0.5 s
+    U = np.where(T >= 0.5, 0.05, 0.0)  # a 5 cm road step at 0.5 s
     A = np.asarray(sys_free.A)
     f = lambda t, x: A @ x  # noqa: E731
     md = ["# qc_control benchmarks", ""]
     say = print
 
-    say(f"qc_control benchmarks ({'quick smoke mode' if quick else 'full'}): "
-        f"{n_samples} samples, h = {h * 1e3:g} ms, best of {repeats}")
+    say(
+        f"qc_control benchmarks ({'quick smoke mode' if quick else 'full'}): "
+        f"{n_samples} samples, h = {h * 1e3:g} ms, best of {repeats}"
+    )
 
     # -- the problem and its reference
     exact_free = control.initial_response(sys_free, T, X0)
     lam, V = np.linalg.eig(A)
-    closed = (V @ (np.linalg.solve(V, X0.astype(complex))[:, None]
-                   * np.exp(np.outer(lam, T)))).real
+    closed = (V @ (np.linalg.solve(V, X0.astype(complex))[:, None] * np.exp(np.outer(lam, T)))).real
     ref_err = float(np.max(np.abs(exact_free.states - closed)))
-    md += ["## Problem", "",
-           f"The seed's quarter car, body released from 5 cm (X0 = [0, 0, 0.05, 0]), 0-10 s "
-           f"on {n_samples} samples (h = {h * 1e3:g} ms); forced case: a 5 cm road step at "
-           "0.5 s with `quarter_car(road=True)`.", "",
-           "## Reference", "",
-           f"`control.initial_response` / `forced_response` (matrix exponential, exact for "
-           f"inputs linear between samples). Against the modal closed form V·exp(Λt)·V⁻¹·x0 "
-           f"the free reference is within {g(ref_err)} m.", ""]
+    md += [
+        "## Problem",
+        "",
+        f"The seed's quarter car, body released from 5 cm (X0 = [0, 0, 0.05, 0]), 0-10 s "
+        f"on {n_samples} samples (h = {h * 1e3:g} ms); forced case: a 5 cm road step at "
+        "0.5 s with `quarter_car(road=True)`.",
+        "",
+        "## Reference",
+        "",
+        f"`control.initial_response` / `forced_response` (matrix exponential, exact for "
+        f"inputs linear between samples). Against the modal closed form V·exp(Λt)·V⁻¹·x0 "
+        f"the free reference is within {g(ref_err)} m.",
+        "",
+    ]
 
     # -- 1. LTI engine and generic stepper against control, every method
     t_ci = best_of(lambda: control.initial_response(sys_free, T, X0), repeats)
@@ -125,19 +165,44 @@ def main(argv=None) -> int:
     for m in qc.METHODS:
         t_lf = best_of(lambda: qc.initial_response(sys_free, T, X0, m), repeats)
         t_lr = best_of(lambda: qc.forced_response(sys_road, T, U, X0, m), repeats)
-        t_gf = best_of(lambda: qc.initial_response(sys_free, T, X0, m, engine="generic"),
-                       max(1, repeats // 3))
+        t_gf = best_of(
+            lambda: qc.initial_response(sys_free, T, X0, m, engine="generic"), max(1, repeats // 3)
+        )
         lti = qc.initial_response(sys_free, T, X0, m)
         gen = qc.initial_response(sys_free, T, X0, m, engine="generic")
         gap = float(np.max(np.abs(lti.states - gen.states)) / np.max(np.abs(gen.states)))
         lti_times[m] = t_lf
-        rows.append([m, g(t_lf * 1e3), g(t_ci / t_lf), g(t_lr * 1e3), g(t_cf / t_lr),
-                     g(t_gf * 1e3), g(gap, 2)])
-    head = ["method", "LTI free [ms]", "× control.initial_response", "LTI road step [ms]",
-            "× control.forced_response", "generic free [ms]", "LTI vs generic (rel.)"]
-    md += ["## Results", "", "### The LTI engine against python-control", "",
-           f"control.initial_response: {g(t_ci * 1e3)} ms; control.forced_response "
-           f"(road step): {g(t_cf * 1e3)} ms.", "", table(head, rows), ""]
+        rows.append(
+            [
+                m,
+                g(t_lf * 1e3),
+                g(t_ci / t_lf),
+                g(t_lr * 1e3),
+                g(t_cf / t_lr),
+                g(t_gf * 1e3),
+                g(gap, 2),
+            ]
+        )
+    head = [
+        "method",
+        "LTI free [ms]",
+        "× control.initial_response",
+        "LTI road step [ms]",
+        "× control.forced_response",
+        "generic free [ms]",
+        "LTI vs generic (rel.)",
+    ]
+    md += [
+        "## Results",
+        "",
+        "### The LTI engine against python-control",
+        "",
+        f"control.initial_response: {g(t_ci * 1e3)} ms; control.forced_response "
+        f"(road step): {g(t_cf * 1e3)} ms.",
+        "",
+        table(head, rows),
+        "",
+    ]
     say(f"\ncontrol.initial_response {t_ci * 1e3:.3g} ms, forced_response {t_cf * 1e3:.3g} ms")
     say(table(head, rows))
 
@@ -148,14 +213,20 @@ def main(argv=None) -> int:
         t_gen = best_of(lambda: qc.integrate(f, T, X0, m), max(1, repeats // 2))
         rows.append([m, g(t_hand * 1e3), g(t_gen * 1e3), g(t_gen / t_hand)])
     head = ["method", "hand loop [ms]", "qc.integrate [ms]", "ratio (target ≤ 1.2)"]
-    md += ["### The generic stepper against a hand-written loop", "",
-           "Both call the same Python `f(t, x) = A @ x`.", "", table(head, rows), ""]
+    md += [
+        "### The generic stepper against a hand-written loop",
+        "",
+        "Both call the same Python `f(t, x) = A @ x`.",
+        "",
+        table(head, rows),
+        "",
+    ]
     say("\n" + table(head, rows))
 
     # -- 3. work-precision: each method over h; solve_ivp over rtol
     rows = []
     wp_T = {}
-    for hh in ([0.01, 0.005] if quick else [0.01, 0.005, 0.002, 0.001, 0.0005]):
+    for hh in [0.01, 0.005] if quick else [0.01, 0.005, 0.002, 0.001, 0.0005]:
         Th = np.linspace(0, 10, int(round(10 / hh)) + 1)
         ex = control.initial_response(sys_free, Th, X0).outputs[0]
         wp_T[hh] = (Th, ex)
@@ -167,69 +238,115 @@ def main(argv=None) -> int:
     ivp = {}
     Tq, exq = wp_T[min(wp_T)]
     for solver in ("RK45", "DOP853"):
-        for k in ([4, 8] if quick else [4, 6, 8, 10, 12]):
-            rtol = 10.0 ** -k
-            sol = solve_ivp(f, (0, 10), X0, method=solver, t_eval=Tq, rtol=rtol,
-                            atol=rtol * 1e-2)
+        for k in [4, 8] if quick else [4, 6, 8, 10, 12]:
+            rtol = 10.0**-k
+            sol = solve_ivp(f, (0, 10), X0, method=solver, t_eval=Tq, rtol=rtol, atol=rtol * 1e-2)
             err = float(np.max(np.abs(sol.y[2] - exq)))
-            t_run = best_of(lambda: solve_ivp(f, (0, 10), X0, method=solver, t_eval=Tq,
-                                              rtol=rtol, atol=rtol * 1e-2), repeats)
+            t_run = best_of(
+                lambda: solve_ivp(
+                    f, (0, 10), X0, method=solver, t_eval=Tq, rtol=rtol, atol=rtol * 1e-2
+                ),
+                repeats,
+            )
             ivp[(solver, k)] = (err, t_run, sol.nfev)
             rows.append([solver, f"rtol = 1e-{k}", g(err), str(sol.nfev), g(t_run * 1e3)])
     head = ["method", "setting", "max |xs error| [m]", "RHS evaluations", "time [ms]"]
-    md += ["### Work and precision", "", "Error against control's exact response over "
-           "0-10 s; solve_ivp evaluated at the finest grid's points (t_eval).", "",
-           table(head, rows), ""]
+    md += [
+        "### Work and precision",
+        "",
+        "Error against control's exact response over "
+        "0-10 s; solve_ivp evaluated at the finest grid's points (t_eval).",
+        "",
+        table(head, rows),
+        "",
+    ]
     say("\n" + table(head, rows))
 
     # solve_ivp at the tolerance that first reaches RK4's error on the default grid
-    rk4_err = float(np.max(np.abs(qc.initial_response(sys_free, T, X0, "rk4").outputs[0]
-                                  - exact_free.outputs[0])))
+    rk4_err = float(
+        np.max(
+            np.abs(qc.initial_response(sys_free, T, X0, "rk4").outputs[0] - exact_free.outputs[0])
+        )
+    )
     rows = []
     for solver in ("RK45", "DOP853"):
         reached = sorted((k, v) for (s, k), v in ivp.items() if s == solver and v[0] <= rk4_err)
         if reached:
             k, (err, t_run, nfev) = reached[0]
-            rows.append([solver, f"1e-{k}", g(err), str(nfev), g(t_run * 1e3),
-                         g(t_run / lti_times["rk4"])])
+            rows.append(
+                [solver, f"1e-{k}", g(err), str(nfev), g(t_run * 1e3), g(t_run / lti_times["rk4"])]
+            )
         else:
             rows.append([solver, "none tried", "–", "–", "–", "–"])
-    head = ["solver", "rtol reaching RK4's error", "error [m]", "RHS evaluations", "time [ms]",
-            "× qc RK4 (LTI)"]
-    md += [f"solve_ivp at the loosest tried tolerance whose error is at most RK4's on the "
-           f"default grid ({g(rk4_err)} m):", "", table(head, rows), ""]
+    head = [
+        "solver",
+        "rtol reaching RK4's error",
+        "error [m]",
+        "RHS evaluations",
+        "time [ms]",
+        "× qc RK4 (LTI)",
+    ]
+    md += [
+        f"solve_ivp at the loosest tried tolerance whose error is at most RK4's on the "
+        f"default grid ({g(rk4_err)} m):",
+        "",
+        table(head, rows),
+        "",
+    ]
     say("\n" + table(head, rows))
 
     # -- 4. sweep against a loop of control calls
     n_ks, n_zeta = (4, 5) if quick else (40, 25)
     grid = {"ks": np.linspace(15e3, 45e3, n_ks), "zeta": np.linspace(0.1, 0.6, n_zeta)}
     designs = design_grid(grid)
-    systems = [qc.quarter_car(qc.QuarterCarParams(**d)) for d in designs]   # built outside timing
-    sweep(grid, T, X0, progress=False)                                       # warm-up
+    systems = [qc.quarter_car(qc.QuarterCarParams(**d)) for d in designs]  # built outside timing
+    sweep(grid, T, X0, progress=False)  # warm-up
     t_sweep = best_of(lambda: sweep(grid, T, X0, progress=False), max(1, repeats // 2))
     t_loop = best_of(lambda: [control.initial_response(s, T, X0) for s in systems], 1)
-    head = ["designs", "qc.sweep (RK4, metrics) [s]", "loop of control.initial_response [s]",
-            "ratio (target ≥ 100)"]
+    head = [
+        "designs",
+        "qc.sweep (RK4, metrics) [s]",
+        "loop of control.initial_response [s]",
+        "ratio (target ≥ 100)",
+    ]
     rows = [[str(len(designs)), g(t_sweep), g(t_loop), g(t_loop / t_sweep)]]
-    md += ["### Design sweep", "", "The control loop times only the `initial_response` calls "
-           "(systems built beforehand); the sweep's time includes validating the designs and "
-           f"computing its {len(DEFAULT_METRICS)} default metrics per design "
-           f"({', '.join(DEFAULT_METRICS)}).", "", table(head, rows), ""]
+    md += [
+        "### Design sweep",
+        "",
+        "The control loop times only the `initial_response` calls "
+        "(systems built beforehand); the sweep's time includes validating the designs and "
+        f"computing its {len(DEFAULT_METRICS)} default metrics per design "
+        f"({', '.join(DEFAULT_METRICS)}).",
+        "",
+        table(head, rows),
+        "",
+    ]
     say("\n" + table(head, rows))
 
-    md += ["## What failed", "",
-           "Nothing raised. solve_ivp's error at loose tolerances includes the interpolation "
-           "of its dense output at t_eval; that is how it is used.", "",
-           "## Conclusion", "",
-           "Ratios above are this run's; the issue's targets are ≥ 30× control for the LTI "
-           "engine, ≤ 1.2× a hand loop for the generic stepper, ≥ 100× a control loop for "
-           "the sweep.", "",
-           "## Versions and command", "",
-           f"python {platform.python_version()}, qc_control {qc.__version__}, python-control "
-           f"{control.__version__}, numpy {np.__version__}, scipy {scipy.__version__}; "
-           f"{platform.system()} {platform.machine()}, {platform.processor() or 'cpu'}; "
-           f"{dt.datetime.now().isoformat(timespec='seconds')}.", "",
-           "```", "python benchmarks/run.py" + (" --quick" if quick else ""), "```", ""]
+    md += [
+        "## What failed",
+        "",
+        "Nothing raised. solve_ivp's error at loose tolerances includes the interpolation "
+        "of its dense output at t_eval; that is how it is used.",
+        "",
+        "## Conclusion",
+        "",
+        "Ratios above are this run's; the issue's targets are ≥ 30× control for the LTI "
+        "engine, ≤ 1.2× a hand loop for the generic stepper, ≥ 100× a control loop for "
+        "the sweep.",
+        "",
+        "## Versions and command",
+        "",
+        f"python {platform.python_version()}, qc_control {qc.__version__}, python-control "
+        f"{control.__version__}, numpy {np.__version__}, scipy {scipy.__version__}; "
+        f"{platform.system()} {platform.machine()}, {platform.processor() or 'cpu'}; "
+        f"{dt.datetime.now().isoformat(timespec='seconds')}.",
+        "",
+        "```",
+        "python benchmarks/run.py" + (" --quick" if quick else ""),
+        "```",
+        "",
+    ]
     out = args.out or (None if quick else str(Path(__file__).with_name("RESULTS.md")))
     if out:
         Path(out).write_text("\n".join(md), encoding="utf-8")

@@ -3,6 +3,7 @@
 Run:  python examples/custom_method.py [OUT_DIR]
 Writes a full report for six methods into OUT_DIR/custom_report/.
 """
+
 import sys
 from pathlib import Path
 
@@ -13,17 +14,24 @@ import qc_control as qc
 out = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
 
 # Ralston's second-order method: the 2-stage method of least error bound.
-ralston = qc.ButcherTableau("ralston", a=[[0, 0], [2 / 3, 0]], b=[1 / 4, 3 / 4],
-                            c=[0, 2 / 3], order=2)
+ralston = qc.ButcherTableau(
+    "ralston", a=[[0, 0], [2 / 3, 0]], b=[1 / 4, 3 / 4], c=[0, 2 / 3], order=2
+)
 # Kutta's 3/8 rule, the other classic fourth-order method.
 three_eighths = qc.ButcherTableau(
     "3/8-rule",
     a=[[0, 0, 0, 0], [1 / 3, 0, 0, 0], [-1 / 3, 1, 0, 0], [1, -1, 1, 0]],
-    b=[1 / 8, 3 / 8, 3 / 8, 1 / 8], c=[0, 1 / 3, 2 / 3, 1], order=4)
+    b=[1 / 8, 3 / 8, 3 / 8, 1 / 8],
+    c=[0, 1 / 3, 2 / 3, 1],
+    order=4,
+)
 
-cmp = qc.compare_methods(qc.QuarterCarParams(), np.linspace(0, 5, 501),
-                         methods=("euler", "midpoint", "heun", ralston, "rk4", three_eighths),
-                         repeats=3)
+cmp = qc.compare_methods(
+    qc.QuarterCarParams(),
+    np.linspace(0, 5, 501),
+    methods=("euler", "midpoint", "heun", ralston, "rk4", three_eighths),
+    repeats=3,
+)
 print(cmp.summary().to_string(float_format=lambda v: f"{v:.4g}"))
 path = cmp.write(out / "custom_report", command="python examples/custom_method.py")
 print(f"\nwrote {path}")

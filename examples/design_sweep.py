@@ -8,6 +8,7 @@ trade-off. (Releasing the body from 5 cm would not do: every design would
 start at 50 mm of travel.)
 Writes design_sweep.png and design_sweep.csv.
 """
+
 import sys
 from pathlib import Path
 
@@ -17,9 +18,9 @@ from matplotlib.figure import Figure
 import qc_control as qc
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
-T = np.linspace(0.0, 10.0, 10001)                           # h = 1 ms
+T = np.linspace(0.0, 10.0, 10001)  # h = 1 ms
 grid = {"ks": np.linspace(15e3, 45e3, 40), "zeta": np.linspace(0.1, 0.6, 25)}
-road_step = np.where(T >= 0.5, 0.05, 0.0)                  # zr [m]
+road_step = np.where(T >= 0.5, 0.05, 0.0)  # zr [m]
 result = qc.sweep(grid, T, X0=np.zeros(4), U=road_step, method="rk4")
 table = result.metrics
 table.to_csv(out / "design_sweep.csv")
@@ -28,16 +29,26 @@ fig = Figure(figsize=(7, 4.5), layout="constrained")
 ax = fig.subplots()
 for ks in grid["ks"][::6]:
     rows = table[np.isclose(table["ks"], ks)]
-    ax.plot(rows["peak_travel [m]"] * 1e3, rows["rms_body_acc [m/s²]"], "o-", ms=3,
-            label=f"ks = {ks / 1e3:.0f} kN/m")
-ax.set(xlabel="peak suspension travel [mm]", ylabel="RMS body acceleration [m/s²]",
-       title="1,000 designs on a 5 cm road step: ζ 0.1 → 0.6 along each curve")
+    ax.plot(
+        rows["peak_travel [m]"] * 1e3,
+        rows["rms_body_acc [m/s²]"],
+        "o-",
+        ms=3,
+        label=f"ks = {ks / 1e3:.0f} kN/m",
+    )
+ax.set(
+    xlabel="peak suspension travel [mm]",
+    ylabel="RMS body acceleration [m/s²]",
+    title="1,000 designs on a 5 cm road step: ζ 0.1 → 0.6 along each curve",
+)
 ax.legend(fontsize="small")
 ax.grid(alpha=0.3)
 fig.savefig(out / "design_sweep.png", dpi=110)
 
 best = table.loc[table["rms_body_acc [m/s²]"].idxmin()]
-print(f"{len(table)} designs; the most comfortable: ks = {best['ks']:.0f} N/m, "
-      f"zeta = {best['zeta']:.3f}, RMS body acceleration {best['rms_body_acc [m/s²]']:.3f} m/s², "
-      f"peak travel {best['peak_travel [m]'] * 1e3:.1f} mm")
+print(
+    f"{len(table)} designs; the most comfortable: ks = {best['ks']:.0f} N/m, "
+    f"zeta = {best['zeta']:.3f}, RMS body acceleration {best['rms_body_acc [m/s²]']:.3f} m/s², "
+    f"peak travel {best['peak_travel [m]'] * 1e3:.1f} mm"
+)
 print(f"wrote {out / 'design_sweep.png'} and {out / 'design_sweep.csv'}")

@@ -5,6 +5,7 @@ Prints the modal table for the seed's car and sweeps the tire stiffness
 to show the body mode's damping approaching the nominal ratio as the
 tire stiffens; writes modal_tire_stiffness.png.
 """
+
 import sys
 from pathlib import Path
 
@@ -14,9 +15,9 @@ from matplotlib.figure import Figure
 import qc_control as qc
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
-print(qc.modal_analysis())                  # the seed's Table 1
+print(qc.modal_analysis())  # the seed's Table 1
 
-ratios = np.logspace(-0.5, 3, 60)           # ku / ks
+ratios = np.logspace(-0.5, 3, 60)  # ku / ks
 seed = qc.QuarterCarParams()
 body = [qc.modal_analysis(qc.QuarterCarParams(ku=r * seed.ks)).body for r in ratios]
 
@@ -28,11 +29,13 @@ top.axvline(seed.ku / seed.ks, color="r", ls=":", label="seed's tire")
 top.set(ylabel="damping ratio [-]")
 top.legend(fontsize="small")
 bottom.semilogx(ratios, [m.fn for m in body])
-bottom.axhline(np.sqrt(seed.ks / seed.ms) / (2 * np.pi), color="k", ls="--",
-               label="rigid tire: √(ks/ms)/2π")
-bottom.set(xlabel="tire stiffness / suspension stiffness, ku/ks [-]",
-           ylabel="body frequency [Hz]")
+bottom.axhline(
+    np.sqrt(seed.ks / seed.ms) / (2 * np.pi), color="k", ls="--", label="rigid tire: √(ks/ms)/2π"
+)
+bottom.set(xlabel="tire stiffness / suspension stiffness, ku/ks [-]", ylabel="body frequency [Hz]")
 bottom.legend(fontsize="small")
 fig.savefig(out / "modal_tire_stiffness.png", dpi=110)
-print(f"\nAt ku/ks = 1000 the body's ζ is {body[-1].zeta:.4f} (nominal {seed.zeta}); "
-      f"wrote {out / 'modal_tire_stiffness.png'}")
+print(
+    f"\nAt ku/ks = 1000 the body's ζ is {body[-1].zeta:.4f} (nominal {seed.zeta}); "
+    f"wrote {out / 'modal_tire_stiffness.png'}"
+)

@@ -6,6 +6,7 @@ RMS dynamic tire load over the static wheel load (road holding) from the
 road PSD (ride_metrics_spectral), checks one cell against a 100 s
 simulation, and writes road_comfort.png.
 """
+
 import sys
 from pathlib import Path
 
@@ -24,24 +25,33 @@ rows = []
 for c in classes:
     for v in speeds:
         m = qc.ride_metrics_spectral(params, c, v)
-        rows.append({"class": c, "speed [m/s]": v,
-                     "comfort: rms body_acc Wk [m/s²]": m["rms body_acc Wk [m/s²]"],
-                     "road holding: rms tire load / static": m["rms tire load / static [-]"],
-                     "rms susp_travel [mm]": 1e3 * m["rms susp_travel [m]"]})
+        rows.append(
+            {
+                "class": c,
+                "speed [m/s]": v,
+                "comfort: rms body_acc Wk [m/s²]": m["rms body_acc Wk [m/s²]"],
+                "road holding: rms tire load / static": m["rms tire load / static [-]"],
+                "rms susp_travel [mm]": 1e3 * m["rms susp_travel [m]"],
+            }
+        )
 table = pd.DataFrame(rows).set_index(["class", "speed [m/s]"])
 print(table.to_string(float_format=lambda x: f"{x:.3f}"))
 
 # one cell by simulation: class C at 20 m/s, 100 s, the first 10 s dropped
 T = np.arange(0, 100.0 + 1e-9, 0.002)
-resp = qc.forced_response(qc.quarter_car(params, road=True), T, road.iso8608(T, "C", 20.0),
-                          method="rk4")
+resp = qc.forced_response(
+    qc.quarter_car(params, road=True), T, road.iso8608(T, "C", 20.0), method="rk4"
+)
 keep = T >= 10
-window = control.TimeResponseData(T[keep], resp.outputs[:, keep], issiso=False,
-                                  output_labels=resp.output_labels)
+window = control.TimeResponseData(
+    T[keep], resp.outputs[:, keep], issiso=False, output_labels=resp.output_labels
+)
 sim = qc.ride_metrics(window, params)
-print(f"\nclass C at 20 m/s simulated: Wk RMS {sim['rms body_acc Wk [m/s²]']:.3f} m/s², "
-      f"tire load {sim['rms tire load / static [-]']:.3f} (spectral: "
-      f"{table.loc[('C', 20.0)].iloc[0]:.3f}, {table.loc[('C', 20.0)].iloc[1]:.3f})")
+print(
+    f"\nclass C at 20 m/s simulated: Wk RMS {sim['rms body_acc Wk [m/s²]']:.3f} m/s², "
+    f"tire load {sim['rms tire load / static [-]']:.3f} (spectral: "
+    f"{table.loc[('C', 20.0)].iloc[0]:.3f}, {table.loc[('C', 20.0)].iloc[1]:.3f})"
+)
 
 fig = Figure(figsize=(9, 3.8), layout="constrained")
 left, right = fig.subplots(1, 2)
@@ -49,10 +59,14 @@ for c in classes:
     sub = table.loc[c]
     left.semilogy(sub.index, sub.iloc[:, 0], "o-", label=f"class {c}")
     right.semilogy(sub.index, sub.iloc[:, 1], "o-", label=f"class {c}")
-left.set(xlabel="speed [m/s]", ylabel="Wk-weighted RMS body acceleration [m/s²]",
-         title="Comfort (ISO 2631-1)")
-right.set(xlabel="speed [m/s]", ylabel="RMS dynamic tire load / static load [-]",
-          title="Road holding")
+left.set(
+    xlabel="speed [m/s]",
+    ylabel="Wk-weighted RMS body acceleration [m/s²]",
+    title="Comfort (ISO 2631-1)",
+)
+right.set(
+    xlabel="speed [m/s]", ylabel="RMS dynamic tire load / static load [-]", title="Road holding"
+)
 for ax in (left, right):
     ax.grid(alpha=0.3, which="both")
 left.legend(fontsize="small")

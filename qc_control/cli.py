@@ -30,18 +30,25 @@ class _Parser(argparse.ArgumentParser):
 def _add_params(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("vehicle (SI units; defaults: the seed's Table 1)")
     for f in fields(QuarterCarParams):
-        group.add_argument(f"--{f.name}", type=float, metavar="X",
-                           help=f"{f.name}, overrides the config file")
-    group.add_argument("--config", metavar="FILE.toml",
-                       help="TOML file with top-level ms, mu, ks, ku, zeta or cs"
-                            " (and a [scenario] table for 'report')")
+        group.add_argument(
+            f"--{f.name}", type=float, metavar="X", help=f"{f.name}, overrides the config file"
+        )
+    group.add_argument(
+        "--config",
+        metavar="FILE.toml",
+        help="TOML file with top-level ms, mu, ks, ku, zeta or cs"
+        " (and a [scenario] table for 'report')",
+    )
 
 
 def _params(args) -> tuple[QuarterCarParams, dict]:
     """The vehicle from ``--config`` and the options; options win."""
     values, scenario = read_config(args.config) if args.config else ({}, {})
-    given = {f.name: getattr(args, f.name) for f in fields(QuarterCarParams)
-             if getattr(args, f.name) is not None}
+    given = {
+        f.name: getattr(args, f.name)
+        for f in fields(QuarterCarParams)
+        if getattr(args, f.name) is not None
+    }
     if {"cs", "zeta"} & set(given):  # damping on the command line replaces the file's
         values.pop("cs", None)
         values.pop("zeta", None)
@@ -68,8 +75,10 @@ def _floats(text: str, name: str, count: int) -> tuple[float, ...]:
     except ValueError:
         raise UsageError(f"{name} must be {count} comma-separated numbers, got {text!r}") from None
     if len(values) != count:
-        raise UsageError(f"{name} must be {count} comma-separated numbers (vs,vu,xs,xu), "
-                         f"got {len(values)} in {text!r}")
+        raise UsageError(
+            f"{name} must be {count} comma-separated numbers (vs,vu,xs,xu), "
+            f"got {len(values)} in {text!r}"
+        )
     return values
 
 
@@ -80,35 +89,47 @@ def _scenario(args, table: dict) -> dict:
 
     unknown = sorted(set(table) - _SCENARIO_KEYS)
     if unknown:
-        raise UsageError(f"unknown [scenario] key {unknown[0]!r}; expected one of "
-                         f"{sorted(_SCENARIO_KEYS)}")
-    pick = lambda name, default: (getattr(args, name) if getattr(args, name) is not None  # noqa
-                                  else table.get(name, default))
+        raise UsageError(
+            f"unknown [scenario] key {unknown[0]!r}; expected one of {sorted(_SCENARIO_KEYS)}"
+        )
+    pick = lambda name, default: (
+        getattr(args, name)
+        if getattr(args, name) is not None  # noqa
+        else table.get(name, default)
+    )
     road = pick("road", None)
     if road is not None and road not in _ROADS:
         raise UsageError(f"--road must be one of {', '.join(_ROADS)}, got {road!r}")
     road_class, speed, seed = pick("road_class", "C"), pick("speed", 20.0), pick("seed", 0)
     if road != "iso8608" and (args.road_class is not None or args.seed is not None):
         raise UsageError("--road-class and --seed apply to --road iso8608 only")
-    if isinstance(speed, bool) or not isinstance(speed, (int, float)) \
-            or not math.isfinite(speed) or speed <= 0:
+    if (
+        isinstance(speed, bool)
+        or not isinstance(speed, (int, float))
+        or not math.isfinite(speed)
+        or speed <= 0
+    ):
         raise UsageError(f"--speed must be a finite number > 0 m/s, got {speed!r}")
     h = pick("h", None)
     if h is None:
         h = DEFAULT_H
         if road == "iso8608":
             from .road import largest_step
+
             limit = largest_step(speed)
             h = next((c for c in _NICE_STEPS if c <= limit), _NICE_STEPS[-1])
     t_end = pick("t_end", DEFAULT_T_END)
     for name, value in (("h", h), ("t-end", t_end)):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                or not math.isfinite(value) or value <= 0:
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, (int, float))
+            or not math.isfinite(value)
+            or value <= 0
+        ):
             raise UsageError(f"--{name} must be a finite number > 0 s, got {value!r}")
     steps = round(t_end / h)
     if steps < 2 or abs(steps * h - t_end) > 1e-9 * t_end:
-        raise UsageError(f"--t-end {t_end!r} s must be a whole number (>= 2) of steps "
-                         f"--h {h!r} s")
+        raise UsageError(f"--t-end {t_end!r} s must be a whole number (>= 2) of steps --h {h!r} s")
     x0 = pick("x0", DEFAULT_X0 if road is None else (0.0, 0.0, 0.0, 0.0))
     x0 = _floats(x0 if isinstance(x0, str) else ",".join(map(str, x0)), "--x0", 4)
     if not all(math.isfinite(v) for v in x0):
@@ -119,9 +140,17 @@ def _scenario(args, table: dict) -> dict:
     tabs = [get_method(m) for m in methods]
     if not tabs:
         raise UsageError("--methods must name at least one method")
-    return {"h": float(h), "t_end": float(t_end), "steps": int(steps), "x0": x0,
-            "methods": tuple(t.name for t in tabs), "road": road, "road_class": road_class,
-            "speed": float(speed), "seed": seed}
+    return {
+        "h": float(h),
+        "t_end": float(t_end),
+        "steps": int(steps),
+        "x0": x0,
+        "methods": tuple(t.name for t in tabs),
+        "road": road,
+        "road_class": road_class,
+        "speed": float(speed),
+        "seed": seed,
+    }
 
 
 def _road_input(sc: dict, T):
@@ -134,13 +163,17 @@ def _road_input(sc: dict, T):
     if kind == "step":
         return road.step(T), "a 5 cm road step at t = 0.5 s"
     if kind == "bump":
-        return (road.bump(T, speed=sc["speed"]),
-                f"a 5 cm, 1 m long 1 − cos bump at t = 0.5 s, at {sc['speed']:g} m/s")
+        return (
+            road.bump(T, speed=sc["speed"]),
+            f"a 5 cm, 1 m long 1 − cos bump at t = 0.5 s, at {sc['speed']:g} m/s",
+        )
     if kind == "sine":
         return road.sine(T), "a sinusoidal road, 1 cm amplitude at 1 Hz"
-    return (road.iso8608(T, sc["road_class"], sc["speed"], sc["seed"]),
-            f"an ISO 8608 class {str(sc['road_class']).upper()} road at {sc['speed']:g} m/s "
-            f"(seed {sc['seed']})")
+    return (
+        road.iso8608(T, sc["road_class"], sc["speed"], sc["seed"]),
+        f"an ISO 8608 class {str(sc['road_class']).upper()} road at {sc['speed']:g} m/s "
+        f"(seed {sc['seed']})",
+    )
 
 
 def _cmd_report(args) -> int:
@@ -157,29 +190,46 @@ def _cmd_report(args) -> int:
     out = args.out
     # fail before the work, not after it
     from pathlib import Path
+
     target = Path(out)
-    if target.exists() and (not target.is_dir() or (any(target.iterdir())
-                                                    and not (target / MARKER).exists())):
-        raise ReportError(f"refusing to overwrite {out!r}: it is not a qc-control report "
-                          f"(no {MARKER} file); choose another --out")
+    if target.exists() and (
+        not target.is_dir() or (any(target.iterdir()) and not (target / MARKER).exists())
+    ):
+        raise ReportError(
+            f"refusing to overwrite {out!r}: it is not a qc-control report "
+            f"(no {MARKER} file); choose another --out"
+        )
     T = np.linspace(0.0, sc["t_end"], sc["steps"] + 1)
-    U, description = _road_input(sc, T)        # validated before any output
+    U, description = _road_input(sc, T)  # validated before any output
 
     def progress(message):
         print(f"  {message}", file=sys.stderr, flush=True)
 
-    print(f"qc-control report: comparing {', '.join(sc['methods'])} at h = {sc['h']:g} s "
-          f"over 0-{sc['t_end']:g} s" + (f" on {description}" if description else ""),
-          file=sys.stderr, flush=True)
-    cmp = compare_methods(params, T, sc["x0"], U=U, methods=sc["methods"], progress=progress,
-                          input_description=description)
+    print(
+        f"qc-control report: comparing {', '.join(sc['methods'])} at h = {sc['h']:g} s "
+        f"over 0-{sc['t_end']:g} s" + (f" on {description}" if description else ""),
+        file=sys.stderr,
+        flush=True,
+    )
+    cmp = compare_methods(
+        params,
+        T,
+        sc["x0"],
+        U=U,
+        methods=sc["methods"],
+        progress=progress,
+        input_description=description,
+    )
     command = "qc-control " + shlex.join(args.argv)
     path = write_report(cmp, out, command=command)
-    with pd.option_context("display.width", 160, "display.max_columns", 20,
-                           "display.float_format", "{:.4g}".format):
+    with pd.option_context(
+        "display.width", 160, "display.max_columns", 20, "display.float_format", "{:.4g}".format
+    ):
         print(cmp.summary())
-    print(f"\nwrote {path / 'report.md'}, {path / 'report.html'} and the CSV tables and "
-          f"figures in {path}")
+    print(
+        f"\nwrote {path / 'report.md'}, {path / 'report.html'} and the CSV tables and "
+        f"figures in {path}"
+    )
     return 0
 
 
@@ -190,26 +240,39 @@ def build_parser() -> argparse.ArgumentParser:
     _add_params(modes)
     modes.set_defaults(run=_cmd_modes)
 
-    report = sub.add_parser("report", help="compare the methods against the exact response "
-                                           "and write the report")
+    report = sub.add_parser(
+        "report", help="compare the methods against the exact response and write the report"
+    )
     _add_params(report)
     sc = report.add_argument_group("scenario (defaults: the seed's, body released from 5 cm)")
     sc.add_argument("--h", type=float, metavar="S", help="step size [s] (default 0.01)")
     sc.add_argument("--t-end", type=float, metavar="S", help="end time [s] (default 10)")
-    sc.add_argument("--x0", metavar="VS,VU,XS,XU", help="initial state [m/s, m/s, m, m] "
-                                                       "(default 0,0,0.05,0)")
-    sc.add_argument("--methods", metavar="A,B,...",
-                    help="methods to compare (default euler,midpoint,heun,rk4)")
+    sc.add_argument(
+        "--x0", metavar="VS,VU,XS,XU", help="initial state [m/s, m/s, m, m] (default 0,0,0.05,0)"
+    )
+    sc.add_argument(
+        "--methods", metavar="A,B,...", help="methods to compare (default euler,midpoint,heun,rk4)"
+    )
     rd = report.add_argument_group("road input (default: none, the free response)")
-    rd.add_argument("--road", metavar="KIND", help="step, bump, sine or iso8608; the car "
-                    "then starts at rest unless --x0 is given")
+    rd.add_argument(
+        "--road",
+        metavar="KIND",
+        help="step, bump, sine or iso8608; the car then starts at rest unless --x0 is given",
+    )
     rd.add_argument("--road-class", metavar="A-H", help="ISO 8608 class (default C)")
-    rd.add_argument("--speed", type=float, metavar="M/S",
-                    help="vehicle speed for bump and iso8608 [m/s] (default 20)")
+    rd.add_argument(
+        "--speed",
+        type=float,
+        metavar="M/S",
+        help="vehicle speed for bump and iso8608 [m/s] (default 20)",
+    )
     rd.add_argument("--seed", type=int, metavar="N", help="ISO 8608 road seed (default 0)")
-    report.add_argument("--out", default="report", metavar="DIR",
-                        help="report directory (default report/); replaced only if it "
-                             "holds an earlier report")
+    report.add_argument(
+        "--out",
+        default="report",
+        metavar="DIR",
+        help="report directory (default report/); replaced only if it holds an earlier report",
+    )
     report.set_defaults(run=_cmd_report)
     return parser
 

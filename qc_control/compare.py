@@ -9,8 +9,8 @@ from __future__ import annotations
 import math
 import time
 import warnings
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Sequence
 
 import control
 import numpy as np
@@ -24,8 +24,15 @@ from .model import QuarterCarParams, quarter_car
 from .response import _initial_state, _input_samples, forced_response, initial_response
 from .stability import max_stable_step, numerical_modes
 
-__all__ = ["MethodComparison", "compare_methods", "DEFAULT_METHODS", "DEFAULT_X0",
-           "DEFAULT_T_END", "DEFAULT_H", "TOLERANCES"]
+__all__ = [
+    "MethodComparison",
+    "compare_methods",
+    "DEFAULT_METHODS",
+    "DEFAULT_X0",
+    "DEFAULT_T_END",
+    "DEFAULT_H",
+    "TOLERANCES",
+]
 
 #: The default scenario: the seed's vehicle, body released from 5 cm, 0-10 s, h = 0.01 s.
 DEFAULT_METHODS = ("euler", "midpoint", "heun", "rk4")
@@ -111,17 +118,29 @@ class MethodComparison:
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""
-        cols = ["order", "RHS evals", "wall time [ms]", "max |xs err| [m]",
-                "max |xu err| [m]", "observed order", "h_max [s]"]
+        cols = [
+            "order",
+            "RHS evals",
+            "wall time [ms]",
+            "max |xs err| [m]",
+            "max |xu err| [m]",
+            "observed order",
+            "h_max [s]",
+        ]
         return self.table[cols]
 
-    def write(self, out_dir, formats=("md", "html", "csv"), *, command: str | None = None,
-              overwrite: bool = True):
+    def write(
+        self,
+        out_dir,
+        formats=("md", "html", "csv"),
+        *,
+        command: str | None = None,
+        overwrite: bool = True,
+    ):
         """Write the report to ``out_dir``; see `qc_control.report.write_report`."""
         from .report import write_report
 
-        return write_report(self, out_dir, formats=formats, command=command,
-                            overwrite=overwrite)
+        return write_report(self, out_dir, formats=formats, command=command, overwrite=overwrite)
 
 
 def best_time(fn: Callable[[], object], repeats: int, warmup: bool = False) -> float:
@@ -197,8 +216,9 @@ def _reference_accuracy(sys, T, X0, U, reference) -> tuple[float, str]:
         other = np.asarray(sys.C)[:n] @ x
         how = "the modal closed form V·exp(Λt)·V⁻¹·x0"
     else:
-        lti = scipy.signal.StateSpace(np.asarray(sys.A), np.asarray(sys.B),
-                                      np.asarray(sys.C)[:n], np.asarray(sys.D)[:n])
+        lti = scipy.signal.StateSpace(
+            np.asarray(sys.A), np.asarray(sys.B), np.asarray(sys.C)[:n], np.asarray(sys.D)[:n]
+        )
         _, y, _ = scipy.signal.lsim(lti, U.T if U.shape[0] > 1 else U[0], T - T[0], X0=X0)
         other = np.atleast_2d(y.T) if y.ndim > 1 else y[None]
         how = "scipy.signal.lsim"
@@ -213,8 +233,7 @@ def _observed_order(hs, errors) -> float:
     return float(np.polyfit(np.log(hs[ok]), np.log(errors[ok]), 1)[0])
 
 
-def _cost_to_reach(conv: pd.DataFrame, method: ButcherTableau, span: float,
-                   h_max: float) -> dict:
+def _cost_to_reach(conv: pd.DataFrame, method: ButcherTableau, span: float, h_max: float) -> dict:
     """RHS evaluations for max |xs error| = tol, for each tolerance.
 
     Inside the refinements: log-log interpolation between the two levels
@@ -222,8 +241,12 @@ def _cost_to_reach(conv: pd.DataFrame, method: ButcherTableau, span: float,
     ``e = C h^p`` with the method's order p through the nearest level,
     never beyond the stability limit ('extrapolated').
     """
-    rows = conv[(conv["method"] == method.name) & conv["stable"] & np.isfinite(conv["error"])
-                & (conv["error"] > _ROUNDING_FLOOR)].sort_values("nfev")
+    rows = conv[
+        (conv["method"] == method.name)
+        & conv["stable"]
+        & np.isfinite(conv["error"])
+        & (conv["error"] > _ROUNDING_FLOOR)
+    ].sort_values("nfev")
     result = {}
     if rows.empty:
         return {tol: (math.nan, "unreached") for tol in TOLERANCES}
@@ -246,7 +269,7 @@ def _cost_to_reach(conv: pd.DataFrame, method: ButcherTableau, span: float,
 def _coincident(responses: dict) -> dict:
     names, pairs = list(responses), {}
     for i, a in enumerate(names):
-        for b in names[i + 1:]:
+        for b in names[i + 1 :]:
             xa, xb = responses[a].states, responses[b].states
             if xa.shape == xb.shape:
                 gap = float(np.max(np.abs(xa - xb)))
@@ -257,16 +280,26 @@ def _coincident(responses: dict) -> dict:
 
 def _limiting_mode(method, modes: ModalAnalysis) -> str:
     """The mode whose eigenvalue sets the method's step limit."""
-    limits = {m.name: max_stable_step(method, [m.eigenvalue, m.eigenvalue.conjugate()])
-              for m in modes.modes}
+    limits = {
+        m.name: max_stable_step(method, [m.eigenvalue, m.eigenvalue.conjugate()])
+        for m in modes.modes
+    }
     return min(limits, key=limits.get)
 
 
-def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = DEFAULT_METHODS,
-                    h: float | None = None, repeats: int = 5,
-                    progress: Callable[[str], None] | None = None,
-                    input_description: str = "",
-                    params: QuarterCarParams | None = None) -> MethodComparison:
+def compare_methods(
+    sys,
+    T=None,
+    X0=DEFAULT_X0,
+    *,
+    U=None,
+    methods: Sequence = DEFAULT_METHODS,
+    h: float | None = None,
+    repeats: int = 5,
+    progress: Callable[[str], None] | None = None,
+    input_description: str = "",
+    params: QuarterCarParams | None = None,
+) -> MethodComparison:
     """Compare fixed-step methods with python-control's exact response.
 
     Parameters
@@ -318,8 +351,9 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
         params = sys if isinstance(sys, QuarterCarParams) else QuarterCarParams(**(sys or {}))
         sys = quarter_car(params, road=U is not None)
     if not isinstance(sys, control.StateSpace):
-        raise TypeError(f"sys must be a control.StateSpace or QuarterCarParams, "
-                        f"got {type(sys).__name__}")
+        raise TypeError(
+            f"sys must be a control.StateSpace or QuarterCarParams, got {type(sys).__name__}"
+        )
     T = check_time_grid(np.linspace(0, DEFAULT_T_END, 1001) if T is None else T, "T")
     h, substeps = _grid(T, h)
     tabs = tuple(get_method(m) for m in methods)
@@ -339,8 +373,10 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
     reference = _exact(sys, T, X0, U)
     reference_time = best_time(lambda: _exact(sys, T, X0, U), repeats)
     reference_error, how = _reference_accuracy(sys, T, X0, U, reference)
-    exact_levels = {lvl: _exact(sys, _refined(T, lvl), X0, _refined_input(T, U, lvl)).outputs
-                    for lvl in range(_LEVELS + 1)}
+    exact_levels = {
+        lvl: _exact(sys, _refined(T, lvl), X0, _refined_input(T, U, lvl)).outputs
+        for lvl in range(_LEVELS + 1)
+    }
 
     rows, conv_rows, responses, nm = {}, [], {}, {}
     span = float(T[-1] - T[0])
@@ -361,25 +397,49 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
 
         for lvl in range(_LEVELS + 1):
             Tl = _refined(T, lvl)
-            r = resp if lvl == 0 else _simulate(sys, Tl, X0, _refined_input(T, U, lvl), tab,
-                                                 substeps)
-            t_run = wall if lvl == 0 else best_time(
-                lambda: _simulate(sys, Tl, X0, _refined_input(T, U, lvl), tab, substeps,
-                                  "generic"), 1)
-            e = r.outputs[0] - exact_levels[lvl][0, :r.time.size]
+            r = (
+                resp
+                if lvl == 0
+                else _simulate(sys, Tl, X0, _refined_input(T, U, lvl), tab, substeps)
+            )
+            t_run = (
+                wall
+                if lvl == 0
+                else best_time(
+                    lambda: _simulate(
+                        sys, Tl, X0, _refined_input(T, U, lvl), tab, substeps, "generic"
+                    ),
+                    1,
+                )
+            )
+            e = r.outputs[0] - exact_levels[lvl][0, : r.time.size]
             error = float(np.max(np.abs(e))) if r.time.size == Tl.size else math.inf
-            conv_rows.append({"method": tab.name, "level": lvl, "h": h / 2**lvl,
-                              "steps": r.steps, "nfev": r.nfev, "time": t_run,
-                              "error": error, "stable": h / 2**lvl <= h_max})
+            conv_rows.append(
+                {
+                    "method": tab.name,
+                    "level": lvl,
+                    "h": h / 2**lvl,
+                    "steps": r.steps,
+                    "nfev": r.nfev,
+                    "time": t_run,
+                    "error": error,
+                    "stable": h / 2**lvl <= h_max,
+                }
+            )
         conv = pd.DataFrame(conv_rows)
         mine = conv[(conv["method"] == tab.name) & (conv["level"] <= 2)]
         order = _observed_order(mine["h"], mine["error"]) if mine["stable"].all() else math.nan
 
         nm[tab.name] = numerical_modes(tab, h, sys)
         row = {
-            "order": tab.order, "stages": tab.stages, "h [s]": h, "steps": resp.steps,
-            "RHS evals": resp.nfev, "wall time [ms]": 1e3 * wall,
-            "LTI engine [ms]": 1e3 * wall_lti, "time / control": wall / reference_time,
+            "order": tab.order,
+            "stages": tab.stages,
+            "h [s]": h,
+            "steps": resp.steps,
+            "RHS evals": resp.nfev,
+            "wall time [ms]": 1e3 * wall,
+            "LTI engine [ms]": 1e3 * wall_lti,
+            "time / control": wall / reference_time,
         }
         for i, name, unit in ((0, "xs", "m"), (1, "xu", "m"), (4, "body_acc", "m/s²")):
             row[f"max |{name} err| [{unit}]"] = float(np.max(np.abs(err[i])))
@@ -401,27 +461,53 @@ def compare_methods(sys, T=None, X0=DEFAULT_X0, *, U=None, methods: Sequence = D
     if U is not None and "zr" in sys.input_labels and sys.ninputs == 1 and params is not None:
         from .ride import ride_metrics, transmissibility
 
-        ride = pd.DataFrame({"reference": ride_metrics(reference, params),
-                             **{m: ride_metrics(r, params) for m, r in responses.items()}}).T
+        ride = pd.DataFrame(
+            {
+                "reference": ride_metrics(reference, params),
+                **{m: ride_metrics(r, params) for m, r in responses.items()},
+            }
+        ).T
         ride.index.name = "response"
         trans = transmissibility(sys)
         numeric = ride.drop(columns=["lift-off", "lift-off time [s]"]).astype(float)
         ref = numeric.loc["reference"]
         ride_error = 100 * (numeric.drop(index="reference") - ref) / ref.where(ref != 0)
         ride_error.columns = [c.split(" [")[0] + " [% off]" for c in ride_error.columns]
-    reach = {tab.name: _cost_to_reach(convergence, tab, span, rows[tab.name]["h_max [s]"])
-             for tab in tabs}
+    reach = {
+        tab.name: _cost_to_reach(convergence, tab, span, rows[tab.name]["h_max [s]"])
+        for tab in tabs
+    }
     cost = pd.DataFrame({m: {tol: v[0] for tol, v in r.items()} for m, r in reach.items()})
     cost_kind = pd.DataFrame({m: {tol: v[1] for tol, v in r.items()} for m, r in reach.items()})
     cost.index.name = cost_kind.index.name = "tolerance [m]"
     return MethodComparison(
-        system=sys, params=params, T=T, X0=X0, U=U, h=h, substeps=substeps, methods=tabs,
-        table=table, modes=modes, numerical_modes=nm, convergence=convergence, cost=cost,
-        cost_kind=cost_kind, coincident=_coincident(responses),
-        reference=reference, reference_error=reference_error, reference_time=reference_time,
-        reference_description=how, responses=responses, eigenvalues=eig,
-        reference_name=(f"control.{'initial' if U is None else 'forced'}_response "
-                        f"(python-control {control.__version__})"),
-        input_description=input_description, ride=ride, ride_error=ride_error,
+        system=sys,
+        params=params,
+        T=T,
+        X0=X0,
+        U=U,
+        h=h,
+        substeps=substeps,
+        methods=tabs,
+        table=table,
+        modes=modes,
+        numerical_modes=nm,
+        convergence=convergence,
+        cost=cost,
+        cost_kind=cost_kind,
+        coincident=_coincident(responses),
+        reference=reference,
+        reference_error=reference_error,
+        reference_time=reference_time,
+        reference_description=how,
+        responses=responses,
+        eigenvalues=eig,
+        reference_name=(
+            f"control.{'initial' if U is None else 'forced'}_response "
+            f"(python-control {control.__version__})"
+        ),
+        input_description=input_description,
+        ride=ride,
+        ride_error=ride_error,
         transmissibility=trans,
     )

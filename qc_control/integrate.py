@@ -10,8 +10,14 @@ import numpy as np
 
 from .methods import ButcherTableau, get_method
 
-__all__ = ["Solution", "DivergenceWarning", "integrate", "check_time_grid", "check_substeps",
-           "uniform_step"]
+__all__ = [
+    "Solution",
+    "DivergenceWarning",
+    "integrate",
+    "check_time_grid",
+    "check_substeps",
+    "uniform_step",
+]
 
 #: Intervals between checks for a non-finite state. Checking every step would
 #: cost about as much as a stage; a blow-up is still cut at its first bad sample.
@@ -62,13 +68,16 @@ def check_time_grid(t, name: str = "T") -> np.ndarray:
     if t.ndim != 1 or t.size < 2:
         raise ValueError(f"{name} must be a 1-D array of at least 2 times, got shape {t.shape}")
     if not np.all(np.isfinite(t)):
-        raise ValueError(f"{name} must be finite; first bad value at index "
-                         f"{int(np.argmin(np.isfinite(t)))}")
+        raise ValueError(
+            f"{name} must be finite; first bad value at index {int(np.argmin(np.isfinite(t)))}"
+        )
     steps = np.diff(t)
     if np.any(steps <= 0):
         i = int(np.argmax(steps <= 0))
-        raise ValueError(f"{name} must increase strictly: {name}[{i}] = {float(t[i])!r} "
-                         f"and {name}[{i + 1}] = {float(t[i + 1])!r}")
+        raise ValueError(
+            f"{name} must increase strictly: {name}[{i}] = {float(t[i])!r} "
+            f"and {name}[{i + 1}] = {float(t[i + 1])!r}"
+        )
     return t
 
 
@@ -82,13 +91,15 @@ def _loop_source(tab: ButcherTableau, substeps: bool) -> str:
     s = tab.stages
     a, b, c = tab.a.tolist(), tab.b.tolist(), tab.c.tolist()
     coef = []
-    lines = ["def run(f, tt, x, out, start, stop, substeps):",
-             "    h_prev = None",
-             "    for n in range(start, stop):",
-             "        t = tt[n]",
-             "        h = (tt[n + 1] - t) / substeps" if substeps else "        h = tt[n + 1] - t",
-             "        if h != h_prev:",
-             "            h_prev = h"]
+    lines = [
+        "def run(f, tt, x, out, start, stop, substeps):",
+        "    h_prev = None",
+        "    for n in range(start, stop):",
+        "        t = tt[n]",
+        "        h = (tt[n + 1] - t) / substeps" if substeps else "        h = tt[n + 1] - t",
+        "        if h != h_prev:",
+        "            h_prev = h",
+    ]
     for i in range(s):
         if c[i] not in (0.0, 1.0):
             coef.append(f"            hc{i} = h * {c[i]!r}")
@@ -104,8 +115,11 @@ def _loop_source(tab: ButcherTableau, substeps: bool) -> str:
     lines += coef
     body = []
     if substeps:
-        body += ["        t0 = t", "        for sub in range(substeps):",
-                 "            t = t0 + sub * h"]
+        body += [
+            "        t0 = t",
+            "        for sub in range(substeps):",
+            "            t = t0 + sub * h",
+        ]
     pad = "            " if substeps else "        "
     for i in range(s):
         ti = "t" if c[i] == 0.0 else "t + h" if c[i] == 1.0 else f"t + hc{i}"
@@ -123,8 +137,7 @@ def _loop_source(tab: ButcherTableau, substeps: bool) -> str:
 @functools.lru_cache(maxsize=64)
 def _compiled_loop(tab: ButcherTableau, substeps: bool):
     namespace: dict = {}
-    exec(compile(_loop_source(tab, substeps), f"<qc_control loop: {tab.name}>", "exec"),
-         namespace)
+    exec(compile(_loop_source(tab, substeps), f"<qc_control loop: {tab.name}>", "exec"), namespace)
     return namespace["run"]
 
 
@@ -199,20 +212,22 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
         for start in range(0, t.size - 1, _CHECK_EVERY):
             stop = min(start + _CHECK_EVERY, t.size - 1)
             x = run(f, tt, x, out, start, stop, substeps)
-            block = out[start + 1:stop + 1]
+            block = out[start + 1 : stop + 1]
             bad = ~np.isfinite(block.reshape(block.shape[0], -1)).all(axis=1)
             if bad.any():
                 n_last = start + int(np.argmax(bad))
                 n_computed = stop
                 status = "diverged"
-                message = (f"{tab.name}: the state became non-finite after t = "
-                           f"{t[n_last]:.6g}; stopped after {n_last} of {t.size - 1} intervals")
+                message = (
+                    f"{tab.name}: the state became non-finite after t = "
+                    f"{t[n_last]:.6g}; stopped after {n_last} of {t.size - 1} intervals"
+                )
                 warnings.warn(message, DivergenceWarning, stacklevel=2)
                 break
     steps = n_computed * substeps
     return Solution(
-        t=t[:n_last + 1],
-        x=np.moveaxis(out[:n_last + 1], 0, -1),
+        t=t[: n_last + 1],
+        x=np.moveaxis(out[: n_last + 1], 0, -1),
         nfev=tab.stages * steps,
         steps=steps,
         method=tab,

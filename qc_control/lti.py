@@ -31,8 +31,9 @@ from .stability import stability_coefficients
 __all__ = ["step_matrices", "affine_scan", "lti_trajectory"]
 
 
-def step_matrices(method: ButcherTableau, A: np.ndarray, B: np.ndarray, H: float,
-                  substeps: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def step_matrices(
+    method: ButcherTableau, A: np.ndarray, B: np.ndarray, H: float, substeps: int = 1
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     r"""Φ, Γ₀, Γ₁ of one interval of length H split into ``substeps`` steps.
 
     Works on a batch: ``A`` of shape ``(..., n, n)`` and ``B`` of shape
@@ -58,17 +59,17 @@ def step_matrices(method: ButcherTableau, A: np.ndarray, B: np.ndarray, H: float
     h = H / substeps
     M = np.zeros(batch + (n + 2 * m, n + 2 * m))
     M[..., :n, :n] = A
-    M[..., :n, n:n + m] = B
-    M[..., n:n + m, n + m:] = np.eye(m) / H
+    M[..., :n, n : n + m] = B
+    M[..., n : n + m, n + m :] = np.eye(m) / H
     coef = stability_coefficients(method)
     hM = h * M
     step = np.broadcast_to(coef[-1] * np.eye(n + 2 * m), M.shape).copy()
-    for c in coef[-2::-1]:               # Horner: R(hM) = c0 I + hM (c1 I + hM (...))
+    for c in coef[-2::-1]:  # Horner: R(hM) = c0 I + hM (c1 I + hM (...))
         step = hM @ step
         step[..., np.arange(n + 2 * m), np.arange(n + 2 * m)] += c
     interval = step if substeps == 1 else np.linalg.matrix_power(step, substeps)
     phi = interval[..., :n, :n]
-    g_u, g_d = interval[..., :n, n:n + m], interval[..., :n, n + m:]
+    g_u, g_d = interval[..., :n, n : n + m], interval[..., :n, n + m :]
     return phi.copy(), g_u - g_d, g_d.copy()
 
 
@@ -83,7 +84,7 @@ def _powers(phi: np.ndarray, L: int) -> np.ndarray:
     k = 1
     while k < L:
         top = min(2 * k, L)
-        P[..., k + 1:top + 1, :, :] = P[..., 1:top - k + 1, :, :] @ P[..., k:k + 1, :, :]
+        P[..., k + 1 : top + 1, :, :] = P[..., 1 : top - k + 1, :, :] @ P[..., k : k + 1, :, :]
         k = top
     return P
 
@@ -108,18 +109,24 @@ def _free_response(phi, x0, N, C, time_last):
     nb = max(1, math.ceil(math.sqrt(N)))
     L = math.ceil(N / nb)
     Pb = _powers(phi, nb)
-    xb = (Pb[..., :nb, :, :] @ x0[..., None, :, None])[..., 0]      # (..., b, a): Φ^b x0
-    Pj = _powers(Pb[..., nb, :, :], L - 1)                           # (Φ^nb)^j
-    obs = Pj if C is None else C[..., None, :, :] @ Pj               # (..., j, r, a)
+    xb = (Pb[..., :nb, :, :] @ x0[..., None, :, None])[..., 0]  # (..., b, a): Φ^b x0
+    Pj = _powers(Pb[..., nb, :, :], L - 1)  # (Φ^nb)^j
+    obs = Pj if C is None else C[..., None, :, :] @ Pj  # (..., j, r, a)
     p = obs.shape[-2]
-    lhs = np.swapaxes(obs, -3, -2).reshape(batch + (p * L, n))       # rows (r, j)
+    lhs = np.swapaxes(obs, -3, -2).reshape(batch + (p * L, n))  # rows (r, j)
     out = (lhs @ np.swapaxes(xb, -1, -2)).reshape(batch + (p, L * nb))[..., :N]
     return out if time_last else np.swapaxes(out, -1, -2)
 
 
-def affine_scan(phi: np.ndarray, x0: np.ndarray, W: np.ndarray | None, N: int,
-                block: int = 16, C: np.ndarray | None = None,
-                time_last: bool = False) -> np.ndarray:
+def affine_scan(
+    phi: np.ndarray,
+    x0: np.ndarray,
+    W: np.ndarray | None,
+    N: int,
+    block: int = 16,
+    C: np.ndarray | None = None,
+    time_last: bool = False,
+) -> np.ndarray:
     r"""Solve ``x_0 = x0``, ``x_{k+1} = Φ x_k + W_k`` for k < N-1; return x or C x.
 
     Parameters
@@ -171,9 +178,9 @@ def affine_scan(phi: np.ndarray, x0: np.ndarray, W: np.ndarray | None, N: int,
     # Y_{b, q+1} for every block: one product with the block-Toeplitz matrix
     # M[(i, a), (q, c)] = (Φ^{q-i})[c, a] for i <= q (row block i feeds Y_{b, q+1})
     Wb = np.zeros(batch + (nb * L, n))
-    Wb[..., :N - 1, :] = W
-    lag = np.arange(L)[None, :] - np.arange(L)[:, None]              # q - i
-    M = np.swapaxes(P[..., np.clip(lag, 0, L), :, :], -1, -2)         # (..., i, q, a, c)
+    Wb[..., : N - 1, :] = W
+    lag = np.arange(L)[None, :] - np.arange(L)[:, None]  # q - i
+    M = np.swapaxes(P[..., np.clip(lag, 0, L), :, :], -1, -2)  # (..., i, q, a, c)
     M = np.swapaxes(M * (lag >= 0)[:, :, None, None], -3, -2).reshape(batch + (L * n, L * n))
     Y = (Wb.reshape(batch + (nb, L * n)) @ M).reshape(batch + (nb, L, n))
     # the carries c_b: V_0 = x0, V_{b+1} = Y_{b,L}, scanned with powers of Φ^L
@@ -184,25 +191,33 @@ def affine_scan(phi: np.ndarray, x0: np.ndarray, W: np.ndarray | None, N: int,
     # x_{bL+j} = Φ^j c_b + Y_{b,j}: one product with [Φ^0ᵀ ... Φ^{L-1}ᵀ] (or [(CΦ^j)ᵀ])
     obs = P[..., :L, :, :] if C is None else C[..., None, :, :] @ P[..., :L, :, :]
     p = obs.shape[-2]
-    stacked = np.swapaxes(np.swapaxes(obs, -1, -2), -3, -2)           # (..., a, j, r)
+    stacked = np.swapaxes(np.swapaxes(obs, -1, -2), -3, -2)  # (..., a, j, r)
     body = (V[..., :nb, :] @ stacked.reshape(batch + (n, L * p))).reshape(batch + (nb, L, p))
-    body[..., :, 1:, :] += (Y if C is None else
-                            Y @ np.swapaxes(C, -1, -2)[..., None, :, :])[..., :, :L - 1, :]
+    body[..., :, 1:, :] += (Y if C is None else Y @ np.swapaxes(C, -1, -2)[..., None, :, :])[
+        ..., :, : L - 1, :
+    ]
     last = V[..., nb, :]
     last = last if C is None else (C @ last[..., None])[..., 0]
     if time_last:
         out = np.empty(batch + (p, nb * L + 1))
-        out[..., :nb * L].reshape(batch + (p, nb, L))[...] = np.moveaxis(body, -1, -3)
+        out[..., : nb * L].reshape(batch + (p, nb, L))[...] = np.moveaxis(body, -1, -3)
         out[..., nb * L] = last
         return out[..., :N]
     out = np.empty(batch + (nb * L + 1, p))
-    out[..., :nb * L, :] = body.reshape(batch + (nb * L, p))
+    out[..., : nb * L, :] = body.reshape(batch + (nb * L, p))
     out[..., nb * L, :] = last
     return out[..., :N, :]
 
 
-def lti_trajectory(method: ButcherTableau, A, B, T: np.ndarray, U: np.ndarray | None,
-                   x0: np.ndarray, substeps: int = 1) -> np.ndarray:
+def lti_trajectory(
+    method: ButcherTableau,
+    A,
+    B,
+    T: np.ndarray,
+    U: np.ndarray | None,
+    x0: np.ndarray,
+    substeps: int = 1,
+) -> np.ndarray:
     """The method's states on a uniform grid T, shape ``(n, len(T))``.
 
     ``U`` is ``(ninputs, len(T))`` or None. The result equals

@@ -31,8 +31,7 @@ def _order_conditions(a, b, c):
         1: [b @ one - 1],
         2: [b @ c - 1 / 2],
         3: [b @ c**2 - 1 / 3, b @ ac - 1 / 6],
-        4: [b @ c**3 - 1 / 4, b @ (c * ac) - 1 / 8, b @ (a @ c**2) - 1 / 12,
-            b @ (a @ ac) - 1 / 24],
+        4: [b @ c**3 - 1 / 4, b @ (c * ac) - 1 / 8, b @ (a @ c**2) - 1 / 12, b @ (a @ ac) - 1 / 24],
     }
 
 
@@ -86,26 +85,32 @@ class ButcherTableau:
         s = b.shape[0] if b.ndim == 1 else -1
         where = f"tableau {self.name!r}"
         if s < 1 or a.shape != (s, s) or c.shape != (s,):
-            raise ValueError(f"{where}: need a (s, s), b (s,), c (s,); got a {a.shape}, "
-                             f"b {b.shape}, c {c.shape}")
+            raise ValueError(
+                f"{where}: need a (s, s), b (s,), c (s,); got a {a.shape}, b {b.shape}, c {c.shape}"
+            )
         if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(np.isfinite(c))):
             raise ValueError(f"{where}: coefficients must be finite")
         if np.any(np.triu(a) != 0):
             raise ValueError(f"{where}: a must be strictly lower triangular (explicit method)")
         for i in range(s):
             if abs(a[i].sum() - c[i]) > _TOL:
-                raise ValueError(f"{where}: row {i} of a sums to {a[i].sum():.15g}, "
-                                 f"but c[{i}] = {c[i]:.15g}")
+                raise ValueError(
+                    f"{where}: row {i} of a sums to {a[i].sum():.15g}, but c[{i}] = {c[i]:.15g}"
+                )
         if abs(b.sum() - 1) > _TOL:
             raise ValueError(f"{where}: b sums to {b.sum():.15g}, not 1")
-        if isinstance(self.order, bool) or not isinstance(self.order, (int, np.integer)) \
-                or self.order < 1:
+        if (
+            isinstance(self.order, bool)
+            or not isinstance(self.order, (int, np.integer))
+            or self.order < 1
+        ):
             raise ValueError(f"{where}: order must be a positive integer, got {self.order!r}")
         residuals = _order_conditions(a, b, c)
         for p in range(1, min(int(self.order), 4) + 1):
             if max(abs(r) for r in residuals[p]) > _TOL:
-                raise ValueError(f"{where}: claims order {self.order} but fails the "
-                                 f"order-{p} conditions")
+                raise ValueError(
+                    f"{where}: claims order {self.order} but fails the order-{p} conditions"
+                )
         for arr in (a, b, c):
             arr.flags.writeable = False
         object.__setattr__(self, "a", a)
@@ -157,6 +162,8 @@ def get_method(method) -> ButcherTableau:
         try:
             return METHODS[method.lower()]
         except KeyError:
-            raise ValueError(f"unknown method {method!r}; known methods are "
-                             f"{', '.join(METHODS)} (or pass a ButcherTableau)") from None
+            raise ValueError(
+                f"unknown method {method!r}; known methods are "
+                f"{', '.join(METHODS)} (or pass a ButcherTableau)"
+            ) from None
     raise TypeError(f"method must be a name or a ButcherTableau, got {type(method).__name__}")

@@ -96,8 +96,10 @@ class ModalAnalysis:
 
     def to_frame(self) -> pd.DataFrame:
         """One row per mode, indexed by name, columns with units."""
-        rows = {m.name: {label: getattr(m, attr) for attr, label in _COLUMNS.items()}
-                for m in self.modes}
+        rows = {
+            m.name: {label: getattr(m, attr) for attr, label in _COLUMNS.items()}
+            for m in self.modes
+        }
         frame = pd.DataFrame.from_dict(rows, orient="index")
         frame.index.name = "mode"
         return frame
@@ -190,10 +192,10 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
     w2, phi = np.linalg.eig(MinvK)
     order = np.argsort(np.abs(w2))
     w2, phi = w2[order].real, phi[:, order].real
-    undamped_names = _classify([abs(phi[1, i] / phi[0, i]) if phi[0, i] else math.inf
-                                for i in range(2)])
-    fn_undamped = {n: math.sqrt(max(w, 0.0)) / (2 * math.pi)
-                   for n, w in zip(undamped_names, w2)}
+    undamped_names = _classify(
+        [abs(phi[1, i] / phi[0, i]) if phi[0, i] else math.inf for i in range(2)]
+    )
+    fn_undamped = {n: math.sqrt(max(w, 0.0)) / (2 * math.pi) for n, w in zip(undamped_names, w2)}
 
     modes = []
     for name, (lams, v) in zip(names, groups):
@@ -205,9 +207,19 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
             wn = math.sqrt(l1 * l2)
             zeta, fd, lam = -(l1 + l2) / (2 * wn), 0.0, complex(max(l1, l2))
         ratio = v[3] / v[2] if v[2] != 0 else complex(math.inf)
-        modes.append(Mode(name, complex(lam), float(wn), float(zeta), float(fd),
-                          fn_undamped[name], float(abs(ratio)),
-                          float(np.degrees(np.angle(ratio))), float(zeta_nominal)))
+        modes.append(
+            Mode(
+                name,
+                complex(lam),
+                float(wn),
+                float(zeta),
+                float(fd),
+                fn_undamped[name],
+                float(abs(ratio)),
+                float(np.degrees(np.angle(ratio))),
+                float(zeta_nominal),
+            )
+        )
     modes.sort(key=lambda m: m.name != BODY)
     return ModalAnalysis(tuple(modes), _damping_note(modes[0], MinvK))
 
@@ -223,8 +235,9 @@ def _pair_eigenvalues(eigvals, eigvecs):
     real_idx = [i for i in range(4) if eigvals[i].imag == 0]
     groups = [((eigvals[i],), eigvecs[:, i]) for i in complex_idx]
     if real_idx:
-        real_idx.sort(key=lambda i: abs(eigvecs[3, i] / eigvecs[2, i])
-                      if eigvecs[2, i] != 0 else math.inf)
+        real_idx.sort(
+            key=lambda i: abs(eigvecs[3, i] / eigvecs[2, i]) if eigvecs[2, i] != 0 else math.inf
+        )
         for pair in (real_idx[:2], real_idx[2:]):
             if pair:
                 slow = max(pair, key=lambda i: eigvals[i].real)
@@ -238,14 +251,18 @@ def _damping_note(body: Mode, MinvK: np.ndarray) -> str:
     if not math.isfinite(nominal) or nominal == 0:
         return ""
     if abs(modal - nominal) <= 0.1 * nominal:
-        return (f"The body mode's modal damping ratio {modal:.3f} is within 10% of the "
-                f"nominal {nominal:.3f} = cs/(2*sqrt(ks*ms)).")
+        return (
+            f"The body mode's modal damping ratio {modal:.3f} is within 10% of the "
+            f"nominal {nominal:.3f} = cs/(2*sqrt(ks*ms))."
+        )
     # M^-1 K = [[ks/ms, -ks/ms], [-ks/mu, (ks+ku)/mu]], so ku/ks is read off the matrix.
     ku_over_ks = (MinvK[1, 1] + MinvK[1, 0]) / -MinvK[1, 0]
     ratio = body.shape_ratio * np.exp(1j * np.radians(body.shape_phase))
     stroke = abs(1.0 - ratio) if math.isfinite(body.shape_ratio) else math.inf
-    return (f"Note: the body mode's modal damping ratio {modal:.3f} is not the nominal "
-            f"{nominal:.3f} = cs/(2*sqrt(ks*ms)), which assumes a rigid tire; here the tire "
-            f"is {ku_over_ks:.2f} times as stiff as the spring, so in body bounce the wheel "
-            f"moves {body.shape_ratio:.2f} times as far as the body and the damper strokes "
-            f"{stroke:.2f} of the body's motion.")
+    return (
+        f"Note: the body mode's modal damping ratio {modal:.3f} is not the nominal "
+        f"{nominal:.3f} = cs/(2*sqrt(ks*ms)), which assumes a rigid tire; here the tire "
+        f"is {ku_over_ks:.2f} times as stiff as the spring, so in body bounce the wheel "
+        f"moves {body.shape_ratio:.2f} times as far as the body and the damper strokes "
+        f"{stroke:.2f} of the body's motion."
+    )

@@ -19,9 +19,10 @@ All quantities are SI: kg, N/m, N·s/m, m, s.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import control
 import numpy as np
@@ -135,14 +136,12 @@ class QuarterCarParams:
             )
 
     @classmethod
-    def from_mapping(cls, values: Mapping[str, Any]) -> "QuarterCarParams":
+    def from_mapping(cls, values: Mapping[str, Any]) -> QuarterCarParams:
         """Build from a dict; an unknown key raises ``ValueError`` naming it."""
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(values) - known)
         if unknown:
-            raise ValueError(
-                f"unknown parameter {unknown[0]!r}; expected one of {sorted(known)}"
-            )
+            raise ValueError(f"unknown parameter {unknown[0]!r}; expected one of {sorted(known)}")
         return cls(**dict(values))
 
     def to_dict(self) -> dict[str, float]:
@@ -213,15 +212,19 @@ def seed_matrices(ms, mu, ks, ku, cs) -> tuple[np.ndarray, np.ndarray, np.ndarra
     ``A (..., 4, 4)``, ``b_road = [0, ku/mu, 0, 0]`` and
     ``b_act = [1/ms, -1/mu, 0, 0]``, each ``(..., 4)``.
     """
-    ms, mu, ks, ku, cs = np.broadcast_arrays(*(np.asarray(v, dtype=float)
-                                              for v in (ms, mu, ks, ku, cs)))
+    ms, mu, ks, ku, cs = np.broadcast_arrays(
+        *(np.asarray(v, dtype=float) for v in (ms, mu, ks, ku, cs))
+    )
     zero, one = np.zeros_like(ms), np.ones_like(ms)
-    A = np.stack([
-        np.stack([-cs / ms, cs / ms, -ks / ms, ks / ms], axis=-1),
-        np.stack([cs / mu, -cs / mu, ks / mu, -(ks + ku) / mu], axis=-1),
-        np.stack([one, zero, zero, zero], axis=-1),
-        np.stack([zero, one, zero, zero], axis=-1),
-    ], axis=-2)
+    A = np.stack(
+        [
+            np.stack([-cs / ms, cs / ms, -ks / ms, ks / ms], axis=-1),
+            np.stack([cs / mu, -cs / mu, ks / mu, -(ks + ku) / mu], axis=-1),
+            np.stack([one, zero, zero, zero], axis=-1),
+            np.stack([zero, one, zero, zero], axis=-1),
+        ],
+        axis=-2,
+    )
     b_road = np.stack([zero, ku / mu, zero, zero], axis=-1)
     b_act = np.stack([1.0 / ms, -1.0 / mu, zero, zero], axis=-1)
     return A, b_road, b_act
@@ -233,8 +236,9 @@ def system_matrices(params=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return seed_matrices(p.ms, p.mu, p.ks, p.ku, p.cs)
 
 
-def quarter_car(params=None, *, road: bool = False, actuator: bool = False,
-                name: str = "quarter_car") -> control.StateSpace:
+def quarter_car(
+    params=None, *, road: bool = False, actuator: bool = False, name: str = "quarter_car"
+) -> control.StateSpace:
     """The quarter car as a continuous-time ``control.StateSpace``.
 
     Parameters
@@ -293,5 +297,6 @@ def quarter_car(params=None, *, road: bool = False, actuator: bool = False,
     if road:
         D[3, inputs.index("zr")] = -1.0
     D[4] = B[0]
-    return control.ss(A, B, C, D, states=list(STATES), inputs=inputs,
-                      outputs=list(OUTPUTS), name=name)
+    return control.ss(
+        A, B, C, D, states=list(STATES), inputs=inputs, outputs=list(OUTPUTS), name=name
+    )

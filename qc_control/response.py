@@ -14,8 +14,14 @@ import warnings
 import control
 import numpy as np
 
-from .integrate import (DivergenceWarning, Solution, check_substeps, check_time_grid, integrate,
-                        uniform_step)
+from .integrate import (
+    DivergenceWarning,
+    Solution,
+    check_substeps,
+    check_time_grid,
+    integrate,
+    uniform_step,
+)
 from .lti import lti_trajectory
 from .methods import ButcherTableau, get_method
 from .stability import amplification, max_stable_step
@@ -66,8 +72,10 @@ def _check_system(sys) -> None:
     if not isinstance(sys, control.StateSpace):
         raise TypeError(f"sys must be a control.StateSpace, got {type(sys).__name__}")
     if not control.isctime(sys, strict=True):
-        raise ValueError(f"system {sys.name!r} must be continuous-time for a fixed-step "
-                         f"method, got dt={sys.dt!r}")
+        raise ValueError(
+            f"system {sys.name!r} must be continuous-time for a fixed-step "
+            f"method, got dt={sys.dt!r}"
+        )
 
 
 def _initial_state(X0, n: int) -> np.ndarray:
@@ -77,8 +85,9 @@ def _initial_state(X0, n: int) -> np.ndarray:
     elif x0.shape in ((n, 1), (1, n)):
         x0 = x0.reshape(n)
     if x0.shape != (n,):
-        raise ValueError(f"X0 must have shape ({n},) for a system with {n} states, "
-                         f"got {np.asarray(X0).shape}")
+        raise ValueError(
+            f"X0 must have shape ({n},) for a system with {n} states, got {np.asarray(X0).shape}"
+        )
     if not np.all(np.isfinite(x0)):
         raise ValueError(f"X0 must be finite, got {x0.tolist()}")
     return x0
@@ -89,15 +98,19 @@ def _input_samples(U, ninputs: int, nsteps: int) -> np.ndarray:
     u = np.asarray(0.0 if U is None else U, dtype=float)
     if u.ndim == 0:
         if ninputs == 0 and u != 0:
-            raise ValueError("U is given but the system has no inputs "
-                             "(build it with quarter_car(road=True) or actuator=True)")
+            raise ValueError(
+                "U is given but the system has no inputs "
+                "(build it with quarter_car(road=True) or actuator=True)"
+            )
         u = np.full((ninputs, nsteps), float(u))
     elif u.ndim == 1 and ninputs == 1:
         u = u.reshape(1, -1)
     if u.shape != (ninputs, nsteps):
         want = f"({nsteps},) or (1, {nsteps})" if ninputs == 1 else f"({ninputs}, {nsteps})"
-        raise ValueError(f"U must have shape {want} to match T (len {nsteps}) and the "
-                         f"system's {ninputs} input(s), got {np.asarray(U).shape}")
+        raise ValueError(
+            f"U must have shape {want} to match T (len {nsteps}) and the "
+            f"system's {ninputs} input(s), got {np.asarray(U).shape}"
+        )
     if not np.all(np.isfinite(u)):
         raise ValueError("U must be finite")
     return u
@@ -130,6 +143,7 @@ def _generic(A, B, T, u_samples, x0, tab, substeps, warn):
         def rhs(t, x):
             return x @ AT + u_of_t(t) @ BT
     else:
+
         def rhs(t, x):
             return x @ AT
 
@@ -139,8 +153,7 @@ def _generic(A, B, T, u_samples, x0, tab, substeps, warn):
         return integrate(rhs, T, x0, tab, substeps=substeps)
 
 
-def _simulate(sys, T, U, X0, method, substeps, kind, transpose, return_x, squeeze,
-              engine="auto"):
+def _simulate(sys, T, U, X0, method, substeps, kind, transpose, return_x, squeeze, engine="auto"):
     _check_system(sys)
     tab = get_method(method)
     T = check_time_grid(T, "T")
@@ -158,8 +171,10 @@ def _simulate(sys, T, U, X0, method, substeps, kind, transpose, return_x, squeez
     if amplification(tab, h, eig) > 1 + 1e-12 and np.all(eig.real <= 0):
         h_max = max_stable_step(tab, eig)
         success = False
-        message = (f"h = {h:.6g} s exceeds the stability limit {h_max:.6g} s of "
-                   f"{tab.name} for system {sys.name!r}: the response grows")
+        message = (
+            f"h = {h:.6g} s exceeds the stability limit {h_max:.6g} s of "
+            f"{tab.name} for system {sys.name!r}: the response grows"
+        )
         warnings.warn(message, DivergenceWarning, stacklevel=3)
     # python-control's own test of an even grid: np.allclose(np.diff(T), dt)
     uniform = uniform_step(T, rtol=1e-5, atol=1e-8) is not None
@@ -179,21 +194,42 @@ def _simulate(sys, T, U, X0, method, substeps, kind, transpose, return_x, squeez
     x, u = sol.x, u_samples[:, :N]
     y = C @ x + D @ u if np.any(u) else C @ x
     resp = FixedStepResponse(
-        sol.t, y, x, u if kind == "forced" else None,
-        issiso=sys.issiso(), output_labels=sys.output_labels,
+        sol.t,
+        y,
+        x,
+        u if kind == "forced" else None,
+        issiso=sys.issiso(),
+        output_labels=sys.output_labels,
         input_labels=sys.input_labels if kind == "forced" else None,
-        state_labels=sys.state_labels, sysname=sys.name, plot_inputs=kind == "forced",
+        state_labels=sys.state_labels,
+        sysname=sys.name,
+        plot_inputs=kind == "forced",
         title=f"{kind.capitalize()} response for {sys.name} ({tab.name}, h = {h:.4g} s)",
-        trace_types=[kind], transpose=transpose, return_x=return_x, squeeze=squeeze,
-        success=success, message=message or None,
+        trace_types=[kind],
+        transpose=transpose,
+        return_x=return_x,
+        squeeze=squeeze,
+        success=success,
+        message=message or None,
     )
     resp.method, resp.h, resp.steps, resp.nfev = tab, h, sol.steps, sol.nfev
     resp._eigenvalues = eig
     return resp
 
 
-def initial_response(sys, T=None, X0=0.0, method="rk4", substeps: int = 1, *,
-                     engine="auto", transpose=False, return_x=False, squeeze=None, **kwargs):
+def initial_response(
+    sys,
+    T=None,
+    X0=0.0,
+    method="rk4",
+    substeps: int = 1,
+    *,
+    engine="auto",
+    transpose=False,
+    return_x=False,
+    squeeze=None,
+    **kwargs,
+):
     """Initial-condition response computed by a fixed-step method.
 
     The same call as ``control.initial_response(sys, T, X0)``; the
@@ -254,12 +290,35 @@ def initial_response(sys, T=None, X0=0.0, method="rk4", substeps: int = 1, *,
     True
     """
     values = _take_aliases(kwargs, {"T": T, "X0": X0, "return_x": return_x})
-    return _simulate(sys, values["T"], 0.0, values["X0"], method, substeps, "initial",
-                     transpose, values["return_x"], squeeze, engine)
+    return _simulate(
+        sys,
+        values["T"],
+        0.0,
+        values["X0"],
+        method,
+        substeps,
+        "initial",
+        transpose,
+        values["return_x"],
+        squeeze,
+        engine,
+    )
 
 
-def forced_response(sys, T=None, U=0.0, X0=0.0, method="rk4", substeps: int = 1, *,
-                    engine="auto", transpose=False, return_x=None, squeeze=None, **kwargs):
+def forced_response(
+    sys,
+    T=None,
+    U=0.0,
+    X0=0.0,
+    method="rk4",
+    substeps: int = 1,
+    *,
+    engine="auto",
+    transpose=False,
+    return_x=None,
+    squeeze=None,
+    **kwargs,
+):
     """Forced response computed by a fixed-step method.
 
     The same call as ``control.forced_response(sys, T, U, X0)``. The input
@@ -302,5 +361,16 @@ def forced_response(sys, T=None, U=0.0, X0=0.0, method="rk4", substeps: int = 1,
     0.05
     """
     values = _take_aliases(kwargs, {"T": T, "U": U, "X0": X0, "return_x": return_x})
-    return _simulate(sys, values["T"], values["U"], values["X0"], method, substeps, "forced",
-                     transpose, values["return_x"], squeeze, engine)
+    return _simulate(
+        sys,
+        values["T"],
+        values["U"],
+        values["X0"],
+        method,
+        substeps,
+        "forced",
+        transpose,
+        values["return_x"],
+        squeeze,
+        engine,
+    )

@@ -22,8 +22,15 @@ from .integrate import uniform_step
 from .model import _as_params, quarter_car
 from .road import ISO8608_BAND, ISO8608_N0, _band, _positive, _road_class
 
-__all__ = ["wk_filter", "wk_weighted", "transmissibility", "Transmissibility", "ride_metrics",
-           "ride_metrics_spectral", "STANDARD_GRAVITY"]
+__all__ = [
+    "wk_filter",
+    "wk_weighted",
+    "transmissibility",
+    "Transmissibility",
+    "ride_metrics",
+    "ride_metrics_spectral",
+    "STANDARD_GRAVITY",
+]
 
 #: Standard gravity [m/s²] (ISO 80000-3), for the static wheel load (ms + mu) g.
 STANDARD_GRAVITY = 9.80665
@@ -54,8 +61,10 @@ def wk_filter() -> control.TransferFunction:
     0.482
     """
     s = control.tf("s")
-    w = {k: 2 * math.pi * f for k, f in
-         {1: 0.4, 2: 100.0, 3: 12.5, 4: 12.5, 5: 2.37, 6: 3.35}.items()}
+    w = {
+        k: 2 * math.pi * f
+        for k, f in {1: 0.4, 2: 100.0, 3: 12.5, 4: 12.5, 5: 2.37, 6: 3.35}.items()
+    }
     q1 = q2 = 1 / math.sqrt(2)
     hh = s**2 / (s**2 + w[1] * s / q1 + w[1] ** 2)
     hl = w[2] ** 2 / (s**2 + w[2] * s / q2 + w[2] ** 2)
@@ -108,15 +117,17 @@ def wk_weighted(acc, T) -> np.ndarray:
     a = np.atleast_2d(np.asarray(acc, dtype=float))
     dt = _uniform(T)
     h, v = _wk_impulse(round(dt, 15), T.size)
-    out = scipy.signal.oaconvolve(a, h[None, :], axes=-1)[:, :T.size] + a[:, :1] * v
+    out = scipy.signal.oaconvolve(a, h[None, :], axes=-1)[:, : T.size] + a[:, :1] * v
     return out.reshape(np.shape(acc))
 
 
 def _road_system(sys_or_params):
     if isinstance(sys_or_params, control.StateSpace):
         if "zr" not in sys_or_params.input_labels:
-            raise ValueError(f"system {sys_or_params.name!r} has no road input 'zr'; build it "
-                             "with quarter_car(params, road=True)")
+            raise ValueError(
+                f"system {sys_or_params.name!r} has no road input 'zr'; build it "
+                "with quarter_car(params, road=True)"
+            )
         return sys_or_params
     return quarter_car(_as_params(sys_or_params), road=True)
 
@@ -160,11 +171,17 @@ class Transmissibility:
             ax.set(title=f"{name} / zr", ylabel=f"|H| [{_UNITS[name]}]")
             ax.grid(alpha=0.3, which="both")
             twin = ax.twinx()
-            twin.semilogx(self.freqs_hz, np.degrees(np.unwrap(np.angle(h))), color="tab:orange",
-                          lw=0.8)
+            twin.semilogx(
+                self.freqs_hz, np.degrees(np.unwrap(np.angle(h))), color="tab:orange", lw=0.8
+            )
             twin.set_ylabel("phase [deg]", color="tab:orange")
-        axes[1].plot([self.invariant_hz], [self.invariant_gain], "ko", mfc="none",
-                     label=f"invariant point: {self.invariant_hz:.2f} Hz, ku/ms")
+        axes[1].plot(
+            [self.invariant_hz],
+            [self.invariant_gain],
+            "ko",
+            mfc="none",
+            label=f"invariant point: {self.invariant_hz:.2f} Hz, ku/ms",
+        )
         axes[1].legend(fontsize="small", loc="lower left")
         for ax in axes[2:]:
             ax.set_xlabel("frequency [Hz]")
@@ -252,29 +269,34 @@ def ride_metrics(response, params=None) -> pd.Series:
     labels = list(response.output_labels)
     missing = [n for n in ("body_acc", "susp_travel", "tire_defl") if n not in labels]
     if missing:
-        raise ValueError(f"the response has no output {missing[0]!r}; use a response of "
-                         "quarter_car(params, road=True)")
+        raise ValueError(
+            f"the response has no output {missing[0]!r}; use a response of "
+            "quarter_car(params, road=True)"
+        )
     y = np.asarray(response.outputs)
     acc, travel, tire = (y[labels.index(n)] for n in ("body_acc", "susp_travel", "tire_defl"))
     dt = _uniform(T)
     aw = wk_weighted(acc, T)
-    dynamic = -p.ku * tire                     # tire compression force beyond static [N]
+    dynamic = -p.ku * tire  # tire compression force beyond static [N]
     static = (p.ms + p.mu) * STANDARD_GRAVITY
     lifted = dynamic < -static
-    return pd.Series({
-        "rms body_acc [m/s²]": _rms(acc, T),
-        "rms body_acc Wk [m/s²]": _rms(aw, T),
-        "VDV [m/s^1.75]": float(np.trapezoid(aw**4, T) ** 0.25),
-        "rms susp_travel [m]": _rms(travel, T),
-        "peak susp_travel [m]": float(np.max(np.abs(travel))),
-        "rms tire load / static [-]": _rms(dynamic, T) / static,
-        "lift-off": bool(lifted.any()),
-        "lift-off time [s]": float(np.count_nonzero(lifted) * dt),
-    })
+    return pd.Series(
+        {
+            "rms body_acc [m/s²]": _rms(acc, T),
+            "rms body_acc Wk [m/s²]": _rms(aw, T),
+            "VDV [m/s^1.75]": float(np.trapezoid(aw**4, T) ** 0.25),
+            "rms susp_travel [m]": _rms(travel, T),
+            "peak susp_travel [m]": float(np.max(np.abs(travel))),
+            "rms tire load / static [-]": _rms(dynamic, T) / static,
+            "lift-off": bool(lifted.any()),
+            "lift-off time [s]": float(np.count_nonzero(lifted) * dt),
+        }
+    )
 
 
-def ride_metrics_spectral(params=None, road_class: str = "C", speed: float = 20.0,
-                          band=ISO8608_BAND, points: int = 4000) -> pd.Series:
+def ride_metrics_spectral(
+    params=None, road_class: str = "C", speed: float = 20.0, band=ISO8608_BAND, points: int = 4000
+) -> pd.Series:
     """RMS ride metrics on an ISO 8608 road, from the road PSD and |H(f)|².
 
     .. math:: σ_y^2 = \\int |H_y(j2πf)|^2\\, G_t(f)\\, df, \\qquad
@@ -296,17 +318,19 @@ def ride_metrics_spectral(params=None, road_class: str = "C", speed: float = 20.
     lo, hi = _band(band)
     f = np.geomspace(speed * lo, speed * hi, points)
     tr = transmissibility(p, f)
-    road_psd = g0 * ((f / speed) / ISO8608_N0) ** -2.0 / speed        # m²/Hz
+    road_psd = g0 * ((f / speed) / ISO8608_N0) ** -2.0 / speed  # m²/Hz
     wk = np.abs(np.asarray(wk_filter()(2j * np.pi * f))).reshape(-1)
 
     def rms(h):
         return float(np.sqrt(np.trapezoid(np.abs(h) ** 2 * road_psd, f)))
 
     static = (p.ms + p.mu) * STANDARD_GRAVITY
-    return pd.Series({
-        "rms body_acc [m/s²]": rms(tr.response["body_acc"]),
-        "rms body_acc Wk [m/s²]": rms(wk * tr.response["body_acc"]),
-        "rms susp_travel [m]": rms(tr.response["susp_travel"]),
-        "rms tire load / static [-]": p.ku * rms(tr.response["tire_defl"]) / static,
-        "rms xs [m]": rms(tr.response["xs"]),
-    })
+    return pd.Series(
+        {
+            "rms body_acc [m/s²]": rms(tr.response["body_acc"]),
+            "rms body_acc Wk [m/s²]": rms(wk * tr.response["body_acc"]),
+            "rms susp_travel [m]": rms(tr.response["susp_travel"]),
+            "rms tire load / static [-]": p.ku * rms(tr.response["tire_defl"]) / static,
+            "rms xs [m]": rms(tr.response["xs"]),
+        }
+    )

@@ -12,14 +12,24 @@ import math
 
 import numpy as np
 
-__all__ = ["step", "bump", "sine", "iso8608", "iso8608_profile", "iso8608_psd",
-           "ISO8608_CLASSES", "ISO8608_N0", "ISO8608_BAND", "largest_step"]
+__all__ = [
+    "step",
+    "bump",
+    "sine",
+    "iso8608",
+    "iso8608_profile",
+    "iso8608_psd",
+    "ISO8608_CLASSES",
+    "ISO8608_N0",
+    "ISO8608_BAND",
+    "largest_step",
+]
 
 #: Reference spatial frequency n0 [cycles/m] of ISO 8608.
 ISO8608_N0 = 0.1
 #: Gd(n0) [m³] of road classes A–H: the geometric mean of each class,
 #: 16e-6 · 4^k (ISO 8608:2016, Table 1).
-ISO8608_CLASSES = {c: 16e-6 * 4.0 ** k for k, c in enumerate("ABCDEFGH")}
+ISO8608_CLASSES = {c: 16e-6 * 4.0**k for k, c in enumerate("ABCDEFGH")}
 #: The band of spatial frequencies [cycles/m] the standard classifies,
 #: wavelengths from 91 m down to 0.35 m (ISO 8608, 0.011 <= n <= 2.83).
 ISO8608_BAND = (0.011, 2.83)
@@ -32,15 +42,22 @@ def _grid(T) -> np.ndarray:
 
 
 def _positive(name: str, value, unit: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) \
-            or not math.isfinite(value) or value <= 0:
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float, np.number))
+        or not math.isfinite(value)
+        or value <= 0
+    ):
         raise ValueError(f"{name} must be a finite number > 0 {unit}, got {value!r}")
     return float(value)
 
 
 def _finite(name: str, value, unit: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) \
-            or not math.isfinite(value):
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float, np.number))
+        or not math.isfinite(value)
+    ):
         raise ValueError(f"{name} must be a finite number [{unit}], got {value!r}")
     return float(value)
 
@@ -55,8 +72,9 @@ def step(T, height: float = 0.05, t0: float = 0.5) -> np.ndarray:
     return np.where(T >= _finite("t0", t0, "s"), _finite("height", height, "m"), 0.0)
 
 
-def bump(T, height: float = 0.05, length: float = 1.0, speed: float = 10.0,
-         t0: float = 0.5) -> np.ndarray:
+def bump(
+    T, height: float = 0.05, length: float = 1.0, speed: float = 10.0, t0: float = 0.5
+) -> np.ndarray:
     """A 1 − cos bump of ``height`` [m] and ``length`` [m] met at ``t0`` [s].
 
     .. math:: z_r = \\frac{h}{2}\\Big(1 - \\cos\\frac{2\\pi x}{\\ell}\\Big),
@@ -74,22 +92,26 @@ def sine(T, amplitude: float = 0.01, frequency: float = 1.0) -> np.ndarray:
     """A sinusoidal road ``zr = amplitude · sin(2π f t)`` [m], f in Hz."""
     T = _grid(T)
     return _finite("amplitude", amplitude, "m") * np.sin(
-        2 * np.pi * _positive("frequency", frequency, "Hz") * T)
+        2 * np.pi * _positive("frequency", frequency, "Hz") * T
+    )
 
 
 def _road_class(road_class: str) -> float:
     key = str(road_class).strip().upper()
     if key not in ISO8608_CLASSES:
-        raise ValueError(f"unknown ISO 8608 road class {road_class!r}; expected one of "
-                         f"{', '.join(ISO8608_CLASSES)}")
+        raise ValueError(
+            f"unknown ISO 8608 road class {road_class!r}; expected one of "
+            f"{', '.join(ISO8608_CLASSES)}"
+        )
     return ISO8608_CLASSES[key]
 
 
 def _band(band) -> tuple[float, float]:
     lo, hi = (float(b) for b in band)
     if not (0 < lo < hi and math.isfinite(hi)):
-        raise ValueError(f"band must be (n_min, n_max) with 0 < n_min < n_max cycles/m, "
-                         f"got {band!r}")
+        raise ValueError(
+            f"band must be (n_min, n_max) with 0 < n_min < n_max cycles/m, got {band!r}"
+        )
     return lo, hi
 
 
@@ -108,8 +130,9 @@ def largest_step(speed: float, band=ISO8608_BAND) -> float:
     return 1.0 / (2.0 * _positive("speed", speed, "m/s") * _band(band)[1])
 
 
-def iso8608_profile(length: float, dx: float, road_class: str = "C", seed: int = 0,
-                    band=ISO8608_BAND) -> tuple[np.ndarray, np.ndarray]:
+def iso8608_profile(
+    length: float, dx: float, road_class: str = "C", seed: int = 0, band=ISO8608_BAND
+) -> tuple[np.ndarray, np.ndarray]:
     """A random ISO 8608 road profile in the distance domain.
 
     Parameters
@@ -146,11 +169,13 @@ def iso8608_profile(length: float, dx: float, road_class: str = "C", seed: int =
     lo, hi = _band(band)
     g0 = _road_class(road_class)
     if dx > 1 / (2 * hi):
-        raise ValueError(f"dx = {dx!r} m is too coarse for the band up to {hi!r} cycles/m: "
-                         f"it must be <= 1/(2 n_max) = {1 / (2 * hi):.4g} m")
+        raise ValueError(
+            f"dx = {dx!r} m is too coarse for the band up to {hi!r} cycles/m: "
+            f"it must be <= 1/(2 n_max) = {1 / (2 * hi):.4g} m"
+        )
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
         raise ValueError(f"seed must be an integer, got {seed!r}")
-    N = int(math.ceil(max(length, 10.0 / lo) / dx)) + 1     # (N - 1) dx >= length
+    N = int(math.ceil(max(length, 10.0 / lo) / dx)) + 1  # (N - 1) dx >= length
     N += N % 2
     dn = 1.0 / (N * dx)
     n = np.arange(N // 2 + 1) * dn
@@ -165,8 +190,9 @@ def iso8608_profile(length: float, dx: float, road_class: str = "C", seed: int =
     return x[keep], z[keep]
 
 
-def iso8608(T, road_class: str = "C", speed: float = 20.0, seed: int = 0,
-            band=ISO8608_BAND) -> np.ndarray:
+def iso8608(
+    T, road_class: str = "C", speed: float = 20.0, seed: int = 0, band=ISO8608_BAND
+) -> np.ndarray:
     """A random ISO 8608 road driven at ``speed`` [m/s], sampled at ``T`` [s].
 
     The profile of `iso8608_profile` with ``x = speed · (t - T[0])``. The
@@ -191,7 +217,8 @@ def iso8608(T, road_class: str = "C", speed: float = 20.0, seed: int = 0,
         raise ValueError(
             f"T's step {dt:.4g} s is too coarse for an ISO 8608 road at {speed:g} m/s: it "
             f"samples the road every {speed * dt:.4g} m, but the band up to {hi:g} cycles/m "
-            f"needs a step <= {limit:.4g} s (or a narrower band)")
+            f"needs a step <= {limit:.4g} s (or a narrower band)"
+        )
     x = speed * (T - T[0])
     dx = speed * float(np.min(np.diff(T)))
     xp, zp = iso8608_profile(max(x[-1], dx), dx, road_class, seed, (lo, hi))

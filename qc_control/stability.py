@@ -21,8 +21,14 @@ from numpy.polynomial import Polynomial
 from .methods import get_method
 from .model import QuarterCarParams, quarter_car
 
-__all__ = ["stability_function", "stability_coefficients", "amplification", "max_stable_step",
-           "numerical_modes", "eigenvalues_of"]
+__all__ = [
+    "stability_function",
+    "stability_coefficients",
+    "amplification",
+    "max_stable_step",
+    "numerical_modes",
+    "eigenvalues_of",
+]
 
 
 def stability_function(method) -> Polynomial:
@@ -84,8 +90,10 @@ def eigenvalues_of(sys_or_eigenvalues) -> np.ndarray:
         sys_or_eigenvalues = quarter_car(sys_or_eigenvalues)
     if isinstance(sys_or_eigenvalues, control.StateSpace):
         if not control.isctime(sys_or_eigenvalues, strict=True):
-            raise ValueError(f"system {sys_or_eigenvalues.name!r} must be continuous-time, "
-                             f"got dt={sys_or_eigenvalues.dt!r}")
+            raise ValueError(
+                f"system {sys_or_eigenvalues.name!r} must be continuous-time, "
+                f"got dt={sys_or_eigenvalues.dt!r}"
+            )
         return np.linalg.eigvals(np.asarray(sys_or_eigenvalues.A, dtype=float))
     lam = np.atleast_1d(np.asarray(sys_or_eigenvalues, dtype=complex))
     if lam.ndim != 1 or not np.all(np.isfinite(lam)):
@@ -109,11 +117,11 @@ def _max_steps(R: Polynomial, lams: np.ndarray) -> np.ndarray:
     lam = lams[nz]
     if not lam.size or deg == 0:
         return out
-    r = coef[None, :] * lam[:, None] ** np.arange(deg + 1)          # R(hλ) in powers of h
+    r = coef[None, :] * lam[:, None] ** np.arange(deg + 1)  # R(hλ) in powers of h
     q = np.zeros((lam.size, 2 * deg + 1))
     for a in range(deg + 1):
-        q[:, a:a + deg + 1] += (r[:, a:a + 1] * np.conj(r)).real
-    g = q[:, 1:]                                                     # (|R|² - 1) / h
+        q[:, a : a + deg + 1] += (r[:, a : a + 1] * np.conj(r)).real
+    g = q[:, 1:]  # (|R|² - 1) / h
     d = g.shape[1] - 1
     if d == 0:
         roots = np.full((lam.size, 1), np.inf + 0j)
@@ -165,7 +173,7 @@ def max_stable_step(method, sys_or_eigenvalues) -> float:
     0.1085
     """
     lam = eigenvalues_of(sys_or_eigenvalues)
-    lam = np.unique(np.where(lam.imag < 0, lam.conj(), lam))   # a conjugate has the same limit
+    lam = np.unique(np.where(lam.imag < 0, lam.conj(), lam))  # a conjugate has the same limit
     return float(_max_steps(stability_function(method), lam).min())
 
 

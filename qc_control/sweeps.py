@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import itertools
 import warnings
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor
 from dataclasses import dataclass, fields
-from typing import Callable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -47,6 +47,7 @@ class SweepChunk:
         """ISO 2631-1 Wk-weighted body acceleration (m, N), computed once."""
         if self._weighted is None:
             from .ride import wk_weighted
+
             self._weighted = wk_weighted(self.y[:, 4], self.T)
         return self._weighted
 
@@ -76,9 +77,9 @@ def _settling_time(c):
     """First time [s] after which xs stays within 2% of its largest excursion
     from its final value (the 2% settling criterion)."""
     T, y = c.T, c.y
-    dev = np.abs(y[:, 0, ::-1] - y[:, 0, -1:])          # time reversed, stored contiguous
+    dev = np.abs(y[:, 0, ::-1] - y[:, 0, -1:])  # time reversed, stored contiguous
     outside = dev > 0.02 * np.max(dev, axis=-1, keepdims=True)
-    from_end = np.argmax(outside, axis=-1)               # first sample outside, from the end
+    from_end = np.argmax(outside, axis=-1)  # first sample outside, from the end
     settle = np.minimum(np.where(outside.any(axis=-1), T.size - from_end, 0), T.size - 1)
     return T[settle]
 
@@ -101,7 +102,7 @@ def _rms_tire_load(c):
 
 def _lift_off_time(c):
     """Time [s] the dynamic load unloads the tire by more than the static load."""
-    lifted = c.y[:, 3] > (_static_load(c) / c.design["ku"])[:, None]   # ku·defl > static
+    lifted = c.y[:, 3] > (_static_load(c) / c.design["ku"])[:, None]  # ku·defl > static
     return np.count_nonzero(lifted, axis=-1) * (c.T[1] - c.T[0])
 
 
@@ -112,7 +113,7 @@ def _rms_body_acc_wk(c):
 
 def _vdv(c):
     """Vibration dose value (∫ a_w⁴ dt)^{1/4} [m/s^1.75] (ISO 2631-1, 6.3.2)."""
-    a4 = c.weighted_acc ** 4
+    a4 = c.weighted_acc**4
     return (np.trapezoid(a4, c.T, axis=-1)) ** 0.25
 
 
@@ -131,8 +132,7 @@ METRICS: dict[str, Callable] = {
 #: Computed unless ``metrics`` says otherwise. The Wk-weighted metrics cost
 #: an FFT convolution per design (about 0.2 ms on 10,001 samples, as much as
 #: the simulation itself), so they are computed when asked for by name.
-DEFAULT_METRICS = tuple(m for m in METRICS if m not in ("rms_body_acc_wk [m/s²]",
-                                                        "vdv [m/s^1.75]"))
+DEFAULT_METRICS = tuple(m for m in METRICS if m not in ("rms_body_acc_wk [m/s²]", "vdv [m/s^1.75]"))
 
 
 @dataclass(eq=False)
@@ -166,15 +166,18 @@ def design_grid(grid: Mapping[str, Sequence], base: QuarterCarParams | None = No
     """
     unknown = sorted(set(grid) - set(_PARAM_NAMES))
     if unknown:
-        raise ValueError(f"unknown parameter {unknown[0]!r} in the grid; expected some of "
-                         f"{_PARAM_NAMES}")
+        raise ValueError(
+            f"unknown parameter {unknown[0]!r} in the grid; expected some of {_PARAM_NAMES}"
+        )
     base_values = (base or QuarterCarParams()).to_dict()
     # cs in the grid is the damping; otherwise zeta (the grid's or the base's)
     # sets it, so that cs follows ks and ms along the grid
     base_values.pop("zeta" if "cs" in grid else "cs")
     keys = list(grid)
-    return [{**base_values, **dict(zip(keys, combo))}
-            for combo in itertools.product(*(list(grid[k]) for k in keys))]
+    return [
+        {**base_values, **dict(zip(keys, combo))}
+        for combo in itertools.product(*(list(grid[k]) for k in keys))
+    ]
 
 
 def _validate(designs) -> tuple[list, list]:
@@ -187,8 +190,9 @@ def _validate(designs) -> tuple[list, list]:
             elif isinstance(d, Mapping):
                 out.append(QuarterCarParams.from_mapping(d))
             else:
-                raise TypeError(f"a design must be QuarterCarParams or a dict, "
-                                f"got {type(d).__name__}")
+                raise TypeError(
+                    f"a design must be QuarterCarParams or a dict, got {type(d).__name__}"
+                )
         except (TypeError, ValueError) as exc:
             out.append(None)
             errors.append((i, d if isinstance(d, Mapping) else repr(d), str(exc)))
@@ -202,8 +206,16 @@ def _matrices(values: np.ndarray, road: bool):
     return A, B
 
 
-def _run_chunk(values: np.ndarray, T: np.ndarray, X0: np.ndarray, U: np.ndarray | None,
-               method: ButcherTableau, substeps: int, metric_items, keep_states: bool):
+def _run_chunk(
+    values: np.ndarray,
+    T: np.ndarray,
+    X0: np.ndarray,
+    U: np.ndarray | None,
+    method: ButcherTableau,
+    substeps: int,
+    metric_items,
+    keep_states: bool,
+):
     """Simulate one chunk of designs; module level so executors can pickle it."""
     A, B = _matrices(values, U is not None)
     H = (T[-1] - T[0]) / (T.size - 1)
@@ -221,8 +233,15 @@ def _run_chunk(values: np.ndarray, T: np.ndarray, X0: np.ndarray, U: np.ndarray 
         C = np.concatenate([np.broadcast_to(np.eye(4), (m, 4, 4)), C], axis=1)
     with np.errstate(over="ignore", invalid="ignore"):
         # time last, so that every metric reduces contiguous memory
-        y = affine_scan(phi, np.broadcast_to(X0, (m, 4)), W, T.size,
-                        block=16 if W is not None else 32, C=C, time_last=True)
+        y = affine_scan(
+            phi,
+            np.broadcast_to(X0, (m, 4)),
+            W,
+            T.size,
+            block=16 if W is not None else 32,
+            C=C,
+            time_last=True,
+        )
         x = y[:, :4] if keep_states else None
         y = y[:, 4:] if keep_states else y
         if U is not None:
@@ -235,9 +254,20 @@ def _run_chunk(values: np.ndarray, T: np.ndarray, X0: np.ndarray, U: np.ndarray 
     return result, x
 
 
-def sweep(designs, T, X0=DEFAULT_X0, U=None, method="rk4", metrics=None, executor=None,
-          states: bool = False, *, substeps: int = 1, chunk_size: int = 16,
-          progress: bool | None = None) -> SweepResult:
+def sweep(
+    designs,
+    T,
+    X0=DEFAULT_X0,
+    U=None,
+    method="rk4",
+    metrics=None,
+    executor=None,
+    states: bool = False,
+    *,
+    substeps: int = 1,
+    chunk_size: int = 16,
+    progress: bool | None = None,
+) -> SweepResult:
     """Simulate many quarter-car designs at once and tabulate their metrics.
 
     Parameters
@@ -299,8 +329,9 @@ def sweep(designs, T, X0=DEFAULT_X0, U=None, method="rk4", metrics=None, executo
     if U is not None:
         U = np.asarray(U, dtype=float).reshape(-1)
         if U.shape != T.shape or not np.all(np.isfinite(U)):
-            raise ValueError(f"U must be {T.size} finite road heights matching T, "
-                             f"got shape {np.shape(U)}")
+            raise ValueError(
+                f"U must be {T.size} finite road heights matching T, got shape {np.shape(U)}"
+            )
     if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
         raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
     if metrics is None:
@@ -315,10 +346,13 @@ def sweep(designs, T, X0=DEFAULT_X0, U=None, method="rk4", metrics=None, executo
 
     params, errors = _validate(designs)
     good = [i for i, p in enumerate(params) if p is not None]
-    values = np.array([[params[i].ms, params[i].mu, params[i].ks, params[i].ku, params[i].cs]
-                       for i in good]).reshape(-1, 5)
-    chunks = [(good[s:s + chunk_size], values[s:s + chunk_size])
-              for s in range(0, len(good), chunk_size)]
+    values = np.array(
+        [[params[i].ms, params[i].mu, params[i].ks, params[i].ku, params[i].cs] for i in good]
+    ).reshape(-1, 5)
+    chunks = [
+        (good[s : s + chunk_size], values[s : s + chunk_size])
+        for s in range(0, len(good), chunk_size)
+    ]
     args = (T, X0, U, tab, substeps, metric_items, states)
     if executor is None:
         results = (_run_chunk(v, *args) for _, v in chunks)
@@ -326,13 +360,20 @@ def sweep(designs, T, X0=DEFAULT_X0, U=None, method="rk4", metrics=None, executo
         futures = [executor.submit(_run_chunk, v, *args) for _, v in chunks]
         results = (f.result() for f in futures)
     else:
-        raise TypeError(f"executor must be a concurrent.futures.Executor, "
-                        f"got {type(executor).__name__}")
+        raise TypeError(
+            f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}"
+        )
 
     from tqdm.auto import tqdm
 
-    bar = tqdm(results, total=len(chunks), unit="chunk", desc="sweep",
-               disable=progress is False, delay=0 if progress else 1.0)
+    bar = tqdm(
+        results,
+        total=len(chunks),
+        unit="chunk",
+        desc="sweep",
+        disable=progress is False,
+        delay=0 if progress else 1.0,
+    )
     table = {name: np.full(len(designs), np.nan) for name, _ in metric_items}
     stable = np.zeros(len(designs), dtype=bool)
     kept = np.full((len(designs), 4, T.size), np.nan) if states else None
@@ -344,8 +385,9 @@ def sweep(designs, T, X0=DEFAULT_X0, U=None, method="rk4", metrics=None, executo
             kept[idx] = x
     bar.close()
 
-    frame = pd.DataFrame([p.to_dict() if p is not None else dict.fromkeys(_PARAM_NAMES)
-                          for p in params])
+    frame = pd.DataFrame(
+        [p.to_dict() if p is not None else dict.fromkeys(_PARAM_NAMES) for p in params]
+    )
     frame["stable"] = stable
     for name, column in table.items():
         frame[name] = column
@@ -354,8 +396,11 @@ def sweep(designs, T, X0=DEFAULT_X0, U=None, method="rk4", metrics=None, executo
         frame.loc[i, "error"] = message
     err_frame = pd.DataFrame(errors, columns=["index", "value", "error"])
     if errors:
-        warnings.warn(f"{len(errors)} of {len(designs)} designs were rejected; first: design "
-                      f"{errors[0][0]}: {errors[0][2]} (see .errors)", RuntimeWarning,
-                      stacklevel=2)
+        warnings.warn(
+            f"{len(errors)} of {len(designs)} designs were rejected; first: design "
+            f"{errors[0][0]}: {errors[0][2]} (see .errors)",
+            RuntimeWarning,
+            stacklevel=2,
+        )
     frame.index.name = "design"
     return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)

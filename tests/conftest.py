@@ -1,4 +1,5 @@
 """Shared fixtures and strategies."""
+
 import os
 
 import matplotlib
@@ -30,6 +31,7 @@ def seed_params():
 def _close_figures():
     yield
     import matplotlib.pyplot as plt
+
     plt.close("all")
 
 

@@ -1,4 +1,5 @@
 """The qc-control command: output and one-line errors with exit status 2."""
+
 import subprocess
 import sys
 
@@ -8,8 +9,9 @@ from qc_control.cli import main
 
 
 def run(*args):
-    return subprocess.run([sys.executable, "-m", "qc_control.cli", *args],
-                          capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "qc_control.cli", *args], capture_output=True, text=True, timeout=300
+    )
 
 
 def test_modes_prints_table():
@@ -27,14 +29,17 @@ def test_modes_options_and_config(tmp_path, capsys):
     assert "8.66" in text
 
 
-@pytest.mark.parametrize("args, words", [
-    (["modes", "--ms", "-1"], "ms (sprung mass) must be > 0 kg, got -1.0"),
-    (["modes", "--ku", "nan"], "ku must be finite, got nan"),
-    (["modes", "--ms", "abc"], "--ms: invalid float value: 'abc'"),
-    (["modes", "--config", "missing.toml"], "missing.toml"),
-    (["modes", "--bogus"], "unrecognized arguments: --bogus"),
-    ([], "command"),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["modes", "--ms", "-1"], "ms (sprung mass) must be > 0 kg, got -1.0"),
+        (["modes", "--ku", "nan"], "ku must be finite, got nan"),
+        (["modes", "--ms", "abc"], "--ms: invalid float value: 'abc'"),
+        (["modes", "--config", "missing.toml"], "missing.toml"),
+        (["modes", "--bogus"], "unrecognized arguments: --bogus"),
+        ([], "command"),
+    ],
+)
 def test_bad_input_one_line_exit_2(args, words, capsys):
     assert main(args) == 2
     err = capsys.readouterr().err

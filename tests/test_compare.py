@@ -49,17 +49,20 @@ def test_errors_against_an_independent_trajectory(seed_cmp):
 
 def test_step_limits_and_modes_from_eigenvalues(seed_cmp):
     lam = np.linalg.eigvals(np.asarray(seed_cmp.system.A))
-    euler = min(-2 * l.real / abs(l) ** 2 for l in lam)     # |1 + h lambda| = 1
+    euler = min(-2 * l.real / abs(l) ** 2 for l in lam)  # |1 + h lambda| = 1
     assert seed_cmp.table.loc["euler", "h_max [s]"] == pytest.approx(euler, rel=1e-12)
     assert seed_cmp.table.loc["euler", "limited by"] == "body bounce"
     wn, zeta, _ = control.damp(seed_cmp.system, doprint=False)
     assert seed_cmp.modes.body.zeta == pytest.approx(min(zeta), rel=1e-12)
     nm = qc.numerical_modes("euler", 0.01, seed_cmp.system)
-    assert seed_cmp.table.loc["euler", "wheel hop freq err [%]"] == nm.loc["wheel hop", "freq error [%]"]
+    assert (
+        seed_cmp.table.loc["euler", "wheel hop freq err [%]"]
+        == nm.loc["wheel hop", "freq error [%]"]
+    )
 
 
 def test_observed_orders_in_the_asymptotic_range():
-    cmp = qc.compare_methods(None, np.linspace(0, 2, 1001), X0, repeats=1)   # h = 2 ms
+    cmp = qc.compare_methods(None, np.linspace(0, 2, 1001), X0, repeats=1)  # h = 2 ms
     for name, p in ORDERS.items():
         assert cmp.table.loc[name, "observed order"] == pytest.approx(p, abs=0.15)
 
@@ -92,23 +95,29 @@ def test_midpoint_heun_recorded_as_coincident(seed_cmp):
 def test_forced_comparison_uses_forced_reference():
     T = np.linspace(0, 2, 201)
     U = np.where(T >= 0.5, 0.05, 0.0)
-    cmp = qc.compare_methods(qc.quarter_car(road=True), T, np.zeros(4), U=U,
-                             methods=("heun", "rk4"), repeats=1)
+    cmp = qc.compare_methods(
+        qc.quarter_car(road=True), T, np.zeros(4), U=U, methods=("heun", "rk4"), repeats=1
+    )
     exact = control.forced_response(qc.quarter_car(road=True), T, U, 0).outputs
     ours = qc.forced_response(qc.quarter_car(road=True), T, U, method="rk4").outputs
-    assert cmp.table.loc["rk4", "max |xs err| [m]"] == pytest.approx(np.max(abs(ours[0] - exact[0])))
+    assert cmp.table.loc["rk4", "max |xs err| [m]"] == pytest.approx(
+        np.max(abs(ours[0] - exact[0]))
+    )
     assert "lsim" in cmp.reference_description and cmp.reference_error < 1e-12
 
 
-@pytest.mark.parametrize("kwargs, error, words", [
-    (dict(h=0.003), ValueError, "must divide the grid spacing"),
-    (dict(h=-1.0), ValueError, "h must be a finite step"),
-    (dict(methods=()), ValueError, "at least one method"),
-    (dict(methods=("rk4", "rk4")), ValueError, "distinct"),
-    (dict(methods=("rk5",)), ValueError, "unknown method"),
-    (dict(X0=[0, 0, 0.05]), ValueError, "X0 must have shape"),
-    (dict(U=np.zeros(7)), ValueError, "system has no inputs|U must have shape"),
-])
+@pytest.mark.parametrize(
+    "kwargs, error, words",
+    [
+        (dict(h=0.003), ValueError, "must divide the grid spacing"),
+        (dict(h=-1.0), ValueError, "h must be a finite step"),
+        (dict(methods=()), ValueError, "at least one method"),
+        (dict(methods=("rk4", "rk4")), ValueError, "distinct"),
+        (dict(methods=("rk5",)), ValueError, "unknown method"),
+        (dict(X0=[0, 0, 0.05]), ValueError, "X0 must have shape"),
+        (dict(U=np.zeros(7)), ValueError, "system has no inputs|U must have shape"),
+    ],
+)
 def test_bad_input(kwargs, error, words):
     args = dict(T=np.linspace(0, 1, 101), X0=X0)
     args.update(kwargs)

@@ -1,4 +1,5 @@
 """Every script in examples/ runs and writes what it says it writes."""
+
 import subprocess
 import sys
 from pathlib import Path
@@ -14,8 +15,13 @@ def test_there_are_examples():
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.name)
 def test_example_runs(script, tmp_path):
-    out = subprocess.run([sys.executable, str(script), str(tmp_path)], capture_output=True,
-                         text=True, timeout=600, env={"MPLBACKEND": "Agg", "PATH": ""})
+    out = subprocess.run(
+        [sys.executable, str(script), str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={"MPLBACKEND": "Agg", "PATH": ""},
+    )
     assert out.returncode == 0, out.stderr
     pngs = list(tmp_path.rglob("*.png"))
     assert pngs and all(p.stat().st_size > 5000 for p in pngs)

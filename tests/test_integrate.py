@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from qc_control import DivergenceWarning, METHODS, integrate, quarter_car
+from qc_control import METHODS, DivergenceWarning, integrate, quarter_car
 
 A = np.asarray(quarter_car().A)
 
@@ -14,6 +14,7 @@ def counting(f):
     def g(t, x):
         calls.append(t)
         return f(t, x)
+
     return g, calls
 
 
@@ -43,12 +44,13 @@ def test_stage_times_and_nonuniform_grid():
     """x' = 3 t^2 has x = t^3: RK4 integrates cubics exactly on any grid."""
     T = np.array([0.0, 0.1, 0.35, 0.4, 1.0])
     sol = integrate(lambda t, x: np.array([3 * t * t]), T, [0.0], "rk4", substeps=2)
-    np.testing.assert_allclose(sol.x[0], T ** 3, rtol=1e-14, atol=1e-16)
+    np.testing.assert_allclose(sol.x[0], T**3, rtol=1e-14, atol=1e-16)
 
 
 def test_substeps_equal_a_finer_grid():
-    coarse = integrate(lambda t, x: x @ A.T, np.linspace(0, 1, 11), [0, 0, 0.05, 0], "heun",
-                       substeps=4)
+    coarse = integrate(
+        lambda t, x: x @ A.T, np.linspace(0, 1, 11), [0, 0, 0.05, 0], "heun", substeps=4
+    )
     fine = integrate(lambda t, x: x @ A.T, np.linspace(0, 1, 41), [0, 0, 0.05, 0], "heun")
     np.testing.assert_allclose(coarse.x, fine.x[:, ::4], rtol=1e-12, atol=1e-16)
 
@@ -67,22 +69,28 @@ def test_blow_up_stops_at_first_non_finite_sample():
         assert not np.isfinite(last + 0.5 * last * last)
 
 
-@pytest.mark.parametrize("t, words", [
-    ([0.0, 1.0, 1.0], r"t\[1\] = 1.0 and t\[2\] = 1.0"),
-    ([0.0, 2.0, 1.0], "must increase strictly"),
-    ([0.0], "at least 2 times"),
-    ([0.0, np.nan], "must be finite"),
-])
+@pytest.mark.parametrize(
+    "t, words",
+    [
+        ([0.0, 1.0, 1.0], r"t\[1\] = 1.0 and t\[2\] = 1.0"),
+        ([0.0, 2.0, 1.0], "must increase strictly"),
+        ([0.0], "at least 2 times"),
+        ([0.0, np.nan], "must be finite"),
+    ],
+)
 def test_bad_time_grid(t, words):
     with pytest.raises(ValueError, match=words):
         integrate(lambda t, x: -x, t, [1.0])
 
 
-@pytest.mark.parametrize("x0, words", [
-    ([np.inf], "x0 must be finite"),
-    (np.zeros((2, 2, 2)), "shape"),
-    ([], "shape"),
-])
+@pytest.mark.parametrize(
+    "x0, words",
+    [
+        ([np.inf], "x0 must be finite"),
+        (np.zeros((2, 2, 2)), "shape"),
+        ([], "shape"),
+    ],
+)
 def test_bad_x0(x0, words):
     with pytest.raises(ValueError, match=words):
         integrate(lambda t, x: -x, [0, 1], x0)

@@ -8,8 +8,9 @@ from qc_control import METHODS
 from qc_control.lti import affine_scan, step_matrices
 
 X0 = [0.1, -0.3, 0.05, 0.01]
-RALSTON = qc.ButcherTableau("ralston", a=[[0, 0], [2 / 3, 0]], b=[1 / 4, 3 / 4],
-                            c=[0, 2 / 3], order=2)
+RALSTON = qc.ButcherTableau(
+    "ralston", a=[[0, 0], [2 / 3, 0]], b=[1 / 4, 3 / 4], c=[0, 2 / 3], order=2
+)
 ALL = list(METHODS) + [RALSTON]
 
 
@@ -24,8 +25,10 @@ def test_lti_equals_generic(method, substeps):
     sys = qc.quarter_car(road=True, actuator=True)
     T = np.linspace(0, 10, 10001)
     U = np.vstack([np.where(T >= 0.5, 0.05, 0.0), 200 * np.sin(2 * np.pi * 2 * T)])
-    for call in (lambda e: qc.initial_response(sys, T, X0, method, substeps, engine=e),
-                 lambda e: qc.forced_response(sys, T, U, X0, method, substeps, engine=e)):
+    for call in (
+        lambda e: qc.initial_response(sys, T, X0, method, substeps, engine=e),
+        lambda e: qc.forced_response(sys, T, U, X0, method, substeps, engine=e),
+    ):
         lti, generic = call("lti"), call("generic")
         assert rel(lti.states, generic.states) < 1e-12
         assert rel(lti.outputs, generic.outputs) < 1e-12
@@ -37,11 +40,13 @@ def test_auto_picks_lti_on_uniform_and_generic_otherwise():
     T = np.linspace(0, 1, 101)
     auto = qc.initial_response(sys, T, X0)
     assert np.array_equal(auto.states, qc.initial_response(sys, T, X0, engine="lti").states)
-    Tn = np.concatenate([np.linspace(0, 0.5, 51), np.linspace(0.52, 1, 25)])   # 10 ms, then 20 ms
+    Tn = np.concatenate([np.linspace(0, 0.5, 51), np.linspace(0.52, 1, 25)])  # 10 ms, then 20 ms
     with pytest.raises(ValueError, match="uniformly spaced"):
         qc.initial_response(sys, Tn, X0, engine="lti")
-    assert np.array_equal(qc.initial_response(sys, Tn, X0).states,
-                          qc.initial_response(sys, Tn, X0, engine="generic").states)
+    assert np.array_equal(
+        qc.initial_response(sys, Tn, X0).states,
+        qc.initial_response(sys, Tn, X0, engine="generic").states,
+    )
     with pytest.raises(ValueError, match="engine must be"):
         qc.initial_response(sys, T, X0, engine="fast")
 
@@ -72,8 +77,9 @@ def test_affine_scan_against_a_plain_loop():
         for k in range(N - 1):
             x[k + 1] = phi @ x[k] + W[k]
         for block in (1, 4, 16, 64):
-            np.testing.assert_allclose(affine_scan(phi, x[0], W, N, block), x, rtol=1e-12,
-                                       atol=1e-12)
+            np.testing.assert_allclose(
+                affine_scan(phi, x[0], W, N, block), x, rtol=1e-12, atol=1e-12
+            )
 
 
 def test_batched_scan_equals_each_design():
@@ -83,5 +89,6 @@ def test_batched_scan_equals_each_design():
     W = rng.normal(size=(5, 99, 4))
     batch = affine_scan(phis, x0, W, 100)
     for i in range(5):
-        np.testing.assert_allclose(batch[i], affine_scan(phis[i], x0[i], W[i], 100),
-                                   rtol=1e-13, atol=1e-14)
+        np.testing.assert_allclose(
+            batch[i], affine_scan(phis[i], x0[i], W[i], 100), rtol=1e-13, atol=1e-14
+        )

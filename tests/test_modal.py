@@ -1,20 +1,23 @@
 """modal_analysis against control.damp and closed forms."""
+
 import math
 
 import control
 import numpy as np
 import pytest
+from conftest import valid_params
 from hypothesis import given, settings
 
 from qc_control import QuarterCarParams, modal_analysis, quarter_car
-from conftest import valid_params
 
 
 def undamped_closed_form(p):
     """Roots of det(K - w^2 M) = 0: ms mu w^4 - (ms (ks+ku) + mu ks) w^2 + ks ku = 0."""
     a, b, c = p.ms * p.mu, -(p.ms * (p.ks + p.ku) + p.mu * p.ks), p.ks * p.ku
     disc = math.sqrt(b * b - 4 * a * c)
-    return sorted(math.sqrt(r) / (2 * math.pi) for r in ((-b - disc) / (2 * a), (-b + disc) / (2 * a)))
+    return sorted(
+        math.sqrt(r) / (2 * math.pi) for r in ((-b - disc) / (2 * a), (-b + disc) / (2 * a))
+    )
 
 
 def test_seed_modes_match_control_damp():

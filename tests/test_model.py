@@ -1,24 +1,31 @@
 """QuarterCarParams and quarter_car against the seed paper and closed forms."""
+
 import dataclasses
 import math
 
 import control
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from conftest import valid_params
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from qc_control import QuarterCarParams, load_config, quarter_car
-from conftest import valid_params
 
 SEED = dict(ms=301.2, mu=100.0, ks=30000.0, ku=29530.0)
 
 
 def seed_A(ms, mu, ks, ku, cs):
     """The seed's matrix A, section 4.2, typed in from the paper."""
-    return np.array([[-cs / ms, cs / ms, -ks / ms, ks / ms],
-                     [cs / mu, -cs / mu, ks / mu, -(ks + ku) / mu],
-                     [1, 0, 0, 0],
-                     [0, 1, 0, 0]], dtype=float)
+    return np.array(
+        [
+            [-cs / ms, cs / ms, -ks / ms, ks / ms],
+            [cs / mu, -cs / mu, ks / mu, -(ks + ku) / mu],
+            [1, 0, 0, 0],
+            [0, 1, 0, 0],
+        ],
+        dtype=float,
+    )
 
 
 def test_defaults_are_the_seed_table():
@@ -107,8 +114,10 @@ def test_A_is_the_seed_matrix_exactly():
     assert control.isctime(sys, strict=True)
 
 
-@pytest.mark.parametrize("road, actuator, labels", [
-    (False, False, []), (True, False, ["zr"]), (False, True, ["fa"]), (True, True, ["zr", "fa"])])
+@pytest.mark.parametrize(
+    "road, actuator, labels",
+    [(False, False, []), (True, False, ["zr"]), (False, True, ["fa"]), (True, True, ["zr", "fa"])],
+)
 def test_inputs(road, actuator, labels):
     p = QuarterCarParams()
     sys = quarter_car(p, road=road, actuator=actuator)

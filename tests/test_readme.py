@@ -1,4 +1,5 @@
 """The README's Python blocks run, in order, as a reader would paste them."""
+
 import re
 from pathlib import Path
 

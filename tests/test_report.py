@@ -1,4 +1,5 @@
 """The written report: files, links, HTML images, atomic writes, section order."""
+
 import re
 from html.parser import HTMLParser
 
@@ -7,8 +8,8 @@ import pytest
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.report import MARKER, ReportError, figures, write_report
 from qc_control.cli import main
+from qc_control.report import MARKER, ReportError, figures, write_report
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -25,18 +26,31 @@ def report(cmp, tmp_path_factory):
 
 def test_files_and_figure_count(report, cmp):
     pngs = sorted(report.glob("*.png"))
-    assert len(pngs) == len(cmp.methods) + 5        # per-method + 5 comparison figures
+    assert len(pngs) == len(cmp.methods) + 5  # per-method + 5 comparison figures
     for png in pngs:
         assert png.read_bytes()[:8] == PNG and png.stat().st_size > 10_000, png.name
-    for name in ("report.md", "report.html", "methods.csv", "convergence.csv",
-                 "cost_to_reach.csv", "modes.csv", "numerical_modes.csv", MARKER):
+    for name in (
+        "report.md",
+        "report.html",
+        "methods.csv",
+        "convergence.csv",
+        "cost_to_reach.csv",
+        "modes.csv",
+        "numerical_modes.csv",
+        MARKER,
+    ):
         assert (report / name).exists(), name
 
 
 def test_figure_functions_return_labelled_figures(cmp):
-    for make in (figures.overlay_figure, figures.error_figure, figures.convergence_figure,
-                 figures.work_precision_figure, figures.stability_figure,
-                 lambda c: figures.method_figure(c, "rk4")):
+    for make in (
+        figures.overlay_figure,
+        figures.error_figure,
+        figures.convergence_figure,
+        figures.work_precision_figure,
+        figures.stability_figure,
+        lambda c: figures.method_figure(c, "rk4"),
+    ):
         fig = make(cmp)
         assert isinstance(fig, Figure)
         for ax in fig.axes:
@@ -83,9 +97,17 @@ def test_html_opens_and_its_images_load(report):
 
 def test_sections_in_the_issues_order(report):
     text = (report / "report.md").read_text()
-    order = ["## Problem card", "## Per-method responses", "## All methods against the reference",
-             "## Accuracy", "## Convergence", "## Work and precision",
-             "## Stability and numerical modes", "## Findings", "## Reproduce"]
+    order = [
+        "## Problem card",
+        "## Per-method responses",
+        "## All methods against the reference",
+        "## Accuracy",
+        "## Convergence",
+        "## Work and precision",
+        "## Stability and numerical modes",
+        "## Findings",
+        "## Reproduce",
+    ]
     positions = [text.index(h) for h in order]
     assert positions == sorted(positions)
     assert "qc-control report" in text.split("## Reproduce")[1]
@@ -124,11 +146,12 @@ def test_a_failure_leaves_no_partial_output(cmp, tmp_path, monkeypatch):
 
     def broken(_):
         raise RuntimeError("disk full")
+
     monkeypatch.setattr("qc_control.report.stability_figure", broken)
     with pytest.raises(RuntimeError, match="disk full"):
         write_report(cmp, out)
-    assert sorted(p.name for p in out.iterdir()) == before       # old report intact
-    assert [p.name for p in tmp_path.iterdir()] == ["rep"]       # no temp dirs left
+    assert sorted(p.name for p in out.iterdir()) == before  # old report intact
+    assert [p.name for p in tmp_path.iterdir()] == ["rep"]  # no temp dirs left
     with pytest.raises(RuntimeError):
         write_report(cmp, tmp_path / "fresh")
     assert not (tmp_path / "fresh").exists()
@@ -141,21 +164,26 @@ def test_unknown_format(cmp, tmp_path):
 
 def test_cli_report_writes_and_prints(tmp_path, capsys):
     out = tmp_path / "rep"
-    assert main(["report", "--out", str(out), "--t-end", "1", "--h", "0.01",
-                 "--methods", "heun,rk4"]) == 0
+    assert (
+        main(["report", "--out", str(out), "--t-end", "1", "--h", "0.01", "--methods", "heun,rk4"])
+        == 0
+    )
     captured = capsys.readouterr()
     assert "rk4" in captured.out and str(out) in captured.out
-    assert "heun" in captured.err                                # progress on stderr
+    assert "heun" in captured.err  # progress on stderr
     assert len(list(out.glob("method_*.png"))) == 2
 
 
-@pytest.mark.parametrize("args, words", [
-    (["--h", "0"], "--h must be a finite number > 0 s, got 0.0"),
-    (["--h", "0.03"], "must be a whole number"),
-    (["--x0", "0,0,x,0"], "--x0 must be 4 comma-separated numbers"),
-    (["--methods", "euler,rk5"], "unknown method 'rk5'"),
-    (["--ms", "0"], "ms (sprung mass) must be > 0 kg"),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["--h", "0"], "--h must be a finite number > 0 s, got 0.0"),
+        (["--h", "0.03"], "must be a whole number"),
+        (["--x0", "0,0,x,0"], "--x0 must be 4 comma-separated numbers"),
+        (["--methods", "euler,rk5"], "unknown method 'rk5'"),
+        (["--ms", "0"], "ms (sprung mass) must be > 0 kg"),
+    ],
+)
 def test_cli_report_bad_input(args, words, tmp_path, capsys):
     out = tmp_path / "rep"
     assert main(["report", "--out", str(out), *args]) == 2
@@ -179,8 +207,26 @@ def test_cli_refuses_foreign_directory(tmp_path, capsys):
 
 def test_road_report_has_the_ride_section(tmp_path, capsys):
     out = tmp_path / "road"
-    assert main(["report", "--road", "iso8608", "--road-class", "B", "--speed", "15",
-                 "--t-end", "4", "--methods", "heun,rk4", "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "report",
+                "--road",
+                "iso8608",
+                "--road-class",
+                "B",
+                "--speed",
+                "15",
+                "--t-end",
+                "4",
+                "--methods",
+                "heun,rk4",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     text = (out / "report.md").read_text()
     assert "## Road and ride" in text and "class B road at 15 m/s" in text
     assert (out / "transmissibility.png").exists() and (out / "road.png").exists()
@@ -189,13 +235,16 @@ def test_road_report_has_the_ride_section(tmp_path, capsys):
     assert "h = 0.01 s" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("args, words", [
-    (["--road", "gravel"], "--road must be one of step, bump, sine, iso8608"),
-    (["--road", "iso8608", "--road-class", "Z"], "unknown ISO 8608 road class 'Z'"),
-    (["--road", "iso8608", "--speed", "-3"], "--speed must be a finite number > 0 m/s"),
-    (["--road", "iso8608", "--h", "0.01"], "too coarse for an ISO 8608 road at 20 m/s"),
-    (["--road", "step", "--road-class", "B"], "apply to --road iso8608 only"),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["--road", "gravel"], "--road must be one of step, bump, sine, iso8608"),
+        (["--road", "iso8608", "--road-class", "Z"], "unknown ISO 8608 road class 'Z'"),
+        (["--road", "iso8608", "--speed", "-3"], "--speed must be a finite number > 0 m/s"),
+        (["--road", "iso8608", "--h", "0.01"], "too coarse for an ISO 8608 road at 20 m/s"),
+        (["--road", "step", "--road-class", "B"], "apply to --road iso8608 only"),
+    ],
+)
 def test_road_cli_bad_input(args, words, tmp_path, capsys):
     assert main(["report", "--out", str(tmp_path / "r"), *args]) == 2
     err = capsys.readouterr().err

@@ -1,4 +1,5 @@
 """Fixed-step responses against python-control's exact responses."""
+
 import math
 import warnings
 
@@ -7,9 +8,9 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control import DivergenceWarning, METHODS
+from qc_control import METHODS, DivergenceWarning
 
-X0 = [0.0, 0.0, 0.05, 0.0]   # the default scenario: body released from 5 cm
+X0 = [0.0, 0.0, 0.05, 0.0]  # the default scenario: body released from 5 cm
 ORDERS = {"euler": 1, "midpoint": 2, "heun": 2, "rk4": 4}
 
 
@@ -105,7 +106,9 @@ def test_forced_response_converges_at_the_order(method):
         T = grid(h, 5.0)
         U = 0.01 * np.sin(2 * np.pi * 1.5 * T)
         exact = control.forced_response(sys, T, U, 0.0).outputs[0]
-        errors.append(np.max(np.abs(qc.forced_response(sys, T, U, method=method).outputs[0] - exact)))
+        errors.append(
+            np.max(np.abs(qc.forced_response(sys, T, U, method=method).outputs[0] - exact))
+        )
     slope = np.polyfit(np.log(hs), np.log(errors), 1)[0]
     assert slope == pytest.approx(ORDERS[method], abs=0.15)
 
@@ -121,7 +124,7 @@ def test_returns_time_response_data_like_control():
     assert ours.input_labels == ref.input_labels == ["zr"]
     assert ours.outputs.shape == ref.outputs.shape and ours.inputs.shape == ref.inputs.shape
     assert list(ours.to_pandas().columns) == list(ref.to_pandas().columns)
-    t, y = ours                      # unpacks like control's
+    t, y = ours  # unpacks like control's
     assert t.shape == T.shape and y.shape == (5, T.size)
     assert ours.nfev == 2 * 100 and ours.method.name == "heun" and ours.h == pytest.approx(0.01)
     assert ours.plot() is not None
@@ -141,7 +144,7 @@ def test_keyword_aliases_like_control():
 
 def test_euler_beyond_limit_is_flagged_not_crashed():
     sys = qc.quarter_car()
-    T = np.arange(0, 401) * 0.025        # h = 0.025 s > 0.0198 s
+    T = np.arange(0, 401) * 0.025  # h = 0.025 s > 0.0198 s
     with pytest.warns(DivergenceWarning, match="exceeds the stability limit 0.0198"):
         r = qc.initial_response(sys, T, X0, method="euler")
     assert not r.success and "exceeds" in r.message
@@ -159,20 +162,40 @@ def test_step_just_inside_the_limit_does_not_warn():
     assert r.success
 
 
-@pytest.mark.parametrize("call, error, words", [
-    (lambda s: qc.initial_response(s, [0, 1, 1, 2], X0), ValueError, "must increase strictly"),
-    (lambda s: qc.initial_response(s, [0, 1], [0, 0, 0.05]), ValueError, r"X0 must have shape \(4,\)"),
-    (lambda s: qc.initial_response(s, [0, 1], [0, 0, np.nan, 0]), ValueError, "X0 must be finite"),
-    (lambda s: qc.initial_response(s, [0, 1], X0, method="rk45"), ValueError,
-     "known methods are euler, midpoint, heun, rk4"),
-    (lambda s: qc.initial_response(control.c2d(s, 0.01), [0, 0.01], X0), ValueError,
-     "must be continuous-time"),
-    (lambda s: qc.initial_response("sys", [0, 1], X0), TypeError, "control.StateSpace"),
-    (lambda s: qc.forced_response(s, [0, 1], 0.05), ValueError, "system has no inputs"),
-    (lambda s: qc.forced_response(qc.quarter_car(road=True), [0, 1, 2], [0, 1]), ValueError,
-     r"U must have shape \(3,\) or \(1, 3\)"),
-    (lambda s: qc.initial_response(s, [0, 1], X0, substeps=0), ValueError, "substeps"),
-])
+@pytest.mark.parametrize(
+    "call, error, words",
+    [
+        (lambda s: qc.initial_response(s, [0, 1, 1, 2], X0), ValueError, "must increase strictly"),
+        (
+            lambda s: qc.initial_response(s, [0, 1], [0, 0, 0.05]),
+            ValueError,
+            r"X0 must have shape \(4,\)",
+        ),
+        (
+            lambda s: qc.initial_response(s, [0, 1], [0, 0, np.nan, 0]),
+            ValueError,
+            "X0 must be finite",
+        ),
+        (
+            lambda s: qc.initial_response(s, [0, 1], X0, method="rk45"),
+            ValueError,
+            "known methods are euler, midpoint, heun, rk4",
+        ),
+        (
+            lambda s: qc.initial_response(control.c2d(s, 0.01), [0, 0.01], X0),
+            ValueError,
+            "must be continuous-time",
+        ),
+        (lambda s: qc.initial_response("sys", [0, 1], X0), TypeError, "control.StateSpace"),
+        (lambda s: qc.forced_response(s, [0, 1], 0.05), ValueError, "system has no inputs"),
+        (
+            lambda s: qc.forced_response(qc.quarter_car(road=True), [0, 1, 2], [0, 1]),
+            ValueError,
+            r"U must have shape \(3,\) or \(1, 3\)",
+        ),
+        (lambda s: qc.initial_response(s, [0, 1], X0, substeps=0), ValueError, "substeps"),
+    ],
+)
 def test_bad_input(call, error, words):
     with pytest.raises(error, match=words):
         call(qc.quarter_car())

@@ -1,16 +1,31 @@
 """Transmissibility, ISO 2631-1 weighting and ride metrics against closed forms."""
+
 import control
 import numpy as np
 import pytest
 
 import qc_control as qc
 from qc_control import road
-from qc_control.ride import (STANDARD_GRAVITY, ride_metrics, ride_metrics_spectral,
-                             transmissibility, wk_filter)
+from qc_control.ride import (
+    STANDARD_GRAVITY,
+    ride_metrics,
+    ride_metrics_spectral,
+    transmissibility,
+    wk_filter,
+)
 
 # ISO 2631-1:1997 Table 3, Wk (factor x 1000 in the standard)
-WK_TABLE = {0.5: 0.418, 1.0: 0.482, 2.0: 0.531, 4.0: 0.967, 6.3: 1.054, 10.0: 0.988,
-            16.0: 0.768, 31.5: 0.405, 63.0: 0.186}
+WK_TABLE = {
+    0.5: 0.418,
+    1.0: 0.482,
+    2.0: 0.531,
+    4.0: 0.967,
+    6.3: 1.054,
+    10.0: 0.988,
+    16.0: 0.768,
+    31.5: 0.405,
+    63.0: 0.186,
+}
 
 
 def test_wk_reproduces_the_standards_table():
@@ -33,7 +48,7 @@ def test_invariant_point_does_not_depend_on_damping(zeta):
 
 def test_static_gains():
     tr = transmissibility(None, [1e-4])
-    assert abs(tr.response["xs"][0]) == pytest.approx(1.0, abs=1e-7)           # body follows
+    assert abs(tr.response["xs"][0]) == pytest.approx(1.0, abs=1e-7)  # body follows
     assert abs(tr.response["susp_travel"][0]) < 1e-7 and abs(tr.response["tire_defl"][0]) < 1e-7
 
 
@@ -55,17 +70,18 @@ def test_ride_metrics_by_hand_on_a_road_step():
     r = control.forced_response(qc.quarter_car(p, road=True), T, road.step(T))
     m = ride_metrics(r, p)
     y = dict(zip(r.output_labels, r.outputs))
-    rms = lambda v: np.sqrt(np.trapezoid(v ** 2, T) / 5.0)  # noqa: E731
+    rms = lambda v: np.sqrt(np.trapezoid(v**2, T) / 5.0)  # noqa: E731
     assert m["rms body_acc [m/s²]"] == pytest.approx(rms(y["body_acc"]), rel=1e-12)
     assert m["peak susp_travel [m]"] == pytest.approx(np.max(np.abs(y["susp_travel"])))
     static = (p.ms + p.mu) * STANDARD_GRAVITY
     assert m["rms tire load / static [-]"] == pytest.approx(rms(p.ku * y["tire_defl"]) / static)
     # the Wk-weighted signal: the filter run by scipy.signal.lsim independently
     import scipy.signal
+
     num, den = wk_filter().num[0][0], wk_filter().den[0][0]
     _, aw, _ = scipy.signal.lsim((num, den), y["body_acc"], T)
     assert m["rms body_acc Wk [m/s²]"] == pytest.approx(rms(aw), rel=1e-6)
-    assert m["VDV [m/s^1.75]"] == pytest.approx(np.trapezoid(aw ** 4, T) ** 0.25, rel=1e-6)
+    assert m["VDV [m/s^1.75]"] == pytest.approx(np.trapezoid(aw**4, T) ** 0.25, rel=1e-6)
     assert not m["lift-off"]
 
 
@@ -89,24 +105,31 @@ def test_spectral_rms_agrees_with_long_simulated_iso_roads():
     zr = road.iso8608(T, "C", 20.0, seed=3)
     r = qc.forced_response(qc.quarter_car(p, road=True), T, zr, method="rk4")
     keep = T >= 10.0
-    window = control.TimeResponseData(r.time[keep], r.outputs[:, keep], issiso=False,
-                                      output_labels=r.output_labels)
+    window = control.TimeResponseData(
+        r.time[keep], r.outputs[:, keep], issiso=False, output_labels=r.output_labels
+    )
     sim = ride_metrics(window, p)
     spec = ride_metrics_spectral(p, "C", 20.0)
-    for key in ("rms body_acc [m/s²]", "rms body_acc Wk [m/s²]", "rms susp_travel [m]",
-                "rms tire load / static [-]"):
+    for key in (
+        "rms body_acc [m/s²]",
+        "rms body_acc Wk [m/s²]",
+        "rms susp_travel [m]",
+        "rms tire load / static [-]",
+    ):
         assert sim[key] == pytest.approx(spec[key], rel=0.03), key
 
 
 def test_bad_inputs():
     T = np.linspace(0, 1, 101)
-    other = control.TimeResponseData(T, np.zeros((5, T.size)), issiso=False,
-                                     output_labels=["xs", "xu", "a", "b", "c"])
+    other = control.TimeResponseData(
+        T, np.zeros((5, T.size)), issiso=False, output_labels=["xs", "xu", "a", "b", "c"]
+    )
     with pytest.raises(ValueError, match="no output 'body_acc'"):
         ride_metrics(other)
     Tn = np.array([0.0, 0.1, 0.3])
-    uneven = control.TimeResponseData(Tn, np.zeros((5, 3)), issiso=False,
-                                      output_labels=list(qc.OUTPUTS))
+    uneven = control.TimeResponseData(
+        Tn, np.zeros((5, 3)), issiso=False, output_labels=list(qc.OUTPUTS)
+    )
     with pytest.raises(ValueError, match="must be uniform"):
         ride_metrics(uneven)
     with pytest.raises(ValueError, match="unknown ISO 8608 road class 'Q'"):

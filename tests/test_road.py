@@ -1,4 +1,5 @@
 """Road inputs: shapes by closed form, ISO 8608 profiles against the standard's PSD."""
+
 import math
 
 import numpy as np
@@ -17,9 +18,9 @@ def test_step_and_sine_closed_forms():
 
 
 def test_bump_shape():
-    z = road.bump(T, height=0.08, length=2.0, speed=4.0, t0=0.5)   # over 0.5-1.0 s
+    z = road.bump(T, height=0.08, length=2.0, speed=4.0, t0=0.5)  # over 0.5-1.0 s
     assert z[T < 0.5].max() == 0 and z[T > 1.0].max() == 0
-    i = int(np.argmin(abs(T - 0.75)))                                 # crest, x = 1 m
+    i = int(np.argmin(abs(T - 0.75)))  # crest, x = 1 m
     assert z[i] == pytest.approx(0.08, rel=1e-12)
     assert z[int(np.argmin(abs(T - 0.625)))] == pytest.approx(0.04, rel=1e-9)  # x = length/4
 
@@ -34,7 +35,7 @@ def test_iso8608_profile_psd_matches_the_class(road_class):
     dx, fits = 0.05, []
     for seed in range(4):
         _, z = road.iso8608_profile(5000.0, dx, road_class, seed)
-        n, psd = scipy.signal.welch(z, fs=1 / dx, nperseg=2 ** 14)
+        n, psd = scipy.signal.welch(z, fs=1 / dx, nperseg=2**14)
         band = (n >= 0.03) & (n <= 2.0)
         fits.append(np.polyfit(np.log(n[band] / 0.1), np.log(psd[band]), 1))
     slope, intercept = np.mean(fits, axis=0)
@@ -61,25 +62,28 @@ def test_time_road_is_the_profile_at_speed():
     """At v = 10 m/s and dt = 1 ms the time samples are the profile samples at 1 cm."""
     zt = road.iso8608(T, "D", speed=10.0, seed=3)
     x, zx = road.iso8608_profile(30.0, 0.01, "D", seed=3)
-    np.testing.assert_allclose(zt, zx[:T.size], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(zt, zx[: T.size], rtol=0, atol=1e-12)
 
 
-@pytest.mark.parametrize("call, words", [
-    (lambda: road.iso8608(T, "K"), "unknown ISO 8608 road class 'K'; expected one of A, B"),
-    (lambda: road.iso8608(T, "C", speed=-20.0), "speed must be a finite number > 0 m/s"),
-    (lambda: road.iso8608(np.linspace(0, 3, 301), "C", 20.0), "too coarse"),
-    (lambda: road.iso8608_profile(100.0, 0.5), "dx = 0.5 m is too coarse"),
-    (lambda: road.iso8608_profile(-1.0, 0.05), "length must be a finite number > 0 m"),
-    (lambda: road.iso8608(T, "C", band=(2.0, 1.0)), "band must be"),
-    (lambda: road.bump(T, length=0.0), "length must be a finite number > 0 m"),
-    (lambda: road.step([0.0, 1.0, 0.5]), "must increase strictly"),
-    (lambda: road.sine(T, frequency=np.nan), "frequency must be a finite number > 0 Hz"),
-])
+@pytest.mark.parametrize(
+    "call, words",
+    [
+        (lambda: road.iso8608(T, "K"), "unknown ISO 8608 road class 'K'; expected one of A, B"),
+        (lambda: road.iso8608(T, "C", speed=-20.0), "speed must be a finite number > 0 m/s"),
+        (lambda: road.iso8608(np.linspace(0, 3, 301), "C", 20.0), "too coarse"),
+        (lambda: road.iso8608_profile(100.0, 0.5), "dx = 0.5 m is too coarse"),
+        (lambda: road.iso8608_profile(-1.0, 0.05), "length must be a finite number > 0 m"),
+        (lambda: road.iso8608(T, "C", band=(2.0, 1.0)), "band must be"),
+        (lambda: road.bump(T, length=0.0), "length must be a finite number > 0 m"),
+        (lambda: road.step([0.0, 1.0, 0.5]), "must increase strictly"),
+        (lambda: road.sine(T, frequency=np.nan), "frequency must be a finite number > 0 Hz"),
+    ],
+)
 def test_bad_input(call, words):
     with pytest.raises(ValueError, match=words):
         call()
 
 
 def test_coarse_grid_is_fine_with_a_narrower_band():
-    Tc = np.linspace(0, 3, 301)                      # 10 ms at 20 m/s: 0.2 m
+    Tc = np.linspace(0, 3, 301)  # 10 ms at 20 m/s: 0.2 m
     assert road.iso8608(Tc, "C", 20.0, band=(0.011, 2.5)).shape == Tc.shape

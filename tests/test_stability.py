@@ -1,4 +1,5 @@
 """Stability functions, step limits and numerical modes against closed forms."""
+
 import cmath
 import math
 
@@ -14,15 +15,21 @@ SEED_EIG = np.linalg.eigvals(np.asarray(qc.quarter_car().A))
 
 @pytest.mark.parametrize("method, p", [("euler", 1), ("midpoint", 2), ("heun", 2), ("rk4", 4)])
 def test_stability_function_is_taylor_for_s_equal_p(method, p):
-    np.testing.assert_allclose(stability_function(method).coef,
-                               [1 / math.factorial(k) for k in range(p + 1)], rtol=1e-15)
+    np.testing.assert_allclose(
+        stability_function(method).coef, [1 / math.factorial(k) for k in range(p + 1)], rtol=1e-15
+    )
 
 
 def test_stability_function_of_a_user_tableau():
     # Ralston's 3rd-order method, s = p = 3: R = 1 + z + z^2/2 + z^3/6
-    tab = qc.ButcherTableau("ralston3", a=[[0, 0, 0], [1/2, 0, 0], [0, 3/4, 0]],
-                            b=[2/9, 1/3, 4/9], c=[0, 1/2, 3/4], order=3)
-    np.testing.assert_allclose(stability_function(tab).coef, [1, 1, 1/2, 1/6], rtol=1e-15)
+    tab = qc.ButcherTableau(
+        "ralston3",
+        a=[[0, 0, 0], [1 / 2, 0, 0], [0, 3 / 4, 0]],
+        b=[2 / 9, 1 / 3, 4 / 9],
+        c=[0, 1 / 2, 3 / 4],
+        order=3,
+    )
+    np.testing.assert_allclose(stability_function(tab).coef, [1, 1, 1 / 2, 1 / 6], rtol=1e-15)
 
 
 def test_euler_limit_closed_form():
@@ -32,8 +39,9 @@ def test_euler_limit_closed_form():
     assert round(expected, 5) == 0.01982
 
 
-@pytest.mark.parametrize("method, quoted", [("euler", 0.0198), ("midpoint", 0.0721),
-                                            ("heun", 0.0721), ("rk4", 0.1085)])
+@pytest.mark.parametrize(
+    "method, quoted", [("euler", 0.0198), ("midpoint", 0.0721), ("heun", 0.0721), ("rk4", 0.1085)]
+)
 def test_seed_limits_are_first_crossings(method, quoted):
     h = max_stable_step(method, qc.QuarterCarParams())
     assert round(h, 4) == quoted
@@ -49,7 +57,7 @@ def test_seed_limits_are_first_crossings(method, quoted):
 
 def test_undamped_modes():
     sys = qc.quarter_car(qc.QuarterCarParams(zeta=0.0))
-    assert max_stable_step("euler", sys) == 0.0         # |1 + i y| > 1 for every y != 0
+    assert max_stable_step("euler", sys) == 0.0  # |1 + i y| > 1 for every y != 0
     wmax = max(abs(np.linalg.eigvals(np.asarray(sys.A))))
     # RK4 is stable on the imaginary axis up to |y| = 2 sqrt(2) (HW II, Fig IV.2.1)
     assert max_stable_step("rk4", sys) == pytest.approx(2 * math.sqrt(2) / wmax, rel=1e-9)
@@ -65,12 +73,14 @@ def test_eigenvalue_inputs():
 def test_numerical_modes_euler_closed_form():
     h = 0.01
     nm = numerical_modes("euler", h)
-    for name, lam in (("body bounce", qc.modal_analysis().body.eigenvalue),
-                      ("wheel hop", qc.modal_analysis().wheel.eigenvalue)):
+    for name, lam in (
+        ("body bounce", qc.modal_analysis().body.eigenvalue),
+        ("wheel hop", qc.modal_analysis().wheel.eigenvalue),
+    ):
         lam_h = cmath.log(1 + h * lam) / h
         assert nm.loc[name, "fd_h [Hz]"] == pytest.approx(lam_h.imag / (2 * math.pi), rel=1e-12)
         assert nm.loc[name, "zeta_h"] == pytest.approx(-lam_h.real / abs(lam_h), rel=1e-12)
-        assert nm.loc[name, "zeta error"] < 0       # Euler adds negative damping
+        assert nm.loc[name, "zeta error"] < 0  # Euler adds negative damping
 
 
 @pytest.mark.parametrize("zeta, sign", [(0.25, -1), (0.0005, +1)])
@@ -85,7 +95,7 @@ def test_rk4_damping_error_sign_follows_the_series(zeta, sign):
     nm = numerical_modes("rk4", h, params)
     lam = qc.modal_analysis(params).body.eigenvalue
     y, delta = h * abs(lam), math.asin(-lam.real / abs(lam))
-    predicted = y ** 5 * math.sin(5 * delta) / 120 - y ** 6 * math.cos(6 * delta) / 144
+    predicted = y**5 * math.sin(5 * delta) / 120 - y**6 * math.cos(6 * delta) / 144
     assert math.copysign(1, -predicted) == sign
     assert math.copysign(1, nm.loc["body bounce", "zeta error"]) == sign
     # the whole shift is below the leading term's size (h|lambda|)^4 |lambda|-scaled
@@ -119,7 +129,7 @@ def test_modes_measured_from_responses(method, h):
         # measure while the mode is well above rounding (the wheel decays ~9% a step)
         live = np.abs(z[i]) > 1e-6 * np.abs(z[i, 0])
         n = int(np.argmin(live)) if not live.all() else live.size
-        lam_h = np.mean(np.log(z[i, 1:n] / z[i, :n - 1])) / h
+        lam_h = np.mean(np.log(z[i, 1:n] / z[i, : n - 1])) / h
         fd_h, zeta_h = lam_h.imag / (2 * math.pi), -lam_h.real / abs(lam_h)
         assert fd_h == pytest.approx(nm.loc[mode.name, "fd_h [Hz]"], rel=1e-9)
         assert zeta_h == pytest.approx(nm.loc[mode.name, "zeta_h"], rel=1e-8)

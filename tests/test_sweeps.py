@@ -1,4 +1,5 @@
 """sweep(): equal to single runs, independent of executor and chunking, robust to bad designs."""
+
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 import control
@@ -10,7 +11,7 @@ from qc_control import road
 from qc_control.ride import ride_metrics
 from qc_control.sweeps import DEFAULT_METRICS, METRICS, design_grid, sweep
 
-T = np.linspace(0, 5, 2001)          # h = 2.5 ms
+T = np.linspace(0, 5, 2001)  # h = 2.5 ms
 X0 = [0.0, 0.0, 0.05, 0.0]
 GRID = {"ks": [2e4, 3e4, 4.5e4], "zeta": [0.1, 0.3, 0.6], "mu": [40.0, 100.0]}
 
@@ -21,13 +22,15 @@ def independent_metrics(y, T, p=qc.QuarterCarParams()):
     dev = np.abs(xs - xs[-1])
     outside = np.flatnonzero(dev > 0.02 * dev.max())
     settle = T[min(outside[-1] + 1, T.size - 1)] if outside.size else T[0]
-    return {"peak_travel [m]": np.max(np.abs(y[2])),
-            "rms_body_acc [m/s²]": np.sqrt(np.trapezoid(y[4] ** 2, T) / (T[-1] - T[0])),
-            "settling_time [s]": settle,
-            "peak_tire_defl [m]": np.max(np.abs(y[3])),
-            "rms_tire_load / static [-]": p.ku * np.sqrt(np.trapezoid(y[3] ** 2, T)
-                                                          / (T[-1] - T[0]))
-            / ((p.ms + p.mu) * 9.80665)}
+    return {
+        "peak_travel [m]": np.max(np.abs(y[2])),
+        "rms_body_acc [m/s²]": np.sqrt(np.trapezoid(y[4] ** 2, T) / (T[-1] - T[0])),
+        "settling_time [s]": settle,
+        "peak_tire_defl [m]": np.max(np.abs(y[3])),
+        "rms_tire_load / static [-]": p.ku
+        * np.sqrt(np.trapezoid(y[3] ** 2, T) / (T[-1] - T[0]))
+        / ((p.ms + p.mu) * 9.80665),
+    }
 
 
 @pytest.fixture(scope="module")
@@ -57,8 +60,9 @@ def test_equal_to_single_runs(grid_result):
 def test_rk4_sweep_against_control_exact():
     """RK4 at h = 1 ms: peak travel within 1e-8 m of the exact response's."""
     T1 = np.linspace(0, 5, 5001)
-    r = sweep([qc.QuarterCarParams(), qc.QuarterCarParams(ks=4e4, zeta=0.4)], T1, X0,
-              progress=False)
+    r = sweep(
+        [qc.QuarterCarParams(), qc.QuarterCarParams(ks=4e4, zeta=0.4)], T1, X0, progress=False
+    )
     for i, p in enumerate([qc.QuarterCarParams(), qc.QuarterCarParams(ks=4e4, zeta=0.4)]):
         exact = control.initial_response(qc.quarter_car(p), T1, X0).outputs
         assert abs(r.metrics.loc[i, "peak_travel [m]"] - np.max(np.abs(exact[2]))) < 1e-8
@@ -69,19 +73,25 @@ def test_road_sweep_equals_forced_response():
     designs = [qc.QuarterCarParams(), qc.QuarterCarParams(zeta=0.5, ku=2e5)]
     r = sweep(designs, T, np.zeros(4), U=U, method="heun", states=True, progress=False)
     for i, p in enumerate(designs):
-        single = qc.forced_response(qc.quarter_car(p, road=True), T, U, method="heun",
-                                    engine="generic")
+        single = qc.forced_response(
+            qc.quarter_car(p, road=True), T, U, method="heun", engine="generic"
+        )
         np.testing.assert_allclose(r.states[i], single.states, rtol=0, atol=1e-12)
         expected = independent_metrics(single.outputs, T)
         assert r.metrics.loc[i, "peak_tire_defl [m]"] == pytest.approx(
-            expected["peak_tire_defl [m]"], rel=1e-9)
+            expected["peak_tire_defl [m]"], rel=1e-9
+        )
 
 
 def test_chunking_and_executors_do_not_change_results(grid_result):
     ref = grid_result.metrics
     cols = list(DEFAULT_METRICS)
-    for kwargs in (dict(chunk_size=1), dict(chunk_size=7), dict(chunk_size=1000),
-                   dict(executor=ThreadPoolExecutor(2), chunk_size=4)):
+    for kwargs in (
+        dict(chunk_size=1),
+        dict(chunk_size=7),
+        dict(chunk_size=1000),
+        dict(executor=ThreadPoolExecutor(2), chunk_size=4),
+    ):
         other = sweep(GRID, T, X0, progress=False, **kwargs).metrics
         # each design's arithmetic is the same whatever its chunk: agree to 1e-13
         np.testing.assert_allclose(other[cols].to_numpy(), ref[cols].to_numpy(), rtol=1e-13)
@@ -92,14 +102,19 @@ def test_chunking_and_executors_do_not_change_results(grid_result):
 
 def test_dask_local_cluster(grid_result):
     distributed = pytest.importorskip("dask.distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster, \
-            distributed.Client(cluster) as client:
-        other = sweep(GRID, T, X0, executor=client.get_executor(), chunk_size=4,
-                      progress=False).metrics
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        other = sweep(
+            GRID, T, X0, executor=client.get_executor(), chunk_size=4, progress=False
+        ).metrics
     cols = list(DEFAULT_METRICS)
-    np.testing.assert_allclose(other[cols].to_numpy(), grid_result.metrics[cols].to_numpy(),
-                               rtol=1e-13)
+    np.testing.assert_allclose(
+        other[cols].to_numpy(), grid_result.metrics[cols].to_numpy(), rtol=1e-13
+    )
 
 
 def test_bad_designs_are_reported_and_nothing_else_is_lost(grid_result):
@@ -115,13 +130,19 @@ def test_bad_designs_are_reported_and_nothing_else_is_lost(grid_result):
     assert list(good.index) == [0, 4] and good[list(DEFAULT_METRICS)].notna().all().all()
     assert r.metrics.loc[1, list(DEFAULT_METRICS)].isna().all()
     alone = sweep([qc.QuarterCarParams(ms=400.0)], T, X0, progress=False).metrics
-    assert r.metrics.loc[4, "peak_travel [m]"] == pytest.approx(alone.loc[0, "peak_travel [m]"],
-                                                                 rel=1e-13)
+    assert r.metrics.loc[4, "peak_travel [m]"] == pytest.approx(
+        alone.loc[0, "peak_travel [m]"], rel=1e-13
+    )
 
 
 def test_unstable_designs_are_flagged():
-    r = sweep([qc.QuarterCarParams(), qc.QuarterCarParams(ku=3e6)], np.linspace(0, 1, 101), X0,
-              method="euler", progress=False)
+    r = sweep(
+        [qc.QuarterCarParams(), qc.QuarterCarParams(ku=3e6)],
+        np.linspace(0, 1, 101),
+        X0,
+        method="euler",
+        progress=False,
+    )
     # h = 10 ms: fine for the seed (limit 19.8 ms), not for a 3e6 N/m tire
     assert list(r.metrics["stable"]) == [True, False]
 
@@ -131,17 +152,20 @@ def test_progress_bar_when_asked(capsys):
     assert "sweep" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("kwargs, error, words", [
-    (dict(designs={"kt": [1.0]}), ValueError, "unknown parameter 'kt' in the grid"),
-    (dict(designs=[]), ValueError, "designs is empty"),
-    (dict(T=[0, 0.1, 0.3]), ValueError, "uniformly spaced"),
-    (dict(X0=[0, 0.05]), ValueError, "X0 must be 4 finite numbers"),
-    (dict(U=np.zeros(5)), ValueError, "U must be 2001 finite road heights"),
-    (dict(chunk_size=0), ValueError, "chunk_size must be a positive integer"),
-    (dict(metrics=["comfort"]), ValueError, "unknown metric 'comfort'"),
-    (dict(executor="pool"), TypeError, "executor must be a concurrent.futures.Executor"),
-    (dict(method="rk5"), ValueError, "unknown method"),
-])
+@pytest.mark.parametrize(
+    "kwargs, error, words",
+    [
+        (dict(designs={"kt": [1.0]}), ValueError, "unknown parameter 'kt' in the grid"),
+        (dict(designs=[]), ValueError, "designs is empty"),
+        (dict(T=[0, 0.1, 0.3]), ValueError, "uniformly spaced"),
+        (dict(X0=[0, 0.05]), ValueError, "X0 must be 4 finite numbers"),
+        (dict(U=np.zeros(5)), ValueError, "U must be 2001 finite road heights"),
+        (dict(chunk_size=0), ValueError, "chunk_size must be a positive integer"),
+        (dict(metrics=["comfort"]), ValueError, "unknown metric 'comfort'"),
+        (dict(executor="pool"), TypeError, "executor must be a concurrent.futures.Executor"),
+        (dict(method="rk5"), ValueError, "unknown method"),
+    ],
+)
 def test_bad_input(kwargs, error, words):
     args = dict(designs=[qc.QuarterCarParams()], T=T, X0=X0)
     args.update(kwargs)
@@ -150,8 +174,13 @@ def test_bad_input(kwargs, error, words):
 
 
 def test_custom_metric_and_states_off():
-    r = sweep([qc.QuarterCarParams()], T, X0, metrics={"final xs [m]": lambda c: c.y[:, 0, -1]},
-              progress=False)
+    r = sweep(
+        [qc.QuarterCarParams()],
+        T,
+        X0,
+        metrics={"final xs [m]": lambda c: c.y[:, 0, -1]},
+        progress=False,
+    )
     assert r.states is None and list(r.metrics.columns)[-2] == "final xs [m]"
     exact = control.initial_response(qc.quarter_car(), T, X0).outputs[0, -1]
     assert r.metrics.loc[0, "final xs [m]"] == pytest.approx(exact, abs=1e-8)
@@ -163,11 +192,13 @@ def test_ride_metrics_in_a_road_sweep_equal_ride_metrics():
     U = road.iso8608(Tr, "D", 15.0, seed=2)
     designs = [qc.QuarterCarParams(), qc.QuarterCarParams(ku=1.5e5, zeta=0.15)]
     r = sweep(designs, Tr, np.zeros(4), U=U, metrics=list(METRICS), progress=False).metrics
-    names = {"rms_body_acc [m/s²]": "rms body_acc [m/s²]",
-             "rms_body_acc_wk [m/s²]": "rms body_acc Wk [m/s²]",
-             "vdv [m/s^1.75]": "VDV [m/s^1.75]",
-             "rms_tire_load / static [-]": "rms tire load / static [-]",
-             "lift_off_time [s]": "lift-off time [s]"}
+    names = {
+        "rms_body_acc [m/s²]": "rms body_acc [m/s²]",
+        "rms_body_acc_wk [m/s²]": "rms body_acc Wk [m/s²]",
+        "vdv [m/s^1.75]": "VDV [m/s^1.75]",
+        "rms_tire_load / static [-]": "rms tire load / static [-]",
+        "lift_off_time [s]": "lift-off time [s]",
+    }
     for i, p in enumerate(designs):
         single = qc.forced_response(qc.quarter_car(p, road=True), Tr, U, method="rk4")
         expected = ride_metrics(single, p)

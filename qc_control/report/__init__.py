@@ -18,8 +18,15 @@ import numpy as np
 import pandas as pd
 
 from .document import Code, Heading, Image, Paragraph, Table, fmt, to_html, to_markdown
-from .figures import (convergence_figure, error_figure, method_figure, overlay_figure,
-                      road_figure, stability_figure, work_precision_figure)
+from .figures import (
+    convergence_figure,
+    error_figure,
+    method_figure,
+    overlay_figure,
+    road_figure,
+    stability_figure,
+    work_precision_figure,
+)
 from .findings import findings
 
 __all__ = ["write_report", "build_blocks", "ReportError", "MARKER", "FORMATS"]
@@ -41,16 +48,22 @@ def _versions() -> dict[str, str]:
 
     from .. import __version__
 
-    return {"qc_control": __version__, "python-control": control.__version__,
-            "numpy": np.__version__, "scipy": scipy.__version__,
-            "matplotlib": matplotlib.__version__, "pandas": pd.__version__,
-            "python": platform.python_version(), "machine": f"{platform.system()} "
-            f"{platform.machine()}"}
+    return {
+        "qc_control": __version__,
+        "python-control": control.__version__,
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "matplotlib": matplotlib.__version__,
+        "pandas": pd.__version__,
+        "python": platform.python_version(),
+        "machine": f"{platform.system()} {platform.machine()}",
+    }
 
 
 def _matrix(name, M) -> str:
-    return f"{name} =\n" + np.array2string(np.asarray(M), precision=6, suppress_small=True,
-                                           max_line_width=100)
+    return f"{name} =\n" + np.array2string(
+        np.asarray(M), precision=6, suppress_small=True, max_line_width=100
+    )
 
 
 def _slug(name: str) -> str:
@@ -60,28 +73,48 @@ def _slug(name: str) -> str:
 
 def _figures(cmp) -> list[tuple[str, str, object]]:
     """(file name, caption, figure factory) for every figure, in report order."""
-    figs = [(f"method_{_slug(tab.name)}.png",
-             f"{tab.name}: displacement of the suspension (sprung mass, red solid) and of "
-             f"the wheel (blue dashed), h = {cmp.h:g} s",
-             lambda name=tab.name: method_figure(cmp, name)) for tab in cmp.methods]
+    figs = [
+        (
+            f"method_{_slug(tab.name)}.png",
+            f"{tab.name}: displacement of the suspension (sprung mass, red solid) and of "
+            f"the wheel (blue dashed), h = {cmp.h:g} s",
+            lambda name=tab.name: method_figure(cmp, name),
+        )
+        for tab in cmp.methods
+    ]
     figs += [
-        ("overlay.png", "All methods' body displacement over the exact response",
-         lambda: overlay_figure(cmp)),
+        (
+            "overlay.png",
+            "All methods' body displacement over the exact response",
+            lambda: overlay_figure(cmp),
+        ),
         ("error.png", "Body-displacement error against time (log axis)", lambda: error_figure(cmp)),
-        ("convergence.png", "Max |xs error| against h, with slope guides of each order",
-         lambda: convergence_figure(cmp)),
-        ("work_precision.png", "Max |xs error| against RHS evaluations and against wall time",
-         lambda: work_precision_figure(cmp)),
-        ("stability.png", "Stability regions |R(z)| ≤ 1 with hλ of each mode",
-         lambda: stability_figure(cmp)),
+        (
+            "convergence.png",
+            "Max |xs error| against h, with slope guides of each order",
+            lambda: convergence_figure(cmp),
+        ),
+        (
+            "work_precision.png",
+            "Max |xs error| against RHS evaluations and against wall time",
+            lambda: work_precision_figure(cmp),
+        ),
+        (
+            "stability.png",
+            "Stability regions |R(z)| ≤ 1 with hλ of each mode",
+            lambda: stability_figure(cmp),
+        ),
     ]
     if cmp.ride is not None:
         figs += [
-            ("road.png", "The road input and the body's exact response",
-             lambda: road_figure(cmp)),
-            ("transmissibility.png", "Transmissibility from the road height zr (magnitude "
-             "and phase); the circle is the invariant point √(ku/mu), where |body_acc/zr| = "
-             "ku/ms for every damper", lambda: cmp.transmissibility.figure()),
+            ("road.png", "The road input and the body's exact response", lambda: road_figure(cmp)),
+            (
+                "transmissibility.png",
+                "Transmissibility from the road height zr (magnitude "
+                "and phase); the circle is the invariant point √(ku/mu), where |body_acc/zr| = "
+                "ku/ms for every damper",
+                lambda: cmp.transmissibility.figure(),
+            ),
         ]
     return figs
 
@@ -89,12 +122,17 @@ def _figures(cmp) -> list[tuple[str, str, object]]:
 def _scenario_text(cmp) -> str:
     t0, t1 = cmp.T[0], cmp.T[-1]
     x0 = ", ".join(fmt(v) for v in cmp.X0)
-    kind = ("free response (no input)" if cmp.U is None else
-            f"forced response to the input(s) {', '.join(cmp.system.input_labels)}"
-            + (f" ({cmp.input_description})" if getattr(cmp, "input_description", "") else ""))
-    return (f"Scenario: {kind}, from X0 = [{x0}] (states {', '.join(cmp.system.state_labels)}; "
-            f"m/s and m), over {fmt(t0)}–{fmt(t1)} s with h = {fmt(cmp.h)} s "
-            f"({cmp.table['steps'].iloc[0]} steps). SI units throughout.")
+    kind = (
+        "free response (no input)"
+        if cmp.U is None
+        else f"forced response to the input(s) {', '.join(cmp.system.input_labels)}"
+        + (f" ({cmp.input_description})" if getattr(cmp, "input_description", "") else "")
+    )
+    return (
+        f"Scenario: {kind}, from X0 = [{x0}] (states {', '.join(cmp.system.state_labels)}; "
+        f"m/s and m), over {fmt(t0)}–{fmt(t1)} s with h = {fmt(cmp.h)} s "
+        f"({cmp.table['steps'].iloc[0]} steps). SI units throughout."
+    )
 
 
 def build_blocks(cmp, command: str | None = None) -> list:
@@ -107,74 +145,123 @@ def build_blocks(cmp, command: str | None = None) -> list:
         blocks.append(Table(frame.set_index("symbol"), "Vehicle parameters"))
     blocks.append(Code(_matrix("A", cmp.system.A) + "\n\n" + _matrix("B", cmp.system.B)))
     modes = cmp.modes.to_frame()
-    blocks.append(Table(modes, "Modes from the eigenvalues of A (eigenvalue, natural and damped "
-                               "frequency, modal and nominal damping, mode shape)"))
+    blocks.append(
+        Table(
+            modes,
+            "Modes from the eigenvalues of A (eigenvalue, natural and damped "
+            "frequency, modal and nominal damping, mode shape)",
+        )
+    )
     if cmp.modes.note:
         blocks.append(Paragraph(cmp.modes.note))
-    blocks.append(Paragraph(
-        f"Reference: {cmp.reference_name}, the exact solution for an input linear between "
-        f"samples (matrix exponential). Its own accuracy: it differs from "
-        f"{cmp.reference_description} by at most {fmt(cmp.reference_error)} m. "
-        f"It took {fmt(cmp.reference_time * 1e3)} ms."))
+    blocks.append(
+        Paragraph(
+            f"Reference: {cmp.reference_name}, the exact solution for an input linear between "
+            f"samples (matrix exponential). Its own accuracy: it differs from "
+            f"{cmp.reference_description} by at most {fmt(cmp.reference_error)} m. "
+            f"It took {fmt(cmp.reference_time * 1e3)} ms."
+        )
+    )
 
     blocks.append(Heading("Per-method responses"))
     blocks += [Image(*figs[f"method_{_slug(tab.name)}.png"]) for tab in cmp.methods]
     blocks += [Heading("All methods against the reference"), Image(*figs["overlay.png"])]
 
     accuracy = [c for c in table.columns if "err" in c and "freq" not in c and "zeta" not in c]
-    blocks += [Heading("Accuracy"), Image(*figs["error.png"]),
-               Table(table[accuracy], "Errors against the reference over the whole run")]
+    blocks += [
+        Heading("Accuracy"),
+        Image(*figs["error.png"]),
+        Table(table[accuracy], "Errors against the reference over the whole run"),
+    ]
 
     blocks += [Heading("Convergence"), Image(*figs["convergence.png"])]
     conv = cmp.convergence.pivot(index="h", columns="method", values="error")
     conv = conv.sort_index(ascending=False)[[t.name for t in cmp.methods]]
     conv.index.name = "h [s]"
     blocks.append(Table(conv, "Max |xs error| [m] at h, h/2, …, h/32"))
-    blocks.append(Table(table[["order", "observed order"]],
-                        "Observed order: least-squares slope of log error against log h over "
-                        "h, h/2 and h/4"))
+    blocks.append(
+        Table(
+            table[["order", "observed order"]],
+            "Observed order: least-squares slope of log error against log h over h, h/2 and h/4",
+        )
+    )
 
     blocks += [Heading("Work and precision"), Image(*figs["work_precision.png"])]
-    cost_cols = ["stages", "steps", "RHS evals", "wall time [ms]", "LTI engine [ms]",
-                 "time / control"]
-    blocks.append(Table(table[cost_cols], f"Cost at h = {fmt(cmp.h)} s (best of several runs): wall time "
-                              "of the step-by-step loop, as the seed runs it, and of qc_control's "
-                              "LTI engine, which computes the same trajectory; control's exact "
-                              f"response took {fmt(cmp.reference_time * 1e3)} ms"))
+    cost_cols = [
+        "stages",
+        "steps",
+        "RHS evals",
+        "wall time [ms]",
+        "LTI engine [ms]",
+        "time / control",
+    ]
+    blocks.append(
+        Table(
+            table[cost_cols],
+            f"Cost at h = {fmt(cmp.h)} s (best of several runs): wall time "
+            "of the step-by-step loop, as the seed runs it, and of qc_control's "
+            "LTI engine, which computes the same trajectory; control's exact "
+            f"response took {fmt(cmp.reference_time * 1e3)} ms",
+        )
+    )
     reach = cmp.cost.T.copy()
     reach.columns = [f"to {fmt(t)} m" for t in cmp.cost.index]
     kinds = cmp.cost_kind.T
     for col, tol in zip(reach.columns, cmp.cost.index):
         reach[col] = [f"{fmt(v)} ({k[0]})" for v, k in zip(reach[col], kinds[tol])]
     reach.index.name = "method"
-    blocks.append(Table(reach, "RHS evaluations to reach each max |xs error| "
-                               "(i: interpolated between refinements, e: extrapolated with "
-                               "e = C·h^p, never beyond h_max)"))
+    blocks.append(
+        Table(
+            reach,
+            "RHS evaluations to reach each max |xs error| "
+            "(i: interpolated between refinements, e: extrapolated with "
+            "e = C·h^p, never beyond h_max)",
+        )
+    )
 
     blocks += [Heading("Stability and numerical modes"), Image(*figs["stability.png"])]
     stab_cols = ["h_max [s]", "limited by", "stable"] + [
-        c for c in table.columns if "freq err" in c or "zeta err" in c]
-    blocks.append(Table(table[stab_cols],
-                        f"Step limit and each mode as the method sees it at h = {fmt(cmp.h)} s "
-                        "(frequency error of the damped frequency; zeta err = ζ_h − ζ)"))
+        c for c in table.columns if "freq err" in c or "zeta err" in c
+    ]
+    blocks.append(
+        Table(
+            table[stab_cols],
+            f"Step limit and each mode as the method sees it at h = {fmt(cmp.h)} s "
+            "(frequency error of the damped frequency; zeta err = ζ_h − ζ)",
+        )
+    )
 
     if cmp.ride is not None:
-        blocks += [Heading("Road and ride"), Image(*figs["road.png"]),
-                   Image(*figs["transmissibility.png"]),
-                   Table(cmp.ride, "Ride metrics of each method and of the exact reference "
-                                   "(ISO 2631-1 Wk weighting; tire load over the static "
-                                   "wheel load (ms + mu)·g)")]
-        blocks.append(Table(cmp.ride_error,
-                            "Each method's ride metrics against the reference [%]"))
+        blocks += [
+            Heading("Road and ride"),
+            Image(*figs["road.png"]),
+            Image(*figs["transmissibility.png"]),
+            Table(
+                cmp.ride,
+                "Ride metrics of each method and of the exact reference "
+                "(ISO 2631-1 Wk weighting; tire load over the static "
+                "wheel load (ms + mu)·g)",
+            ),
+        ]
+        blocks.append(Table(cmp.ride_error, "Each method's ride metrics against the reference [%]"))
     blocks.append(Heading("Findings"))
     blocks += [Paragraph(text) for text in findings(cmp)]
 
     blocks.append(Heading("Reproduce"))
     versions = _versions()
-    blocks.append(Paragraph("Versions: " + ", ".join(f"{k} {v}" for k, v in versions.items())
-                            + f". Written {_dt.datetime.now().isoformat(timespec='seconds')}."))
-    blocks.append(Code(command or "python -c 'import qc_control as qc; "
-                                  "qc.compare_methods(None).write(\"report\")'"))
+    blocks.append(
+        Paragraph(
+            "Versions: "
+            + ", ".join(f"{k} {v}" for k, v in versions.items())
+            + f". Written {_dt.datetime.now().isoformat(timespec='seconds')}."
+        )
+    )
+    blocks.append(
+        Code(
+            command
+            or "python -c 'import qc_control as qc; qc.compare_methods(None).write(\"report\")'"
+        )
+    )
     return blocks
 
 
@@ -183,9 +270,13 @@ def _csv_tables(cmp) -> dict[str, pd.DataFrame]:
     cost = cmp.cost.copy()
     for name in cost.columns:
         cost[f"{name} kind"] = cmp.cost_kind[name]
-    return {"methods.csv": cmp.table, "convergence.csv": cmp.convergence.set_index("method"),
-            "cost_to_reach.csv": cost, "modes.csv": cmp.modes.to_frame(),
-            "numerical_modes.csv": nm}
+    return {
+        "methods.csv": cmp.table,
+        "convergence.csv": cmp.convergence.set_index("method"),
+        "cost_to_reach.csv": cost,
+        "modes.csv": cmp.modes.to_frame(),
+        "numerical_modes.csv": nm,
+    }
 
 
 def _check_target(out: Path, overwrite: bool) -> None:
@@ -194,14 +285,17 @@ def _check_target(out: Path, overwrite: bool) -> None:
             raise ReportError(f"{str(out)!r} exists and is not a directory")
         if any(out.iterdir()):
             if not (out / MARKER).exists():
-                raise ReportError(f"refusing to overwrite {str(out)!r}: it is not a qc-control "
-                                  f"report (no {MARKER} file); choose another --out")
+                raise ReportError(
+                    f"refusing to overwrite {str(out)!r}: it is not a qc-control "
+                    f"report (no {MARKER} file); choose another --out"
+                )
             if not overwrite:
                 raise ReportError(f"{str(out)!r} already holds a report")
 
 
-def write_report(cmp, out_dir, formats=FORMATS, *, command: str | None = None,
-                 overwrite: bool = True) -> Path:
+def write_report(
+    cmp, out_dir, formats=FORMATS, *, command: str | None = None, overwrite: bool = True
+) -> Path:
     """Write the comparison report into ``out_dir``, atomically.
 
     Parameters
@@ -232,8 +326,10 @@ def write_report(cmp, out_dir, formats=FORMATS, *, command: str | None = None,
     formats = tuple(formats)
     bad = [f for f in formats if f not in FORMATS]
     if bad or not formats:
-        raise ValueError(f"unknown report format {bad[0] if bad else '(none)'!r}; "
-                         f"choose from {', '.join(FORMATS)}")
+        raise ValueError(
+            f"unknown report format {bad[0] if bad else '(none)'!r}; "
+            f"choose from {', '.join(FORMATS)}"
+        )
     out = Path(out_dir).resolve()
     _check_target(out, overwrite)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -35,7 +35,7 @@ class Table:
 
 @dataclass(frozen=True)
 class Image:
-    path: str      # relative to the report
+    path: str  # relative to the report
     caption: str
 
 
@@ -104,9 +104,17 @@ pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; }
 
 def to_html(title: str, blocks) -> str:
     esc = html.escape
-    out = ["<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',
-           f"<title>{esc(title)}</title>", f"<style>{_CSS}</style>", "</head>", "<body>",
-           f"<h1>{esc(title)}</h1>"]
+    out = [
+        "<!DOCTYPE html>",
+        '<html lang="en">',
+        "<head>",
+        '<meta charset="utf-8">',
+        f"<title>{esc(title)}</title>",
+        f"<style>{_CSS}</style>",
+        "</head>",
+        "<body>",
+        f"<h1>{esc(title)}</h1>",
+    ]
     for b in blocks:
         if isinstance(b, Heading):
             out.append(f"<h{b.level}>{esc(b.text)}</h{b.level}>")
@@ -121,8 +129,10 @@ def to_html(title: str, blocks) -> str:
             out += ["<tr>" + "".join(f"<td>{esc(c)}</td>" for c in row) + "</tr>" for row in body]
             out.append("</table>")
         elif isinstance(b, Image):
-            out.append(f'<figure><img src="{esc(b.path)}" alt="{esc(b.caption)}">'
-                       f"<figcaption>{esc(b.caption)}</figcaption></figure>")
+            out.append(
+                f'<figure><img src="{esc(b.path)}" alt="{esc(b.caption)}">'
+                f"<figcaption>{esc(b.caption)}</figcaption></figure>"
+            )
         elif isinstance(b, Code):
             out.append(f"<pre><code>{esc(b.text)}</code></pre>")
     out += ["</body>", "</html>", ""]

@@ -8,8 +8,11 @@ from .document import fmt
 
 __all__ = ["findings"]
 
-_KIND = {"interpolated": "interpolated", "extrapolated": "extrapolated from its order",
-         "unreached": "not reached"}
+_KIND = {
+    "interpolated": "interpolated",
+    "extrapolated": "extrapolated from its order",
+    "unreached": "not reached",
+}
 
 
 def _cheapest(cmp) -> list[str]:
@@ -26,7 +29,8 @@ def _cheapest(cmp) -> list[str]:
             f"Cheapest to reach {fmt(tol)} m (max |xs error|): {who}, about "
             f"{fmt(int(costs.iloc[0]))} RHS evaluations "
             f"({_KIND[cmp.cost_kind.loc[tol, best]]})"
-            + (f"; the others need {others}." if others else "."))
+            + (f"; the others need {others}." if others else ".")
+        )
     return out
 
 
@@ -38,15 +42,18 @@ def _step_limits(cmp) -> list[str]:
         out.append(
             f"Euler's step limit is h = {fmt(row['h_max [s]'])} s, set by the "
             f"{row['limited by']} mode (|1 + hλ| ≤ 1, i.e. h ≤ −2·Re λ/|λ|²); the chosen "
-            f"h = {fmt(cmp.h)} s is {fmt(100 * cmp.h / row['h_max [s]'])}% of it.")
+            f"h = {fmt(cmp.h)} s is {fmt(100 * cmp.h / row['h_max [s]'])}% of it."
+        )
     others = [f"{m} {fmt(r['h_max [s]'])} s" for m, r in t.iterrows() if m != "euler"]
     if others:
         out.append("The other limits: " + ", ".join(others) + ".")
     unstable = [m for m, r in t.iterrows() if not r["stable"]]
     if unstable:
-        out.append(f"At h = {fmt(cmp.h)} s {', '.join(unstable)} "
-                   f"{'is' if len(unstable) == 1 else 'are'} beyond the stability limit: "
-                   "the response grows instead of decaying, and its errors mean nothing.")
+        out.append(
+            f"At h = {fmt(cmp.h)} s {', '.join(unstable)} "
+            f"{'is' if len(unstable) == 1 else 'are'} beyond the stability limit: "
+            "the response grows instead of decaying, and its errors mean nothing."
+        )
     return out
 
 
@@ -72,22 +79,29 @@ def _coincidence(cmp) -> list[str]:
             f"{names} give the same trajectory (largest state difference {fmt(gap)} m, which "
             f"is rounding). On a linear system the free step of every method with as many "
             f"stages as its order p is the Taylor polynomial T_{p}(hA)·x"
-            + (", and an input linear within each step enters them alike (Midpoint's "
-               "u(t + h/2) is Heun's (u(t) + u(t + h))/2)" if {"midpoint", "heun"} <= set(group)
-               else "")
-            + ". They can differ on nonlinear systems or inputs that curve within a step.")
+            + (
+                ", and an input linear within each step enters them alike (Midpoint's "
+                "u(t + h/2) is Heun's (u(t) + u(t + h))/2)"
+                if {"midpoint", "heun"} <= set(group)
+                else ""
+            )
+            + ". They can differ on nonlinear systems or inputs that curve within a step."
+        )
     names = set(cmp.table.index)
-    if {"midpoint", "heun"} <= names and not any({"midpoint", "heun"} <= set(g)
-                                                  for g in _groups(cmp.coincident)):
+    if {"midpoint", "heun"} <= names and not any(
+        {"midpoint", "heun"} <= set(g) for g in _groups(cmp.coincident)
+    ):
         out.append("midpoint and heun differ here by more than 1e-12 m.")
     return out
 
 
 def _damping(cmp) -> list[str]:
     body, wheel = cmp.modes.body, cmp.modes.wheel
-    text = (f"Nominal against modal damping: the nominal ratio cs/(2·√(ks·ms)) = "
-            f"{fmt(body.zeta_nominal)}, but the modes have ζ = {fmt(body.zeta)} (body bounce, "
-            f"{fmt(body.fn)} Hz) and ζ = {fmt(wheel.zeta)} (wheel hop, {fmt(wheel.fn)} Hz).")
+    text = (
+        f"Nominal against modal damping: the nominal ratio cs/(2·√(ks·ms)) = "
+        f"{fmt(body.zeta_nominal)}, but the modes have ζ = {fmt(body.zeta)} (body bounce, "
+        f"{fmt(body.fn)} Hz) and ζ = {fmt(wheel.zeta)} (wheel hop, {fmt(wheel.fn)} Hz)."
+    )
     out = [text]
     for m, nm in cmp.numerical_modes.items():
         b = nm.loc["body bounce"]
@@ -96,7 +110,8 @@ def _damping(cmp) -> list[str]:
         out.append(
             f"{m} at h = {fmt(cmp.h)} s {sign} damping: body-bounce ζ {fmt(b['zeta'])} → "
             f"{fmt(b['zeta_h'])} (Δζ = {b['zeta error']:+.2g}); its largest frequency error is "
-            f"{fmt(nm.loc[worst, 'freq error [%]'])}% ({worst}).")
+            f"{fmt(nm.loc[worst, 'freq error [%]'])}% ({worst})."
+        )
     return out
 
 
@@ -104,12 +119,17 @@ def _orders(cmp) -> list[str]:
     t = cmp.table
     parts = [f"{m} {fmt(r['observed order'])} (theory {r['order']})" for m, r in t.iterrows()]
     out = ["Observed orders from h, h/2, h/4: " + ", ".join(parts) + "."]
-    off = [m for m, r in t.iterrows()
-           if math.isfinite(r["observed order"]) and abs(r["observed order"] - r["order"]) > 0.15]
+    off = [
+        m
+        for m, r in t.iterrows()
+        if math.isfinite(r["observed order"]) and abs(r["observed order"] - r["order"]) > 0.15
+    ]
     if off:
-        out.append(f"{', '.join(off)}: more than 0.15 from theory, so h = {fmt(cmp.h)} s is not "
-                   "yet in the asymptotic range there; the convergence table shows the slope "
-                   "settling at finer steps.")
+        out.append(
+            f"{', '.join(off)}: more than 0.15 from theory, so h = {fmt(cmp.h)} s is not "
+            "yet in the asymptotic range there; the convergence table shows the slope "
+            "settling at finer steps."
+        )
     return out
 
 
@@ -121,16 +141,29 @@ def _ride(cmp) -> list[str]:
     off = cmp.ride_error["rms body_acc Wk [% off]"]
     parts = [f"{m} {v:+.2g}%" for m, v in off.items()]
     lift = bool(cmp.ride.loc["reference", "lift-off"])
-    return [f"On this road the exact Wk-weighted body acceleration is {fmt(ref)} m/s² RMS "
-            f"(ISO 2631-1); at h = {fmt(cmp.h)} s the methods give it " + ", ".join(parts)
-            + ". " + ("The dynamic tire load exceeds the static wheel load: the wheel would "
-                      "lift off, which this linear model does not represent." if lift else
-                      f"The RMS dynamic tire load is "
-                      f"{fmt(float(cmp.ride.loc['reference', 'rms tire load / static [-]']))} "
-                      "of the static wheel load, and the wheel never lifts off.")]
+    return [
+        f"On this road the exact Wk-weighted body acceleration is {fmt(ref)} m/s² RMS "
+        f"(ISO 2631-1); at h = {fmt(cmp.h)} s the methods give it "
+        + ", ".join(parts)
+        + ". "
+        + (
+            "The dynamic tire load exceeds the static wheel load: the wheel would "
+            "lift off, which this linear model does not represent."
+            if lift
+            else f"The RMS dynamic tire load is "
+            f"{fmt(float(cmp.ride.loc['reference', 'rms tire load / static [-]']))} "
+            "of the static wheel load, and the wheel never lifts off."
+        )
+    ]
 
 
 def findings(cmp) -> list[str]:
     """Sentences that state what the numbers of ``cmp`` show."""
-    return (_cheapest(cmp) + _step_limits(cmp) + _coincidence(cmp) + _damping(cmp)
-            + _orders(cmp) + _ride(cmp))
+    return (
+        _cheapest(cmp)
+        + _step_limits(cmp)
+        + _coincidence(cmp)
+        + _damping(cmp)
+        + _orders(cmp)
+        + _ride(cmp)
+    )
