@@ -33,5 +33,5 @@ cmp = qc.compare_methods(
     repeats=3,
 )
 print(cmp.summary().to_string(float_format=lambda v: f"{v:.4g}"))
-path = cmp.write(out / "custom_report", command="python examples/custom_method.py")
+path = qc.write_report(cmp, out / "custom_report", command="python examples/custom_method.py")
 print(f"\nwrote {path}")

@@ -30,7 +30,7 @@ ax = fig.subplots()
 for ks in grid["ks"][::6]:
     rows = table[np.isclose(table["ks"], ks)]
     ax.plot(
-        rows["peak_travel [m]"] * 1e3,
+        rows["peak_susp_travel [m]"] * 1e3,
         rows["rms_body_acc [m/s²]"],
         "o-",
         ms=3,
@@ -49,6 +49,6 @@ best = table.loc[table["rms_body_acc [m/s²]"].idxmin()]
 print(
     f"{len(table)} designs; the most comfortable: ks = {best['ks']:.0f} N/m, "
     f"zeta = {best['zeta']:.3f}, RMS body acceleration {best['rms_body_acc [m/s²]']:.3f} m/s², "
-    f"peak travel {best['peak_travel [m]'] * 1e3:.1f} mm"
+    f"peak travel {best['peak_susp_travel [m]'] * 1e3:.1f} mm"
 )
 print(f"wrote {out / 'design_sweep.png'} and {out / 'design_sweep.csv'}")

@@ -29,9 +29,9 @@ for c in classes:
             {
                 "class": c,
                 "speed [m/s]": v,
-                "comfort: rms body_acc Wk [m/s²]": m["rms body_acc Wk [m/s²]"],
-                "road holding: rms tire load / static": m["rms tire load / static [-]"],
-                "rms susp_travel [mm]": 1e3 * m["rms susp_travel [m]"],
+                "comfort: rms body_acc Wk [m/s²]": m["rms_body_acc_wk [m/s²]"],
+                "road holding: rms tire load / static": m["rms_tire_load / static [-]"],
+                "rms susp_travel [mm]": 1e3 * m["rms_susp_travel [m]"],
             }
         )
 table = pd.DataFrame(rows).set_index(["class", "speed [m/s]"])
@@ -48,8 +48,8 @@ window = control.TimeResponseData(
 )
 sim = qc.ride_metrics(window, params)
 print(
-    f"\nclass C at 20 m/s simulated: Wk RMS {sim['rms body_acc Wk [m/s²]']:.3f} m/s², "
-    f"tire load {sim['rms tire load / static [-]']:.3f} (spectral: "
+    f"\nclass C at 20 m/s simulated: Wk RMS {sim['rms_body_acc_wk [m/s²]']:.3f} m/s², "
+    f"tire load {sim['rms_tire_load / static [-]']:.3f} (spectral: "
     f"{table.loc[('C', 20.0)].iloc[0]:.3f}, {table.loc[('C', 20.0)].iloc[1]:.3f})"
 )
 

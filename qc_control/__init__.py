@@ -10,8 +10,17 @@ from . import road
 from .compare import MethodComparison, compare_methods
 from .integrate import DivergenceWarning, Solution, integrate
 from .methods import METHODS, ButcherTableau, get_method
+from .metrics import Metric, RideSignals
 from .modal import ModalAnalysis, Mode, modal_analysis
-from .model import OUTPUTS, STATES, QuarterCarParams, load_config, quarter_car, read_config
+from .model import (
+    OUTPUTS,
+    STATES,
+    QuarterCarParams,
+    load_config,
+    quarter_car,
+    quarter_car_model,
+    read_config,
+)
 from .response import FixedStepResponse, forced_response, initial_response
 from .ride import (
     Transmissibility,
@@ -23,11 +32,19 @@ from .ride import (
 )
 from .stability import max_stable_step, numerical_modes, stability_function
 from .sweeps import DEFAULT_METRICS, METRICS, SweepChunk, SweepResult, design_grid, sweep
+from .vehicle import Corner, SignalRoles, VehicleModel
 
 __version__ = "0.1.0"
 __all__ = [
     "QuarterCarParams",
     "quarter_car",
+    "quarter_car_model",
+    "VehicleModel",
+    "SignalRoles",
+    "Corner",
+    "Metric",
+    "RideSignals",
+    "write_report",
     "load_config",
     "read_config",
     "STATES",
@@ -63,3 +80,12 @@ __all__ = [
     "wk_filter",
     "wk_weighted",
 ]
+
+
+def __getattr__(name: str):
+    # the report needs matplotlib: load it only when asked for
+    if name == "write_report":
+        from .report import write_report
+
+        return write_report
+    raise AttributeError(f"module 'qc_control' has no attribute {name!r}")

@@ -11,6 +11,7 @@ import time
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import control
 import numpy as np
@@ -20,13 +21,26 @@ import scipy.signal
 from .integrate import DivergenceWarning, check_time_grid, uniform_step
 from .methods import ButcherTableau, get_method
 from .modal import ModalAnalysis, modal_analysis
-from .model import QuarterCarParams, quarter_car
-from .response import _initial_state, _input_samples, forced_response, initial_response
+from .model import SEED_X0, QuarterCarParams, as_params, quarter_car_model
+from .response import check_initial_state, check_input_samples, forced_response, initial_response
+from .ride import Transmissibility, ride_metrics, transmissibility
 from .stability import max_stable_step, numerical_modes
+from .vehicle import VehicleModel
 
 __all__ = [
     "MethodComparison",
     "compare_methods",
+    "Reference",
+    "exact_reference",
+    "method_responses",
+    "error_table",
+    "convergence_study",
+    "observed_orders",
+    "cost_to_reach",
+    "mode_errors",
+    "ride_comparison",
+    "method_timings",
+    "best_time",
     "DEFAULT_METHODS",
     "DEFAULT_X0",
     "DEFAULT_T_END",
@@ -36,7 +50,7 @@ __all__ = [
 
 #: The default scenario: the seed's vehicle, body released from 5 cm, 0-10 s, h = 0.01 s.
 DEFAULT_METHODS = ("euler", "midpoint", "heun", "rk4")
-DEFAULT_X0 = (0.0, 0.0, 0.05, 0.0)
+DEFAULT_X0 = SEED_X0
 DEFAULT_T_END = 10.0
 DEFAULT_H = 0.01
 #: Accuracies [m] at which the report names the cheapest method.
@@ -87,10 +101,16 @@ class MethodComparison:
         Each method's ride metrics against the reference's [%].
     transmissibility : Transmissibility or None
         Under a road input: the road-to-ride frequency responses.
+    model : VehicleModel or None
+        The vehicle's description (signal roles, units), when known.
+    scenario : Scenario or None
+        The run this comparison came from, when it came from one
+        (`qc_control.scenario.Scenario.run`); the report saves it.
     """
 
     system: control.StateSpace
     params: QuarterCarParams | None
+    model: VehicleModel | None
     T: np.ndarray
     X0: np.ndarray
     U: np.ndarray | None
@@ -114,7 +134,8 @@ class MethodComparison:
     input_description: str = ""
     ride: pd.DataFrame | None = None
     ride_error: pd.DataFrame | None = None
-    transmissibility: object | None = None
+    transmissibility: Transmissibility | None = None
+    scenario: Any = None
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""
@@ -128,19 +149,6 @@ class MethodComparison:
             "h_max [s]",
         ]
         return self.table[cols]
-
-    def write(
-        self,
-        out_dir,
-        formats=("md", "html", "csv"),
-        *,
-        command: str | None = None,
-        overwrite: bool = True,
-    ):
-        """Write the report to ``out_dir``; see `qc_control.report.write_report`."""
-        from .report import write_report
-
-        return write_report(self, out_dir, formats=formats, command=command, overwrite=overwrite)
 
 
 def best_time(fn: Callable[[], object], repeats: int, warmup: bool = False) -> float:
@@ -197,32 +205,6 @@ def _exact(sys, T, X0, U):
     if U is None:
         return control.initial_response(sys, T, X0)
     return control.forced_response(sys, T, U, X0)
-
-
-def _reference_accuracy(sys, T, X0, U, reference) -> tuple[float, str]:
-    """The reference's error against an independent exact evaluation [m].
-
-    Free response: the modal closed form ``V e^{Λt} V⁻¹ x0`` at every t
-    (no recurrence, so no accumulated rounding). Forced response:
-    ``scipy.signal.lsim``, an independent implementation of the same
-    exact (input linear between samples) solution.
-    """
-    n = 2  # the displacement outputs xs, xu
-    if U is None:
-        A = np.asarray(sys.A, dtype=float)
-        lam, V = np.linalg.eig(A)
-        z0 = np.linalg.solve(V, np.asarray(X0, dtype=complex))
-        x = (V @ (z0[:, None] * np.exp(np.outer(lam, T - T[0])))).real
-        other = np.asarray(sys.C)[:n] @ x
-        how = "the modal closed form V·exp(Λt)·V⁻¹·x0"
-    else:
-        lti = scipy.signal.StateSpace(
-            np.asarray(sys.A), np.asarray(sys.B), np.asarray(sys.C)[:n], np.asarray(sys.D)[:n]
-        )
-        _, y, _ = scipy.signal.lsim(lti, U.T if U.shape[0] > 1 else U[0], T - T[0], X0=X0)
-        other = np.atleast_2d(y.T) if y.ndim > 1 else y[None]
-        how = "scipy.signal.lsim"
-    return float(np.max(np.abs(reference.outputs[:n] - other))), how
 
 
 def _observed_order(hs, errors) -> float:
@@ -287,6 +269,284 @@ def _limiting_mode(method, modes: ModalAnalysis) -> str:
     return min(limits, key=limits.get)
 
 
+@dataclass(frozen=True, eq=False)
+class Reference:
+    """The exact response every method is measured against, and its own accuracy.
+
+    Attributes
+    ----------
+    response : control.TimeResponseData
+        python-control's exact response on the grid.
+    error : float
+        Its largest difference from an independent exact evaluation, over
+        every output (in the outputs' units).
+    description : str
+        What that independent evaluation is.
+    name : str
+        What computed the reference (with python-control's version).
+    time : float
+        Its best wall time [s]; NaN when not timed.
+    """
+
+    response: control.TimeResponseData
+    error: float
+    description: str
+    name: str
+    time: float = math.nan
+
+
+def exact_reference(sys, T, X0, U=None, *, repeats: int = 0) -> Reference:
+    """python-control's exact response and its accuracy against an independent one.
+
+    Free response: the modal closed form ``C V e^{Λt} V⁻¹ x0`` at every t
+    (no recurrence, so no accumulated rounding). Forced response:
+    ``scipy.signal.lsim``, an independent implementation of the same exact
+    solution for an input linear between samples. ``repeats > 0`` also
+    times ``control``'s call (best of ``repeats``).
+    """
+    reference = _exact(sys, T, X0, U)
+    A, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.C, sys.D))
+    if U is None:
+        lam, V = np.linalg.eig(A)
+        z0 = np.linalg.solve(V, np.asarray(X0, dtype=complex))
+        other = C @ (V @ (z0[:, None] * np.exp(np.outer(lam, T - T[0])))).real
+        how = "the modal closed form C·V·exp(Λt)·V⁻¹·x0"
+    else:
+        lti = scipy.signal.StateSpace(A, np.asarray(sys.B, dtype=float), C, D)
+        _, y, _ = scipy.signal.lsim(lti, U.T if U.shape[0] > 1 else U[0], T - T[0], X0=X0)
+        other = np.atleast_2d(y.T) if y.ndim > 1 else y[None]
+        how = "scipy.signal.lsim"
+    error = float(np.max(np.abs(np.asarray(reference.outputs).reshape(other.shape) - other)))
+    elapsed = best_time(lambda: _exact(sys, T, X0, U), repeats) if repeats else math.nan
+    name = (
+        f"control.{'initial' if U is None else 'forced'}_response "
+        f"(python-control {control.__version__})"
+    )
+    return Reference(reference, error, how, name, elapsed)
+
+
+def method_responses(
+    sys,
+    T,
+    X0,
+    U,
+    methods: Sequence[ButcherTableau],
+    substeps: int = 1,
+    progress: Callable[[str], None] | None = None,
+) -> dict:
+    """Each method's response at the grid's step: ``{name: FixedStepResponse}``."""
+    out = {}
+    for tab in methods:
+        if progress:
+            progress(f"{tab.name}: simulating")
+        out[tab.name] = _simulate(sys, T, X0, U, tab, substeps)
+    return out
+
+
+def _outputs(resp, n: int) -> np.ndarray:
+    """``(outputs, N)`` padded with inf after a divergence cut at ``resp.time.size``."""
+    y = np.asarray(resp.outputs).reshape(len(resp.output_labels), -1)
+    if y.shape[1] < n:  # diverged: the missing samples count as infinitely wrong
+        y = np.concatenate([y, np.full((y.shape[0], n - y.shape[1]), np.inf)], axis=1)
+    return y
+
+
+def error_table(responses: dict, reference: Reference, model: VehicleModel) -> pd.DataFrame:
+    """Per method (rows): max and RMS error of every output, and the final body error.
+
+    Columns ``max |label err| [unit]`` and ``rms label err [unit]`` for each
+    output label, in the model's units, and ``final |body err| [m]``.
+    """
+    ref = np.asarray(reference.response.outputs)
+    labels = list(reference.response.output_labels)
+    ref = ref.reshape(len(labels), -1)
+    body = labels.index(model.body_disp)
+    rows = {}
+    for name, resp in responses.items():
+        with np.errstate(invalid="ignore"):
+            err = _outputs(resp, ref.shape[1]) - ref
+        row = {}
+        for i, label in enumerate(labels):
+            unit = model.unit(label)
+            row[f"max |{label} err| [{unit}]"] = float(np.max(np.abs(err[i])))
+            row[f"rms {label} err [{unit}]"] = float(np.sqrt(np.mean(err[i] ** 2)))
+        row[f"final |{model.body_disp} err| [{model.unit(model.body_disp)}]"] = float(
+            abs(err[body, -1])
+        )
+        rows[name] = row
+    frame = pd.DataFrame.from_dict(rows, orient="index")
+    frame.index.name = "method"
+    return frame
+
+
+def convergence_study(
+    sys,
+    T,
+    X0,
+    U,
+    methods: Sequence[ButcherTableau],
+    h: float,
+    substeps: int,
+    model: VehicleModel,
+    *,
+    levels: int = _LEVELS,
+    timing: bool = True,
+    progress: Callable[[str], None] | None = None,
+) -> pd.DataFrame:
+    """Max body-displacement error at h, h/2, ..., h/2**levels, per method (long form).
+
+    Columns: method, level, h, steps, nfev, time (step-by-step wall time of
+    one run [s], NaN without ``timing``), error [m], stable (h within the
+    method's stability limit). The input is refined by linear
+    interpolation, which is the same input function.
+    """
+    eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
+    body = list(sys.output_labels).index(model.body_disp)
+    rows = []
+    for tab in methods:
+        if progress:
+            progress(
+                f"{tab.name}: h = {h:g} s, then {levels} halvings of h for the convergence study"
+            )
+        h_max = max_stable_step(tab, eig)
+        for lvl in range(levels + 1):
+            Tl, Ul = _refined(T, lvl), _refined_input(T, U, lvl)
+            exact = np.asarray(_exact(sys, Tl, X0, Ul).outputs)[body]
+            r = _simulate(sys, Tl, X0, Ul, tab, substeps)
+            t_run = (
+                best_time(lambda: _simulate(sys, Tl, X0, Ul, tab, substeps, "generic"), 1)
+                if timing
+                else math.nan
+            )
+            y = np.asarray(r.outputs)[body]
+            error = float(np.max(np.abs(y - exact[: y.size]))) if y.size == Tl.size else math.inf
+            rows.append(
+                {
+                    "method": tab.name,
+                    "level": lvl,
+                    "h": h / 2**lvl,
+                    "steps": r.steps,
+                    "nfev": r.nfev,
+                    "time": t_run,
+                    "error": error,
+                    "stable": h / 2**lvl <= h_max,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def observed_orders(convergence: pd.DataFrame, levels: int = 2) -> pd.Series:
+    """Least-squares slope of log error against log h over the first ``levels + 1``
+    steps, per method; NaN when a step is unstable or errors are rounding."""
+    out = {}
+    for name, rows in convergence.groupby("method", sort=False):
+        mine = rows[rows["level"] <= levels]
+        out[name] = _observed_order(mine["h"], mine["error"]) if mine["stable"].all() else math.nan
+    return pd.Series(out, name="observed order")
+
+
+def cost_to_reach(
+    convergence: pd.DataFrame, methods: Sequence[ButcherTableau], span: float, h_max: dict
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """RHS evaluations to reach each of `TOLERANCES`, and how each was found.
+
+    Returns ``(cost, kind)``, indexed by tolerance [m], a column per method.
+    """
+    reach = {tab.name: _cost_to_reach(convergence, tab, span, h_max[tab.name]) for tab in methods}
+    cost = pd.DataFrame({m: {tol: v[0] for tol, v in r.items()} for m, r in reach.items()})
+    kind = pd.DataFrame({m: {tol: v[1] for tol, v in r.items()} for m, r in reach.items()})
+    cost.index.name = kind.index.name = "tolerance [m]"
+    return cost, kind
+
+
+def mode_errors(
+    methods: Sequence[ButcherTableau], h: float, sys, modes: ModalAnalysis
+) -> tuple[dict, pd.DataFrame]:
+    """Each method's view of the modes at h, and its step limit.
+
+    Returns ``(numerical_modes per method, frame)`` where the frame has, per
+    method, ``h_max [s]``, the mode that limits it, whether h is stable, and
+    each mode's frequency and damping error.
+    """
+    eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
+    per_method, rows = {}, {}
+    for tab in methods:
+        nm = numerical_modes(tab, h, sys)
+        per_method[tab.name] = nm
+        h_max = max_stable_step(tab, eig)
+        row = {
+            "h_max [s]": h_max,
+            "limited by": _limiting_mode(tab, modes),
+            "stable": bool(h <= h_max),
+        }
+        for mode_name, mrow in nm.iterrows():
+            row[f"{mode_name} freq err [%]"] = mrow["freq error [%]"]
+            row[f"{mode_name} zeta err"] = mrow["zeta error"]
+        rows[tab.name] = row
+    frame = pd.DataFrame.from_dict(rows, orient="index")
+    frame.index.name = "method"
+    return per_method, frame
+
+
+def ride_comparison(
+    reference: Reference, responses: dict, model: VehicleModel
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """`ride_metrics` of the reference (first row) and of each method, and each
+    method's numeric metrics against the reference's [%]."""
+    ride = pd.DataFrame(
+        {
+            "reference": ride_metrics(reference.response, model),
+            **{m: ride_metrics(r, model) for m, r in responses.items()},
+        }
+    ).T
+    ride.index.name = "response"
+    flags = [c for c in ride.columns if ride[c].map(lambda v: isinstance(v, bool)).all()]
+    numeric = ride.drop(columns=flags).astype(float)
+    ref = numeric.loc["reference"]
+    error = 100 * (numeric.drop(index="reference") - ref) / ref.where(ref != 0)
+    error.columns = [c.split(" [")[0] + " [% off]" for c in error.columns]
+    return ride.astype({c: float for c in numeric.columns}), error
+
+
+def method_timings(
+    sys, T, X0, U, methods: Sequence[ButcherTableau], substeps: int, repeats: int
+) -> pd.DataFrame:
+    """Best wall time [ms] of each method step by step (``engine='generic'``, the
+    seed's loop, whose time follows the RHS evaluations) and with the LTI engine."""
+    rows = {}
+    for tab in methods:
+        generic = best_time(lambda: _simulate(sys, T, X0, U, tab, substeps, "generic"), repeats)
+        lti = best_time(lambda: _simulate(sys, T, X0, U, tab, substeps), repeats)
+        rows[tab.name] = {"wall time [ms]": 1e3 * generic, "LTI engine [ms]": 1e3 * lti}
+    return pd.DataFrame.from_dict(rows, orient="index")
+
+
+def _as_model(sys, U, params) -> tuple[control.StateSpace, VehicleModel | None, Any]:
+    """(system, model, params) from a system, parameters, a model, or None."""
+    if isinstance(sys, VehicleModel):
+        return sys.system, sys, sys.params
+    if sys is None or isinstance(sys, (QuarterCarParams, dict)):
+        model = quarter_car_model(as_params(sys), road=U is not None)
+        return model.system, model, model.params
+    if not isinstance(sys, control.StateSpace):
+        raise TypeError(
+            f"sys must be a control.StateSpace, a VehicleModel or QuarterCarParams, "
+            f"got {type(sys).__name__}"
+        )
+    if params is not None:
+        model = quarter_car_model(
+            params, road="zr" in sys.input_labels, actuator="fa" in sys.input_labels
+        )
+        return sys, model, params
+    try:  # a quarter car's labels: the roles are known even without the masses
+        model = quarter_car_model(road="zr" in sys.input_labels, actuator="fa" in sys.input_labels)
+        if list(model.system.output_labels) == list(sys.output_labels):
+            return sys, model, None
+    except ValueError:
+        pass
+    return sys, None, None
+
+
 def compare_methods(
     sys,
     T=None,
@@ -296,17 +556,23 @@ def compare_methods(
     methods: Sequence = DEFAULT_METHODS,
     h: float | None = None,
     repeats: int = 5,
+    timing: bool = True,
     progress: Callable[[str], None] | None = None,
     input_description: str = "",
     params: QuarterCarParams | None = None,
 ) -> MethodComparison:
     """Compare fixed-step methods with python-control's exact response.
 
+    The comparison is composed of steps that can be run alone:
+    `exact_reference`, `method_responses`, `error_table`,
+    `convergence_study`, `observed_orders`, `cost_to_reach`, `mode_errors`,
+    `ride_comparison` and (optionally) `method_timings`.
+
     Parameters
     ----------
-    sys : control.StateSpace or QuarterCarParams
-        A quarter car (states ``[vs, vu, xs, xu]``). Parameters build
-        ``quarter_car(params, road=U is not None)``.
+    sys : control.StateSpace, VehicleModel or QuarterCarParams
+        The vehicle. Parameters build
+        ``quarter_car_model(params, road=U is not None)``.
     T : array_like, optional
         Uniform output grid [s]; default 0-10 s at 0.01 s.
     X0 : array_like, default ``(0, 0, 0.05, 0)``
@@ -322,14 +588,17 @@ def compare_methods(
         step-by-step stepper (``engine='generic'``, the seed's loop, whose
         time follows the RHS evaluations) and ``LTI engine`` of the default
         engine, which gives the same trajectory.
+    timing : bool, default True
+        Measure wall times at all; without, the time columns are NaN and
+        the comparison's numbers do not depend on the machine.
     progress : callable, optional
-        Called with a short message as each method starts.
+        Called with a short message as each step starts.
     input_description : str, optional
         What the input is (e.g. "ISO 8608 class C road at 20 m/s"), for
         the report.
     params : QuarterCarParams, optional
-        The vehicle behind ``sys`` when ``sys`` is a system: the ride
-        metrics need its masses for the static wheel load.
+        The vehicle behind ``sys`` when ``sys`` is a quarter-car system: the
+        ride metrics need its masses for the static wheel load.
 
     Returns
     -------
@@ -340,19 +609,20 @@ def compare_methods(
     The reference is ``control.initial_response`` (or ``forced_response``),
     the exact solution for an input linear between samples, via the matrix
     exponential. Errors are the largest (``max``) and root-mean-square
-    (``rms``) differences over ``T``, and the difference at the last time.
-    The observed order is the least-squares slope of log max-error against
-    log h over h, h/2 and h/4, leaving out errors below 1e-13 m (rounding).
-    Each mode's error is ``numerical_modes`` at the chosen h. Under a road
-    input (``'zr'``) the comparison also holds `qc_control.ride_metrics`
-    of the reference and of each method, and the transmissibility.
+    (``rms``) differences over ``T`` of every output, and the difference
+    of the body displacement at the last time. The observed order is the
+    least-squares slope of log max-error against log h over h, h/2 and
+    h/4, leaving out errors below 1e-13 m (rounding). Each mode's error is
+    ``numerical_modes`` at the chosen h. Under a road input the comparison
+    also holds `qc_control.ride_metrics` of the reference and of each
+    method, and the transmissibility.
     """
-    if sys is None or isinstance(sys, (QuarterCarParams, dict)):
-        params = sys if isinstance(sys, QuarterCarParams) else QuarterCarParams(**(sys or {}))
-        sys = quarter_car(params, road=U is not None)
-    if not isinstance(sys, control.StateSpace):
-        raise TypeError(
-            f"sys must be a control.StateSpace or QuarterCarParams, got {type(sys).__name__}"
+    sys, model, params = _as_model(sys, U, params)
+    if model is None:
+        raise ValueError(
+            f"system {sys.name!r} is not a known vehicle: pass a VehicleModel "
+            "(e.g. qc.quarter_car_model(params, road=True)) so that the "
+            "comparison knows which output is which"
         )
     T = check_time_grid(np.linspace(0, DEFAULT_T_END, 1001) if T is None else T, "T")
     h, substeps = _grid(T, h)
@@ -364,125 +634,55 @@ def compare_methods(
         raise ValueError(f"methods must be distinct, got {names}")
     if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
         raise ValueError(f"repeats must be a positive integer, got {repeats!r}")
-    X0 = _initial_state(X0, sys.nstates)
+    X0 = check_initial_state(X0, sys.nstates)
     if U is not None:
-        U = _input_samples(U, sys.ninputs, T.size)
+        U = check_input_samples(U, sys.ninputs, T.size)
 
     modes = modal_analysis(sys)
     eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
-    reference = _exact(sys, T, X0, U)
-    reference_time = best_time(lambda: _exact(sys, T, X0, U), repeats)
-    reference_error, how = _reference_accuracy(sys, T, X0, U, reference)
-    exact_levels = {
-        lvl: _exact(sys, _refined(T, lvl), X0, _refined_input(T, U, lvl)).outputs
-        for lvl in range(_LEVELS + 1)
-    }
+    reference = exact_reference(sys, T, X0, U, repeats=repeats if timing else 0)
+    responses = method_responses(sys, T, X0, U, tabs, substeps)
+    errors = error_table(responses, reference, model)
+    convergence = convergence_study(
+        sys, T, X0, U, tabs, h, substeps, model, timing=timing, progress=progress
+    )
+    orders = observed_orders(convergence)
+    nm, stability = mode_errors(tabs, h, sys, modes)
+    cost, cost_kind = cost_to_reach(
+        convergence, tabs, float(T[-1] - T[0]), stability["h_max [s]"].to_dict()
+    )
+    if timing:
+        times = method_timings(sys, T, X0, U, tabs, substeps, repeats)
+        times["time / control"] = times["wall time [ms]"] / (1e3 * reference.time)
+    else:
+        times = pd.DataFrame(
+            math.nan, index=names, columns=["wall time [ms]", "LTI engine [ms]", "time / control"]
+        )
 
-    rows, conv_rows, responses, nm = {}, [], {}, {}
-    span = float(T[-1] - T[0])
-    for tab in tabs:
-        if progress:
-            progress(f"{tab.name}: h = {h:g} s and {_LEVELS} refinements")
-        h_max = max_stable_step(tab, eig)
-        resp = _simulate(sys, T, X0, U, tab, substeps)
-        responses[tab.name] = resp
-        # The method's cost is its step-by-step time; the LTI engine's is shown beside it
-        # (it computes the same trajectory, to rounding, in nearly the same time for all).
-        wall = best_time(lambda: _simulate(sys, T, X0, U, tab, substeps, "generic"), repeats)
-        wall_lti = best_time(lambda: _simulate(sys, T, X0, U, tab, substeps), repeats)
-        n = resp.time.size
-        err = resp.outputs - reference.outputs[:, :n]
-        if n < T.size:  # diverged: the missing samples count as infinitely wrong
-            err = np.concatenate([err, np.full((err.shape[0], T.size - n), np.inf)], axis=1)
-
-        for lvl in range(_LEVELS + 1):
-            Tl = _refined(T, lvl)
-            r = (
-                resp
-                if lvl == 0
-                else _simulate(sys, Tl, X0, _refined_input(T, U, lvl), tab, substeps)
-            )
-            t_run = (
-                wall
-                if lvl == 0
-                else best_time(
-                    lambda: _simulate(
-                        sys, Tl, X0, _refined_input(T, U, lvl), tab, substeps, "generic"
-                    ),
-                    1,
-                )
-            )
-            e = r.outputs[0] - exact_levels[lvl][0, : r.time.size]
-            error = float(np.max(np.abs(e))) if r.time.size == Tl.size else math.inf
-            conv_rows.append(
-                {
-                    "method": tab.name,
-                    "level": lvl,
-                    "h": h / 2**lvl,
-                    "steps": r.steps,
-                    "nfev": r.nfev,
-                    "time": t_run,
-                    "error": error,
-                    "stable": h / 2**lvl <= h_max,
-                }
-            )
-        conv = pd.DataFrame(conv_rows)
-        mine = conv[(conv["method"] == tab.name) & (conv["level"] <= 2)]
-        order = _observed_order(mine["h"], mine["error"]) if mine["stable"].all() else math.nan
-
-        nm[tab.name] = numerical_modes(tab, h, sys)
-        row = {
-            "order": tab.order,
-            "stages": tab.stages,
+    cost_cols = pd.DataFrame(
+        {
+            "order": [t.order for t in tabs],
+            "stages": [t.stages for t in tabs],
             "h [s]": h,
-            "steps": resp.steps,
-            "RHS evals": resp.nfev,
-            "wall time [ms]": 1e3 * wall,
-            "LTI engine [ms]": 1e3 * wall_lti,
-            "time / control": wall / reference_time,
-        }
-        for i, name, unit in ((0, "xs", "m"), (1, "xu", "m"), (4, "body_acc", "m/s²")):
-            row[f"max |{name} err| [{unit}]"] = float(np.max(np.abs(err[i])))
-            row[f"rms {name} err [{unit}]"] = float(np.sqrt(np.mean(err[i] ** 2)))
-        row["final |xs err| [m]"] = float(abs(err[0, -1]))
-        row["observed order"] = order
-        row["h_max [s]"] = h_max
-        row["limited by"] = _limiting_mode(tab, modes)
-        row["stable"] = bool(h <= h_max)
-        for mode_name, mrow in nm[tab.name].iterrows():
-            row[f"{mode_name} freq err [%]"] = mrow["freq error [%]"]
-            row[f"{mode_name} zeta err"] = mrow["zeta error"]
-        rows[tab.name] = row
-
-    table = pd.DataFrame.from_dict(rows, orient="index")
+            "steps": [responses[n].steps for n in names],
+            "RHS evals": [responses[n].nfev for n in names],
+        },
+        index=names,
+    )
+    table = pd.concat(
+        [cost_cols, times, errors, orders.rename("observed order"), stability], axis=1
+    )
     table.index.name = "method"
-    convergence = pd.DataFrame(conv_rows)
-    ride, ride_error, trans = None, None, None
-    if U is not None and "zr" in sys.input_labels and sys.ninputs == 1 and params is not None:
-        from .ride import ride_metrics, transmissibility
 
-        ride = pd.DataFrame(
-            {
-                "reference": ride_metrics(reference, params),
-                **{m: ride_metrics(r, params) for m, r in responses.items()},
-            }
-        ).T
-        ride.index.name = "response"
-        trans = transmissibility(sys)
-        numeric = ride.drop(columns=["lift-off", "lift-off time [s]"]).astype(float)
-        ref = numeric.loc["reference"]
-        ride_error = 100 * (numeric.drop(index="reference") - ref) / ref.where(ref != 0)
-        ride_error.columns = [c.split(" [")[0] + " [% off]" for c in ride_error.columns]
-    reach = {
-        tab.name: _cost_to_reach(convergence, tab, span, rows[tab.name]["h_max [s]"])
-        for tab in tabs
-    }
-    cost = pd.DataFrame({m: {tol: v[0] for tol, v in r.items()} for m, r in reach.items()})
-    cost_kind = pd.DataFrame({m: {tol: v[1] for tol, v in r.items()} for m, r in reach.items()})
-    cost.index.name = cost_kind.index.name = "tolerance [m]"
+    ride, ride_error, trans = None, None, None
+    roads = model.road_inputs()
+    if U is not None and len(roads) == 1 and list(sys.input_labels) == roads:
+        ride, ride_error = ride_comparison(reference, responses, model)
+        trans = transmissibility(sys) if params is not None else None
     return MethodComparison(
         system=sys,
         params=params,
+        model=model,
         T=T,
         X0=X0,
         U=U,
@@ -496,16 +696,13 @@ def compare_methods(
         cost=cost,
         cost_kind=cost_kind,
         coincident=_coincident(responses),
-        reference=reference,
-        reference_error=reference_error,
-        reference_time=reference_time,
-        reference_description=how,
+        reference=reference.response,
+        reference_error=reference.error,
+        reference_time=reference.time,
+        reference_description=reference.description,
+        reference_name=reference.name,
         responses=responses,
         eigenvalues=eig,
-        reference_name=(
-            f"control.{'initial' if U is None else 'forced'}_response "
-            f"(python-control {control.__version__})"
-        ),
         input_description=input_description,
         ride=ride,
         ride_error=ride_error,

@@ -18,8 +18,9 @@ All quantities are SI: kg, N/m, N·s/m, m, s.
 
 from __future__ import annotations
 
+import functools
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
@@ -27,17 +28,46 @@ from typing import Any
 import control
 import numpy as np
 
+from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel
+
 try:  # Python >= 3.11
     import tomllib
 except ModuleNotFoundError:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["QuarterCarParams", "quarter_car", "STATES", "OUTPUTS", "load_config", "read_config"]
+__all__ = [
+    "QuarterCarParams",
+    "quarter_car",
+    "quarter_car_model",
+    "quarter_car_abcd",
+    "as_params",
+    "seed_matrices",
+    "SEED_X0",
+    "STATES",
+    "OUTPUTS",
+    "UNITS",
+    "load_config",
+    "read_config",
+]
 
 #: State names: the seed's ``[xs', xu', xs, xu]``.
 STATES = ("vs", "vu", "xs", "xu")
 #: Output names, in order.
 OUTPUTS = ("xs", "xu", "susp_travel", "tire_defl", "body_acc")
+#: The seed's initial state: the body released from 5 cm, at rest [m/s, m/s, m, m].
+SEED_X0 = (0.0, 0.0, 0.05, 0.0)
+#: The SI unit of every signal of the quarter car.
+UNITS = {
+    "vs": "m/s",
+    "vu": "m/s",
+    "xs": "m",
+    "xu": "m",
+    "zr": "m",
+    "fa": "N",
+    "susp_travel": "m",
+    "tire_defl": "m",
+    "body_acc": "m/s²",
+}
 
 _UNITS = {"ms": "kg", "mu": "kg", "ks": "N/m", "ku": "N/m", "zeta": "-", "cs": "N·s/m"}
 _DESCRIPTIONS = {
@@ -107,10 +137,13 @@ class QuarterCarParams:
     def __post_init__(self):
         for name in ("ms", "mu", "ks", "ku", "zeta", "cs"):
             value = getattr(self, name)
-            if value is None:
+            if value is None and name in ("zeta", "cs"):
                 continue
             if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
-                raise ValueError(f"{name} must be a number, got {value!r}")
+                raise ValueError(
+                    f"{name} ({_DESCRIPTIONS[name]}) must be a number in {_UNITS[name]}, "
+                    f"got {value!r}"
+                )
             value = float(value)
             if not math.isfinite(value):
                 raise ValueError(f"{name} must be finite, got {value!r}")
@@ -122,7 +155,8 @@ class QuarterCarParams:
                     f"{name} ({_DESCRIPTIONS[name]}) must be > 0 {_UNITS[name]}, got {value!r}"
                 )
             object.__setattr__(self, name, value)
-        critical = 2.0 * math.sqrt(self.ks * self.ms)
+        # 2·√ks·√ms rather than 2·√(ks·ms): the product overflows first
+        critical = 2.0 * math.sqrt(self.ks) * math.sqrt(self.ms)
         if self.cs is None:
             zeta = 0.25 if self.zeta is None else self.zeta
             object.__setattr__(self, "zeta", zeta)
@@ -132,8 +166,32 @@ class QuarterCarParams:
         elif not math.isclose(self.cs, self.zeta * critical, rel_tol=1e-9, abs_tol=1e-12):
             raise ValueError(
                 f"cs={self.cs!r} and zeta={self.zeta!r} disagree: "
-                f"cs = 2*zeta*sqrt(ks*ms) = {self.zeta * critical!r}; give only one"
+                f"cs = 2*zeta*sqrt(ks*ms) = {self.zeta * critical:.6g}; give only one"
             )
+        # every entry of A must be a finite number, or no method can step the model
+        ratios = {
+            "cs": self.cs,
+            "ks/ms": self.ks / self.ms,
+            "ks/mu": self.ks / self.mu,
+            "ku/mu": self.ku / self.mu,
+            "cs/ms": self.cs / self.ms,
+            "cs/mu": self.cs / self.mu,
+        }
+        for what, value in ratios.items():
+            if not math.isfinite(value):
+                raise ValueError(
+                    f"{what} overflows to {value!r} for ms={self.ms!r}, mu={self.mu!r}, "
+                    f"ks={self.ks!r}, ku={self.ku!r}: the model's matrix would not be finite"
+                )
+
+    @property
+    def system(self) -> control.StateSpace:
+        """The plain quarter car (no inputs): ``quarter_car(self)``."""
+        return quarter_car(self)
+
+    def model(self, *, road: bool = False, actuator: bool = False) -> VehicleModel:
+        """The quarter car as a `VehicleModel`: ``quarter_car_model(self, ...)``."""
+        return quarter_car_model(self, road=road, actuator=actuator)
 
     @classmethod
     def from_mapping(cls, values: Mapping[str, Any]) -> QuarterCarParams:
@@ -144,9 +202,18 @@ class QuarterCarParams:
             raise ValueError(f"unknown parameter {unknown[0]!r}; expected one of {sorted(known)}")
         return cls(**dict(values))
 
-    def to_dict(self) -> dict[str, float]:
-        """The six values as a plain dict (``cs`` and ``zeta`` both resolved)."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
+    def to_dict(self, *, changing: Iterable[str] | None = None) -> dict[str, float]:
+        """The six values as a plain dict (``cs`` and ``zeta`` both resolved).
+
+        With ``changing``, the values to build a variant from when the fields
+        in ``changing`` take new values: ``cs`` and ``zeta`` are one quantity,
+        so ``cs`` is left out (it follows ``zeta``, ``ks`` and ``ms``) unless
+        ``cs`` itself changes, and then ``zeta`` is left out.
+        """
+        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        if changing is not None:
+            values.pop("zeta" if "cs" in set(changing) else "cs")
+        return values
 
     def table(self) -> list[tuple[str, str, float, str]]:
         """Rows ``(symbol, description, value, unit)`` for reports."""
@@ -193,7 +260,8 @@ def load_config(path: str | Path) -> tuple[QuarterCarParams, dict[str, Any]]:
     return QuarterCarParams(**values), scenario
 
 
-def _as_params(params) -> QuarterCarParams:
+def as_params(params) -> QuarterCarParams:
+    """``params`` as `QuarterCarParams`: the seed's car for None, a dict by field name."""
     if params is None:
         return QuarterCarParams()
     if isinstance(params, QuarterCarParams):
@@ -230,10 +298,41 @@ def seed_matrices(ms, mu, ks, ku, cs) -> tuple[np.ndarray, np.ndarray, np.ndarra
     return A, b_road, b_act
 
 
+def quarter_car_abcd(ms, mu, ks, ku, cs, *, road: bool = False, actuator: bool = False):
+    """``A, B, C, D`` of the quarter car, for one design or a batch.
+
+    Numbers give ``A (4, 4)``, ``B (4, k)``, ``C (5, 4)``, ``D (5, k)``;
+    equal-shaped arrays of ``m`` designs give the same with a leading
+    ``(m,)``. The inputs are ``zr`` (if ``road``) then ``fa`` (if
+    ``actuator``); the outputs are `OUTPUTS`:
+    ``xs``, ``xu``, ``susp_travel = xs - xu``, ``tire_defl = xu - zr`` and
+    ``body_acc``, the first row of ``A x + B u`` (exact, no differencing).
+    This is the one place the model's matrices are assembled: `quarter_car`
+    and the sweep engine both read it.
+    """
+    A, b_road, b_act = seed_matrices(ms, mu, ks, ku, cs)
+    batch = A.shape[:-2]
+    columns = [b for b, on in ((b_road, road), (b_act, actuator)) if on]
+    B = np.stack(columns, axis=-1) if columns else np.zeros(batch + (4, 0))
+    C = np.zeros(batch + (5, 4))
+    C[..., 0, 2] = C[..., 1, 3] = C[..., 2, 2] = C[..., 3, 3] = 1.0
+    C[..., 2, 3] = -1.0
+    C[..., 4, :] = A[..., 0, :]
+    D = np.zeros(batch + (5, B.shape[-1]))
+    if road:
+        D[..., 3, 0] = -1.0
+    D[..., 4, :] = B[..., 0, :]
+    return A, B, C, D
+
+
 def system_matrices(params=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """`seed_matrices` of one vehicle: ``(A, b_road, b_act)``."""
-    p = _as_params(params)
+    p = as_params(params)
     return seed_matrices(p.ms, p.mu, p.ks, p.ku, p.cs)
+
+
+def _inputs(road: bool, actuator: bool) -> list[str]:
+    return [label for label, on in (("zr", road), ("fa", actuator)) if on]
 
 
 def quarter_car(
@@ -275,28 +374,58 @@ def quarter_car(
     >>> round(float(control.dcgain(sys)[0, 0]), 12)   # zr -> xs: the body follows the road
     1.0
     """
-    A, b_road, b_act = system_matrices(params)
-    columns, inputs = [], []
-    if road:
-        columns.append(b_road)
-        inputs.append("zr")
-    if actuator:
-        columns.append(b_act)
-        inputs.append("fa")
-    B = np.column_stack(columns) if columns else np.zeros((4, 0))
-    C = np.array(
-        [
-            [0.0, 0.0, 1.0, 0.0],
-            [0.0, 0.0, 0.0, 1.0],
-            [0.0, 0.0, 1.0, -1.0],
-            [0.0, 0.0, 0.0, 1.0],
-            A[0],
-        ]
-    )
-    D = np.zeros((5, len(inputs)))
-    if road:
-        D[3, inputs.index("zr")] = -1.0
-    D[4] = B[0]
+    p = as_params(params)
+    A, B, C, D = quarter_car_abcd(p.ms, p.mu, p.ks, p.ku, p.cs, road=road, actuator=actuator)
     return control.ss(
-        A, B, C, D, states=list(STATES), inputs=inputs, outputs=list(OUTPUTS), name=name
+        A,
+        B,
+        C,
+        D,
+        states=list(STATES),
+        inputs=_inputs(road, actuator),
+        outputs=list(OUTPUTS),
+        name=name,
     )
+
+
+def quarter_car_model(params=None, *, road: bool = False, actuator: bool = False) -> VehicleModel:
+    """The quarter car as a `VehicleModel`: `quarter_car` plus the roles of its signals.
+
+    The body acceleration is ``body_acc``, the body displacement ``xs``;
+    its one corner has the travel ``susp_travel``, the tire deflection
+    ``tire_defl``, the road ``zr`` (when ``road``), the tire stiffness
+    ``ku`` and the static wheel load ``(ms + mu)·g``.
+
+    Examples
+    --------
+    >>> m = quarter_car_model(road=True)
+    >>> m.body_acc, m.corners[0].tire_defl, round(m.corners[0].static_load, 1)
+    ('body_acc', 'tire_defl', 3934.4)
+    """
+    p = as_params(params)
+    corner = Corner(
+        "",
+        "susp_travel",
+        "tire_defl",
+        "zr" if road else None,
+        p.ku,
+        (p.ms + p.mu) * STANDARD_GRAVITY,
+    )
+    # partials of module-level functions, so that a model pickles to worker processes
+    return VehicleModel(
+        quarter_car(p, road=road, actuator=actuator),
+        p,
+        UNITS,
+        SignalRoles("body_acc", "xs", (corner,)),
+        functools.partial(quarter_car_model, road=road, actuator=actuator),
+        functools.partial(_quarter_car_batch, road=road, actuator=actuator),
+    )
+
+
+def _quarter_car_batch(designs, *, road: bool, actuator: bool) -> BatchedModel:
+    """`quarter_car_model`'s matrices for many designs at once (no loop per design)."""
+    ms, mu, ks, ku, cs = (
+        np.array([[d.ms, d.mu, d.ks, d.ku, d.cs] for d in map(as_params, designs)]).reshape(-1, 5).T
+    )
+    A, B, C, D = quarter_car_abcd(ms, mu, ks, ku, cs, road=road, actuator=actuator)
+    return BatchedModel(A, B, C, D, (ku,), ((ms + mu) * STANDARD_GRAVITY,))

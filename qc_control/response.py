@@ -374,3 +374,8 @@ def forced_response(
         squeeze,
         engine,
     )
+
+
+#: The input checks, public for the layers above (compare); see the functions.
+check_initial_state = _initial_state
+check_input_samples = _input_samples

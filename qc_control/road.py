@@ -12,6 +12,8 @@ import math
 
 import numpy as np
 
+from .integrate import check_time_grid
+
 __all__ = [
     "step",
     "bump",
@@ -23,6 +25,10 @@ __all__ = [
     "ISO8608_N0",
     "ISO8608_BAND",
     "largest_step",
+    "positive",
+    "finite",
+    "road_class_psd",
+    "band_limits",
 ]
 
 #: Reference spatial frequency n0 [cycles/m] of ISO 8608.
@@ -36,12 +42,10 @@ ISO8608_BAND = (0.011, 2.83)
 
 
 def _grid(T) -> np.ndarray:
-    from .integrate import check_time_grid
-
     return check_time_grid(T, "T")
 
 
-def _positive(name: str, value, unit: str) -> float:
+def positive(name: str, value, unit: str) -> float:
     if (
         isinstance(value, bool)
         or not isinstance(value, (int, float, np.number))
@@ -52,7 +56,7 @@ def _positive(name: str, value, unit: str) -> float:
     return float(value)
 
 
-def _finite(name: str, value, unit: str) -> float:
+def finite(name: str, value, unit: str) -> float:
     if (
         isinstance(value, bool)
         or not isinstance(value, (int, float, np.number))
@@ -69,7 +73,7 @@ def step(T, height: float = 0.05, t0: float = 0.5) -> np.ndarray:
     ``t0`` the input is a ramp, as python-control interpolates it.
     """
     T = _grid(T)
-    return np.where(T >= _finite("t0", t0, "s"), _finite("height", height, "m"), 0.0)
+    return np.where(T >= finite("t0", t0, "s"), finite("height", height, "m"), 0.0)
 
 
 def bump(
@@ -81,8 +85,8 @@ def bump(
               \\quad 0 \\le x = v (t - t_0) \\le \\ell
     """
     T = _grid(T)
-    height, t0 = _finite("height", height, "m"), _finite("t0", t0, "s")
-    length, speed = _positive("length", length, "m"), _positive("speed", speed, "m/s")
+    height, t0 = finite("height", height, "m"), finite("t0", t0, "s")
+    length, speed = positive("length", length, "m"), positive("speed", speed, "m/s")
     x = speed * (T - t0)
     inside = (x >= 0) & (x <= length)
     return np.where(inside, 0.5 * height * (1 - np.cos(2 * np.pi * x / length)), 0.0)
@@ -91,12 +95,12 @@ def bump(
 def sine(T, amplitude: float = 0.01, frequency: float = 1.0) -> np.ndarray:
     """A sinusoidal road ``zr = amplitude · sin(2π f t)`` [m], f in Hz."""
     T = _grid(T)
-    return _finite("amplitude", amplitude, "m") * np.sin(
-        2 * np.pi * _positive("frequency", frequency, "Hz") * T
+    return finite("amplitude", amplitude, "m") * np.sin(
+        2 * np.pi * positive("frequency", frequency, "Hz") * T
     )
 
 
-def _road_class(road_class: str) -> float:
+def road_class_psd(road_class: str) -> float:
     key = str(road_class).strip().upper()
     if key not in ISO8608_CLASSES:
         raise ValueError(
@@ -106,7 +110,7 @@ def _road_class(road_class: str) -> float:
     return ISO8608_CLASSES[key]
 
 
-def _band(band) -> tuple[float, float]:
+def band_limits(band) -> tuple[float, float]:
     lo, hi = (float(b) for b in band)
     if not (0 < lo < hi and math.isfinite(hi)):
         raise ValueError(
@@ -122,12 +126,12 @@ def iso8608_psd(n, road_class: str = "C") -> np.ndarray:
 
     with ``Gd(n0)`` the class's geometric mean, `ISO8608_CLASSES`.
     """
-    return _road_class(road_class) * (np.asarray(n, dtype=float) / ISO8608_N0) ** -2.0
+    return road_class_psd(road_class) * (np.asarray(n, dtype=float) / ISO8608_N0) ** -2.0
 
 
 def largest_step(speed: float, band=ISO8608_BAND) -> float:
     """The largest time step [s] that samples the band at ``speed``: 1/(2 v n_max)."""
-    return 1.0 / (2.0 * _positive("speed", speed, "m/s") * _band(band)[1])
+    return 1.0 / (2.0 * positive("speed", speed, "m/s") * band_limits(band)[1])
 
 
 def iso8608_profile(
@@ -144,7 +148,7 @@ def iso8608_profile(
         standard band) so that the band's shortest wavelength is resolved.
     road_class : {'A', ..., 'H'}
     seed : int
-        Seed of the random phases: the same seed gives the same road.
+        Seed (>= 0) of the random phases: the same seed gives the same road.
     band : (n_min, n_max), default ``(0.011, 2.83)`` cycles/m
 
     Returns
@@ -165,16 +169,16 @@ def iso8608_profile(
     Interaction*, ch. 3) and zero outside it. The period is at least ten
     of the longest wavelengths, so the band's low end holds ten harmonics.
     """
-    length, dx = _positive("length", length, "m"), _positive("dx", dx, "m")
-    lo, hi = _band(band)
-    g0 = _road_class(road_class)
+    length, dx = positive("length", length, "m"), positive("dx", dx, "m")
+    lo, hi = band_limits(band)
+    g0 = road_class_psd(road_class)
     if dx > 1 / (2 * hi):
         raise ValueError(
             f"dx = {dx!r} m is too coarse for the band up to {hi!r} cycles/m: "
             f"it must be <= 1/(2 n_max) = {1 / (2 * hi):.4g} m"
         )
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
-        raise ValueError(f"seed must be an integer, got {seed!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
     N = int(math.ceil(max(length, 10.0 / lo) / dx)) + 1  # (N - 1) dx >= length
     N += N % 2
     dn = 1.0 / (N * dx)
@@ -209,8 +213,8 @@ def iso8608(
     ((2001,), True)
     """
     T = _grid(T)
-    speed = _positive("speed", speed, "m/s")
-    lo, hi = _band(band)
+    speed = positive("speed", speed, "m/s")
+    lo, hi = band_limits(band)
     dt = float(np.max(np.diff(T)))
     limit = largest_step(speed, (lo, hi))
     if dt > limit * (1 + 1e-12):

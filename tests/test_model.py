@@ -64,7 +64,7 @@ def test_bad_damping_names_field_and_value(field, value):
 
 
 def test_non_number_is_rejected():
-    with pytest.raises(ValueError, match="ms must be a number, got '300'"):
+    with pytest.raises(ValueError, match=r"ms \(sprung mass\) must be a number in kg, got '300'"):
         QuarterCarParams(ms="300")
 
 

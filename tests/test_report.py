@@ -230,7 +230,7 @@ def test_road_report_has_the_ride_section(tmp_path, capsys):
     text = (out / "report.md").read_text()
     assert "## Road and ride" in text and "class B road at 15 m/s" in text
     assert (out / "transmissibility.png").exists() and (out / "road.png").exists()
-    assert "rms body_acc Wk" in text and "On this road the exact Wk-weighted" in text
+    assert "rms_body_acc_wk" in text and "On this road the exact Wk-weighted" in text
     # 15 m/s: the band needs h <= 1/(2*15*2.83) = 11.8 ms, so the default 10 ms stands
     assert "h = 0.01 s" in capsys.readouterr().err
 

@@ -259,7 +259,8 @@ def build_blocks(cmp, command: str | None = None) -> list:
     blocks.append(
         Code(
             command
-            or "python -c 'import qc_control as qc; qc.compare_methods(None).write(\"report\")'"
+            or "python -c 'import qc_control as qc; "
+            'qc.write_report(qc.compare_methods(None), "report")\''
         )
     )
     return blocks

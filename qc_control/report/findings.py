@@ -136,11 +136,11 @@ def _orders(cmp) -> list[str]:
 def _ride(cmp) -> list[str]:
     if cmp.ride is None:
         return []
-    key = "rms body_acc Wk [m/s²]"
+    key = "rms_body_acc_wk [m/s²]"
     ref = float(cmp.ride.loc["reference", key])
-    off = cmp.ride_error["rms body_acc Wk [% off]"]
+    off = cmp.ride_error["rms_body_acc_wk [% off]"]
     parts = [f"{m} {v:+.2g}%" for m, v in off.items()]
-    lift = bool(cmp.ride.loc["reference", "lift-off"])
+    lift = bool(cmp.ride.loc["reference", "lift_off"])
     return [
         f"On this road the exact Wk-weighted body acceleration is {fmt(ref)} m/s² RMS "
         f"(ISO 2631-1); at h = {fmt(cmp.h)} s the methods give it "
@@ -151,7 +151,7 @@ def _ride(cmp) -> list[str]:
             "lift off, which this linear model does not represent."
             if lift
             else f"The RMS dynamic tire load is "
-            f"{fmt(float(cmp.ride.loc['reference', 'rms tire load / static [-]']))} "
+            f"{fmt(float(cmp.ride.loc['reference', 'rms_tire_load / static [-]']))} "
             "of the static wheel load, and the wheel never lifts off."
         )
     ]
