@@ -2,6 +2,7 @@
 
 import control
 import numpy as np
+import pandas as pd
 import pytest
 
 import qc_control as qc
@@ -128,3 +129,30 @@ def test_bad_input(kwargs, error, words):
 def test_non_uniform_grid_rejected():
     with pytest.raises(ValueError, match="uniformly spaced"):
         qc.compare_methods(None, [0, 0.1, 0.3], X0)
+
+
+def test_steps_compose_and_timing_is_optional():
+    """compare_methods is its steps: each run alone gives the same numbers, and
+    without timing every number but the times is unchanged."""
+    from qc_control import compare as cmp_mod
+
+    T = np.linspace(0, 2, 201)
+    X0 = [0.0, 0.0, 0.05, 0.0]
+    timed = qc.compare_methods(qc.QuarterCarParams(), T, X0, methods=["heun", "rk4"], repeats=1)
+    plain = qc.compare_methods(qc.QuarterCarParams(), T, X0, methods=["heun", "rk4"], timing=False)
+    assert plain.table[["wall time [ms]", "LTI engine [ms]"]].isna().all().all()
+    assert np.isnan(plain.reference_time)
+    numbers = ["max |xs err| [m]", "rms body_acc err [m/s²]", "observed order", "h_max [s]"]
+    pd.testing.assert_frame_equal(timed.table[numbers], plain.table[numbers])
+
+    model = qc.quarter_car_model()
+    ref = cmp_mod.exact_reference(model.system, T, np.array(X0), outputs=["xs", "xu"])
+    assert ref.error == plain.reference_error
+    # the modal closed form agrees to rounding: a few ulps of the 5 cm scale
+    assert ref.error < 1e-15
+    tabs = [qc.get_method("heun"), qc.get_method("rk4")]
+    responses = cmp_mod.method_responses(model.system, T, np.array(X0), None, tabs)
+    errors = cmp_mod.error_table(responses, ref, model)
+    pd.testing.assert_series_equal(errors["max |xs err| [m]"], plain.table["max |xs err| [m]"])
+    # every output is measured, by label, in its own unit
+    assert {"max |tire_defl err| [m]", "max |body_acc err| [m/s²]"} <= set(errors.columns)
