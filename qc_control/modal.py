@@ -137,9 +137,21 @@ def quarter_car_matrices(sys: control.StateSpace) -> tuple[np.ndarray, np.ndarra
     return -A[:2, :2], -A[:2, 2:], A
 
 
-def _classify(ratios: list[float]) -> list[str]:
-    """The mode where the wheel moves least relative to the body is body bounce."""
-    body = int(np.argmin(ratios))
+def _in_phase(ratio: complex) -> float:
+    """Re(xu/xs): how far the wheel moves with the body (-inf when xs = 0)."""
+    return float(np.real(ratio)) if np.isfinite(ratio) else -math.inf
+
+
+def _classify(ratios: list[complex]) -> list[str]:
+    """Body bounce is the mode in which the wheel moves most in phase with the body.
+
+    In the two-mass chain the undamped shapes have ``xu/xs`` of opposite
+    signs: bounce in phase, hop against the body. That holds for damped and
+    overdamped modes too, where |xu/xs| alone does not: with a stiff damper
+    the body and the wheel bounce together on the tire (|xu/xs| ≈ 1) while
+    the overdamped relative motion has a slow part with |xu/xs| ≈ 0.
+    """
+    body = int(np.argmax([_in_phase(r) for r in ratios]))
     return [BODY if i == body else WHEEL for i in range(len(ratios))]
 
 
@@ -168,7 +180,10 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
     The undamped frequencies solve :math:`K\\varphi = \\omega^2 M\\varphi`,
     i.e. they are the square roots of the eigenvalues of :math:`M^{-1}K`.
     A mode is named from its eigenvector's displacements ``(xs, xu)``: of
-    the two, the mode with the smaller :math:`|x_u/x_s|` is body bounce.
+    the two, the mode in which the wheel moves most in phase with the body
+    (the larger :math:`\\mathrm{Re}(x_u/x_s)`) is body bounce, and the
+    other, the wheel moving against the body, is wheel hop. This holds for
+    overdamped modes too.
     The nominal ratio :math:`c_s/(2\\sqrt{k_s m_s})` is the body's damping
     on a rigid tire (:math:`k_u \\to \\infty`); a soft tire lowers it.
 
@@ -186,14 +201,13 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
 
     eigvals, eigvecs = np.linalg.eig(A)
     groups = _pair_eigenvalues(eigvals, eigvecs)
-    ratios = [abs(v[3] / v[2]) if v[2] != 0 else math.inf for _, v in groups]
-    names = _classify(ratios)
+    names = _classify([_shape(v) for _, v in groups])
 
     w2, phi = np.linalg.eig(MinvK)
     order = np.argsort(np.abs(w2))
     w2, phi = w2[order].real, phi[:, order].real
     undamped_names = _classify(
-        [abs(phi[1, i] / phi[0, i]) if phi[0, i] else math.inf for i in range(2)]
+        [phi[1, i] / phi[0, i] if phi[0, i] else complex(math.inf) for i in range(2)]
     )
     fn_undamped = {n: math.sqrt(max(w, 0.0)) / (2 * math.pi) for n, w in zip(undamped_names, w2)}
 
@@ -206,7 +220,7 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
             l1, l2 = (float(x.real) for x in lams)
             wn = math.sqrt(l1 * l2)
             zeta, fd, lam = -(l1 + l2) / (2 * wn), 0.0, complex(max(l1, l2))
-        ratio = v[3] / v[2] if v[2] != 0 else complex(math.inf)
+        ratio = _shape(v)
         modes.append(
             Mode(
                 name,
@@ -224,20 +238,23 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
     return ModalAnalysis(tuple(modes), _damping_note(modes[0], MinvK))
 
 
+def _shape(v: np.ndarray) -> complex:
+    """``xu/xs`` of an eigenvector (states ``[vs, vu, xs, xu]``); inf when xs = 0."""
+    return complex(v[3] / v[2]) if v[2] != 0 else complex(math.inf)
+
+
 def _pair_eigenvalues(eigvals, eigvecs):
     """Group the 4 eigenvalues into 2 modes: ``[(eigenvalues, eigenvector)]``.
 
     A conjugate pair is one mode. Real eigenvalues come from overdamped
-    modes; they are paired by mode shape (the two with the smallest
-    |xu/xs| form the body mode), and the slower one's vector stands for it.
+    modes; they are paired by mode shape (the two most in phase, largest
+    Re(xu/xs), form the body mode), and the slower one's vector stands for it.
     """
     complex_idx = [i for i in range(4) if eigvals[i].imag > 0]
     real_idx = [i for i in range(4) if eigvals[i].imag == 0]
     groups = [((eigvals[i],), eigvecs[:, i]) for i in complex_idx]
     if real_idx:
-        real_idx.sort(
-            key=lambda i: abs(eigvecs[3, i] / eigvecs[2, i]) if eigvecs[2, i] != 0 else math.inf
-        )
+        real_idx.sort(key=lambda i: -_in_phase(_shape(eigvecs[:, i])))
         for pair in (real_idx[:2], real_idx[2:]):
             if pair:
                 slow = max(pair, key=lambda i: eigvals[i].real)
