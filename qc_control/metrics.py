@@ -183,66 +183,39 @@ class Metric:
         return f"{self.name}{where} [{self.unit}]" if self.unit else f"{self.name}{where}"
 
 
+def _at_corner(signal: str, reduce: Callable[[np.ndarray], np.ndarray]):
+    """A wheel metric's formula: ``reduce`` of the corner's ``signal`` output."""
+    return lambda s, i: reduce(s.output(getattr(s.corner(i), signal)))
+
+
+# fmt: off
 _ALL = (
-    Metric(
-        "rms_body_acc",
-        "m/s²",
-        "RMS body acceleration (trapezoidal time mean): comfort",
-        lambda s, _: _rms(s.body_acc),
-    ),
-    Metric("peak_body_acc", "m/s²", "largest |body acceleration|", lambda s, _: peak(s.body_acc)),
-    Metric(
-        "rms_body_acc_wk",
-        "m/s²",
-        "ISO 2631-1 Wk-weighted RMS body acceleration (ISO 2631-1:1997, 6.4)",
-        lambda s, _: _rms(s.weighted_acc),
-    ),
-    Metric("vdv", "m/s^1.75", "vibration dose value (∫ a_w⁴ dt)^¼ (ISO 2631-1:1997, 6.3.2)", _vdv),
+    Metric("rms_body_acc", "m/s²", "RMS body acceleration (trapezoidal time mean): comfort",
+           lambda s, _: _rms(s.body_acc)),
+    Metric("peak_body_acc", "m/s²", "largest |body acceleration|",
+           lambda s, _: peak(s.body_acc)),
+    Metric("rms_body_acc_wk", "m/s²",
+           "ISO 2631-1 Wk-weighted RMS body acceleration (ISO 2631-1:1997, 6.4)",
+           lambda s, _: _rms(s.weighted_acc)),
+    Metric("vdv", "m/s^1.75", "vibration dose value (∫ a_w⁴ dt)^¼ (ISO 2631-1:1997, 6.3.2)",
+           _vdv),
     Metric("settling_time", "s", "2 % settling time of the body displacement", _settling_time),
-    Metric(
-        "rms_susp_travel",
-        "m",
-        "RMS suspension travel",
-        lambda s, i: _rms(s.output(s.corner(i).susp_travel)),
-        per_corner=True,
-    ),
-    Metric(
-        "peak_susp_travel",
-        "m",
-        "largest |suspension travel|: the rattle space needed",
-        lambda s, i: peak(s.output(s.corner(i).susp_travel)),
-        per_corner=True,
-    ),
-    Metric(
-        "peak_tire_defl",
-        "m",
-        "largest |dynamic tire deflection|",
-        lambda s, i: peak(s.output(s.corner(i).tire_defl)),
-        per_corner=True,
-    ),
-    Metric(
-        "rms_tire_load / static",
-        "-",
-        "RMS dynamic tire load kt·|tire_defl| over the static wheel load: road holding",
-        _rms_tire_load,
-        per_corner=True,
-    ),
-    Metric(
-        "lift_off",
-        "",
-        "whether the dynamic load ever exceeds the static wheel load "
-        "(the wheel would leave the road; a linear model does not represent it)",
-        lambda s, i: _lifted(s, i).any(axis=-1),
-        per_corner=True,
-    ),
-    Metric(
-        "lift_off_duration",
-        "s",
-        "total time the wheel would be off the road",
-        lambda s, i: np.count_nonzero(_lifted(s, i), axis=-1) * s.dt,
-        per_corner=True,
-    ),
+    Metric("rms_susp_travel", "m", "RMS suspension travel",
+           _at_corner("susp_travel", _rms), per_corner=True),
+    Metric("peak_susp_travel", "m", "largest |suspension travel|: the rattle space needed",
+           _at_corner("susp_travel", peak), per_corner=True),
+    Metric("peak_tire_defl", "m", "largest |dynamic tire deflection|",
+           _at_corner("tire_defl", peak), per_corner=True),
+    Metric("rms_tire_load / static", "-",
+           "RMS dynamic tire load kt·|tire_defl| over the static wheel load: road holding",
+           _rms_tire_load, per_corner=True),
+    Metric("lift_off", "", "whether the dynamic load ever exceeds the static wheel load "
+           "(the wheel would leave the road; a linear model does not represent it)",
+           lambda s, i: _lifted(s, i).any(axis=-1), per_corner=True),
+    Metric("lift_off_duration", "s", "total time the wheel would be off the road",
+           lambda s, i: np.count_nonzero(_lifted(s, i), axis=-1) * s.dt, per_corner=True),
 )
+# fmt: on
 
 #: Every registered metric, by name.
 METRICS: dict[str, Metric] = {m.name: m for m in _ALL}
