@@ -19,6 +19,7 @@ import pandas as pd
 import scipy.signal
 
 from .integrate import DivergenceWarning, check_time_grid, uniform_step
+from .limits import check_memory
 from .methods import ButcherTableau, get_method
 from .modal import ModalAnalysis, modal_analysis
 from .model import SEED_X0, QuarterCarParams, as_params, quarter_car_model
@@ -645,6 +646,14 @@ def compare_methods(
     if U is not None:
         U = check_input_samples(U, sys.ninputs, T.size)
 
+    # the finest refinement holds 2**levels times the samples, states and outputs, in the
+    # method's response and the exact one, with the scans' temporaries
+    finest = (T.size - 1) * 2**_LEVELS + 1
+    check_memory(
+        6 * finest * (sys.nstates + sys.noutputs + sys.ninputs) * 8,
+        f"a method comparison over {T.size - 1} steps (refined down to h/{2**_LEVELS})",
+        "use a shorter run or a larger step",
+    )
     modes = modal_analysis(sys)
     eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
     metres = [label for label in sys.output_labels if model.unit(label) == "m"]

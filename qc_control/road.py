@@ -12,7 +12,8 @@ import math
 
 import numpy as np
 
-from .integrate import check_time_grid
+from .integrate import check_time_grid, uniform_step
+from .limits import check_memory
 
 __all__ = [
     "step",
@@ -224,6 +225,18 @@ def iso8608(
             f"needs a step <= {limit:.4g} s (or a narrower band)"
         )
     x = speed * (T - T[0])
-    dx = speed * float(np.min(np.diff(T)))
+    # The profile's spacing follows the grid's span and mean step, never its
+    # smallest gap: a uniform grid samples the profile exactly at its points,
+    # and a non-uniform one (every step within the limit, checked above)
+    # interpolates it linearly between samples at most 1/(2 n_max) apart.
+    mean = float(T[-1] - T[0]) / (T.size - 1)
+    step = uniform_step(T)
+    dx = speed * (step if step is not None else mean)
+    samples = max(x[-1], 10.0 / lo) / dx
+    check_memory(
+        samples * 8 * 6,
+        f"an ISO 8608 profile of {samples:.3g} samples",
+        "use a shorter or coarser time grid",
+    )
     xp, zp = iso8608_profile(max(x[-1], dx), dx, road_class, seed, (lo, hi))
     return np.interp(x, xp, zp)

@@ -14,6 +14,7 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from .integrate import check_substeps, check_time_grid, uniform_step
+from .limits import check_memory
 from .lti import affine_scan, step_matrices
 from .methods import ButcherTableau, get_method
 from .metrics import METRICS, SWEEP_METRICS, RideSignals, metric_columns
@@ -286,6 +287,14 @@ def sweep(
     if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
         raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
     metric_items = _metric_items(metrics, model.roles)
+    # a chunk's outputs (and states) with the scan's temporaries, plus every kept trajectory
+    per_chunk = 3 * min(chunk_size, len(designs)) * (sys_.noutputs + n * states) * T.size * 8
+    check_memory(
+        per_chunk + states * len(designs) * n * T.size * 8,
+        f"a sweep of {len(designs)} designs over {T.size} samples"
+        + (" keeping their states" if states else ""),
+        "use fewer samples, a smaller chunk_size" + (" or states=False" if states else ""),
+    )
 
     params, errors = _validate(designs, type(model.params))
     good = [i for i, p in enumerate(params) if p is not None]
