@@ -400,7 +400,8 @@ def _vehicle(values) -> QuarterCarParams:
                 None,
                 name,
             )
-    A, b_road, b_act = seed_matrices(*(resolved[k] for k in ("ms", "mu", "ks", "ku", "cs")))
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # checked next
+        A, b_road, b_act = seed_matrices(*(resolved[k] for k in ("ms", "mu", "ks", "ku", "cs")))
     if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b_road)) and np.all(np.isfinite(b_act))):
         raise ScenarioError(
             "the model's matrices overflow (a ratio such as ks/ms, cs/ms or ku/mu is not "
@@ -678,8 +679,11 @@ class Scenario:
             For an unknown key, a key that does not apply (a road parameter
             of another kind of road), or a bad value.
         """
-        base = _canonical(values)
         over = _canonical(overrides or {})
+        try:
+            base = _canonical(values)
+        except ScenarioError as exc:
+            raise ScenarioError(exc.detail, exc.section, exc.key, source) from None
         vehicle = dict(base["vehicle"])
         if {"zeta", "cs"} & set(over["vehicle"]):
             vehicle.pop("zeta", None)
