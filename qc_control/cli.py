@@ -12,7 +12,9 @@ import argparse
 import os
 import sys
 import traceback
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 __all__ = ["main", "build_parser", "scenario_from_args"]
 
@@ -79,7 +81,13 @@ def _add_road(parser: argparse.ArgumentParser) -> None:
     for kind, cls in ROADS.items():
         for f in fields(cls):
             options.setdefault(road_option(f), []).append((kind, f))
-    types = {"finite": float, "positive": float, "class": str, "seed": int, "band": _floats}
+    types: dict[str, Callable[[str], Any]] = {
+        "finite": float,
+        "positive": float,
+        "class": str,
+        "seed": int,
+        "band": _floats,
+    }
     metavars = {"class": "A-H", "seed": "N", "band": "LO,HI"}
     for option, uses in options.items():
         f = uses[0][1]
@@ -136,7 +144,6 @@ def build_parser() -> argparse.ArgumentParser:
     sc.add_argument("--t-end", type=float, metavar="S", help="end time [s] (default 10)")
     sc.add_argument(
         "--x0",
-        type=_floats,
         metavar="VS,VU,XS,XU",
         help="initial state [m/s, m/s, m, m] (default 0,0,0.05,0; at rest under a road)",
     )
@@ -168,7 +175,7 @@ def scenario_from_args(args: argparse.Namespace):
     from dataclasses import fields
 
     from .model import QuarterCarParams
-    from .scenario import ROADS, Scenario
+    from .scenario import ROADS, Scenario, ScenarioError
 
     doc: dict = {
         f.name: getattr(args, f.name)
@@ -186,9 +193,40 @@ def scenario_from_args(args: argparse.Namespace):
         run["road"] = road
     if run:
         doc["scenario"] = run
-    if args.config:
-        return Scenario.from_toml(args.config, overrides=doc)
-    return Scenario.from_mapping({}, overrides=doc)
+    try:
+        if args.config:
+            return Scenario.from_toml(args.config, overrides=doc)
+        return Scenario.from_mapping({}, overrides=doc)
+    except ScenarioError as exc:
+        raise UsageError(_in_options(exc, doc)) from None
+
+
+def _in_options(exc, doc: dict) -> str:
+    """The error in the words of the command line: '--h must be ...' for a bad --h."""
+    from dataclasses import fields
+
+    from .scenario import ROADS, road_option
+
+    key, section = exc.key, exc.section
+    run = doc.get("scenario", {})
+    if section is None and key in doc and key != "scenario":
+        option = f"--{key}"
+    elif section == "scenario" and key in run:
+        option = "--" + key.replace("_", "-")
+    elif section == "scenario.road" and key in run.get("road", {}):
+        option = (
+            "--road"
+            if key == "kind"
+            else next(
+                road_option(f) for cls in ROADS.values() for f in fields(cls) if f.name == key
+            )
+        )
+    else:
+        return str(exc)
+    for lead in (f"{key} = ", f"{key}: ", f"{key} "):
+        if exc.detail.startswith(lead):
+            return option + lead[len(key) :].replace(" = ", " ") + exc.detail[len(lead) :]
+    return str(exc)
 
 
 def _cmd_modes(args) -> int:

@@ -38,7 +38,7 @@ import math
 import shlex
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 import numpy as np
 
@@ -57,7 +57,7 @@ from .model import STATES, QuarterCarParams, seed_matrices
 try:  # Python >= 3.11
     import tomllib
 except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
+    import tomli as tomllib  # type: ignore[no-redef]
 
 __all__ = [
     "Scenario",
@@ -120,8 +120,8 @@ def _is_number(value) -> bool:
 
 def _number(section: str, key: str, value, unit: str, *, positive: bool) -> float:
     if not _is_number(value) or not math.isfinite(value) or (positive and value <= 0):
-        what = "a finite number > 0" if positive else "a finite number"
-        raise ScenarioError(f"{key} must be {what} [{unit}], got {value!r}", section, key)
+        what = f"a finite number > 0 {unit}" if positive else f"a finite number [{unit}]"
+        raise ScenarioError(f"{key} must be {what}, got {value!r}", section, key)
     return float(value)
 
 
@@ -152,8 +152,8 @@ def _road_value(f, value):
         name = value.strip().upper() if isinstance(value, str) else None
         if name not in roads.ISO8608_CLASSES:
             raise ScenarioError(
-                f"{key} must be an ISO 8608 class, one of {', '.join(roads.ISO8608_CLASSES)}, "
-                f"got {value!r}",
+                f"unknown ISO 8608 road class {value!r}; expected one of "
+                f"{', '.join(roads.ISO8608_CLASSES)}",
                 _ROAD_SECTION,
                 key,
             )
@@ -213,6 +213,10 @@ class Road:
     def largest_step(self) -> float:
         """The largest time step [s] that samples this road; inf if any step does."""
         return math.inf
+
+    def sampled(self) -> str:
+        """What `largest_step` samples, in words."""
+        return self.noun
 
 
 @dataclass(frozen=True)
@@ -314,6 +318,9 @@ class ISO8608Road(Road):
     def largest_step(self) -> float:
         return roads.largest_step(self.speed, self.band)
 
+    def sampled(self) -> str:
+        return f"an ISO 8608 road at {self.speed:g} m/s, whose band reaches {self.band[1]:g} cycles/m"
+
 
 #: Every kind of road, by its ``kind``.
 ROADS: dict[str, type[Road]] = {
@@ -336,8 +343,11 @@ def road_from_mapping(values: Mapping[str, Any]) -> Road:
     values = dict(values)
     kind = values.pop("kind", "none")
     if not isinstance(kind, str) or kind.lower() not in ROADS:
+        kinds = [k for k in ROADS if k != NoRoad.kind]
         raise ScenarioError(
-            f"kind must be one of {', '.join(ROADS)}, got {kind!r}", _ROAD_SECTION, "kind"
+            f"kind must be one of {', '.join(kinds)} or {NoRoad.kind}, got {kind!r}",
+            _ROAD_SECTION,
+            "kind",
         )
     cls = ROADS[kind.lower()]
     allowed = [f.name for f in fields(cls)]
@@ -358,7 +368,7 @@ def road_from_mapping(values: Mapping[str, Any]) -> Road:
                 _ROAD_SECTION,
                 key,
             )
-        raise ScenarioError(f"unknown key {key!r}; {takes}", _ROAD_SECTION, key)
+        raise ScenarioError(f"unknown [scenario.road] key {key!r}; {takes}", None, key)
     return cls(**values)
 
 
@@ -490,9 +500,10 @@ class Scenario:
 
     vehicle: QuarterCarParams = field(default_factory=QuarterCarParams)
     road: Road = field(default_factory=NoRoad)
-    x0: tuple[float, ...] | None = None
+    # None resolves to the default in __post_init__: the attribute is always set
+    x0: tuple[float, ...] = None  # type: ignore[assignment]
     t_end: float = DEFAULT_T_END
-    h: float | None = None
+    h: float = None  # type: ignore[assignment]
     methods: tuple[str, ...] = DEFAULT_METHODS
     max_steps: int = MAX_STEPS
 
@@ -528,9 +539,8 @@ class Scenario:
         self._check_grid()
         if self.h > limit * (1 + 1e-12):
             raise ScenarioError(
-                f"h = {self.h!r} s is too coarse for {road.describe()}: it must be <= "
-                f"{limit:.4g} s to sample the road's band at this speed (give a smaller h, "
-                f"or narrow the band)",
+                f"h = {self.h!r} s is too coarse for {road.sampled()}: it must be <= "
+                f"{limit:.4g} s (give a smaller h, or narrow the band)",
                 "scenario",
                 "h",
             )
@@ -599,8 +609,8 @@ class Scenario:
             or not all(_is_number(v) and math.isfinite(v) for v in values)
         ):
             raise ScenarioError(
-                f"x0 must be {len(names)} finite numbers [{', '.join(names)}] in "
-                f"{_X0_UNITS[type(self.vehicle)]}, got {x0!r}",
+                f"x0 must be {len(names)} comma-separated numbers, all finite: "
+                f"{', '.join(names)} [{_X0_UNITS[type(self.vehicle)]}]; got {x0!r}",
                 "scenario",
                 "x0",
             )
@@ -643,7 +653,7 @@ class Scenario:
             progress=progress,
             input_description=description,
         )
-        cmp.scenario = self
+        cmp.scenario = self  # type: ignore[attr-defined]  # until MethodComparison has the field
         return cmp
 
     # ------------------------------------------------------ reading, writing
@@ -697,7 +707,7 @@ class Scenario:
             road = {**road, **over["road"]}
         given = {None: over["vehicle"], "scenario": over["run"], _ROAD_SECTION: over["road"]}
         try:
-            return cls(vehicle=vehicle, road=road, **run)
+            return cls(vehicle=cast(Any, vehicle), road=cast(Any, road), **run)
         except ScenarioError as exc:
             from_overrides = exc.key is not None and exc.key in given.get(exc.section, {})
             section = exc.section
@@ -856,9 +866,9 @@ def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
     unknown = sorted(set(table) - set(_RUN_KEYS))
     if unknown:
         raise ScenarioError(
-            f"unknown key {unknown[0]!r}; expected {', '.join(_RUN_KEYS)} and a road "
-            f"(a [scenario.road] table with kind and its parameters)",
-            "scenario",
+            f"unknown [scenario] key {unknown[0]!r}; expected {', '.join(_RUN_KEYS)} and a "
+            f"road (a [scenario.road] table with kind and its parameters)",
+            None,
             unknown[0],
         )
     if isinstance(road, Mapping):

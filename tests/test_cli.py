@@ -72,17 +72,24 @@ BAD = [
     (["report", "--t-end", "1e308", "--h", "1"], "1e+308 steps per method"),
     (["report", "--t-end", "1e6", "--h", "0.01"], "1e+08 steps per method"),
     (["report", "--t-end", "1e4", "--h", "0.01", "--max-steps", "1000"], "max_steps = 1,000"),
-    (["report", "--road", "iso8608", "--seed", "-1"], "seed must be a non-negative integer, got -1"),
-    (["report", "--seed", "-1"], "seed = -1 does not apply without a road"),
-    (["report", "--road", "bump", "--seed", "3"], "seed = 3 does not apply to a bump road"),
-    (["report", "--road-height", "0.1"], "height = 0.1 does not apply without a road"),
-    (["report", "--road", "wobble"], "kind must be one of none, step, bump, sine, iso8608"),
-    (["report", "--road", "iso8608", "--h", "0.01"], "h = 0.01 s is too coarse"),
+    (
+        ["report", "--road", "iso8608", "--seed", "-1"],
+        "--seed must be a non-negative integer, got -1",
+    ),
+    (["report", "--seed", "-1"], "--seed -1 does not apply without a road"),
+    (["report", "--road", "bump", "--seed", "3"], "--seed 3 does not apply to a bump road"),
+    (["report", "--road-height", "0.1"], "--road-height 0.1 does not apply without a road"),
+    (["report", "--road", "wobble"], "--road must be one of step, bump, sine, iso8608 or none"),
+    (["report", "--road", "iso8608", "--h", "0.01"], "--h 0.01 s is too coarse for an ISO 8608"),
+    (["report", "--road", "iso8608", "--road-class", "Z"], "unknown ISO 8608 road class 'Z'"),
+    (["report", "--road", "bump", "--speed", "0"], "--speed must be a finite number > 0 m/s"),
+    (["report", "--road-band", "1,a"], "argument --road-band: expected comma-separated numbers"),
     (["report", "--ms", "1e200", "--ks", "1e200"], "cs = inf overflows"),
-    (["report", "--x0", "1,2"], "x0 must be 4 finite numbers [vs, vu, xs, xu]"),
-    (["report", "--x0", "1,a,0,0"], "argument --x0: expected comma-separated numbers"),
-    (["report", "--methods", "rk5"], "unknown method 'rk5'"),
-    (["report", "--methods", ""], "methods must name at least one method"),
+    (["report", "--x0", "1,2"], "--x0 must be 4 comma-separated numbers, all finite: vs, vu"),
+    (["report", "--x0", "1,a,0,0"], "--x0 must be 4 comma-separated numbers"),
+    (["report", "--methods", "rk5"], "--methods: unknown method 'rk5'"),
+    (["report", "--methods", ""], "--methods must name at least one method"),
+    (["report", "--t-end", "-1"], "--t-end must be a finite number > 0 s, got -1.0"),
     (["report", "--t-end", "1.234"], "must be a whole number (at least 2) of steps"),
     (["report", "--config", "seed.toml"], "'seed.toml': [scenario] seed = 3 does not apply"),
     (["report", "--config", "step_class.toml"], "road_class = 'C' does not apply to a step"),
@@ -109,9 +116,7 @@ def test_bad_input_one_line_exit_2(files, monkeypatch, args, words, capsys):
 def test_bad_input_via_real_process(files):
     out = run("report", "--road", "iso8608", "--seed", "-1")
     assert out.returncode == 2 and out.stdout == ""
-    assert out.stderr == (
-        "qc-control: error: [scenario.road] seed must be a non-negative integer, got -1\n"
-    )
+    assert out.stderr == ("qc-control: error: --seed must be a non-negative integer, got -1\n")
 
 
 def test_unwritable_out_is_refused_before_computing(files, monkeypatch, capsys):
