@@ -319,7 +319,9 @@ class ISO8608Road(Road):
         return roads.largest_step(self.speed, self.band)
 
     def sampled(self) -> str:
-        return f"an ISO 8608 road at {self.speed:g} m/s, whose band reaches {self.band[1]:g} cycles/m"
+        return (
+            f"an ISO 8608 road at {self.speed:g} m/s, whose band reaches {self.band[1]:g} cycles/m"
+        )
 
 
 #: Every kind of road, by its ``kind``.
@@ -526,7 +528,8 @@ class Scenario:
         put("methods", self._methods(self.methods))
         put("t_end", _number("scenario", "t_end", self.t_end, "s", positive=True))
         limit = road.largest_step()
-        if self.h is None:
+        chosen = self.h is None
+        if chosen:
             put("h", DEFAULT_H if DEFAULT_H <= limit else _iso_step(limit))
         else:
             put("h", _number("scenario", "h", self.h, "s", positive=True))
@@ -536,7 +539,7 @@ class Scenario:
                 f"max_steps must be an integer >= 2, got {m!r}", "scenario", "max_steps"
             )
         put("max_steps", int(m))
-        self._check_grid()
+        self._check_grid(chosen)
         if self.h > limit * (1 + 1e-12):
             raise ScenarioError(
                 f"h = {self.h!r} s is too coarse for {road.sampled()}: it must be <= "
@@ -568,7 +571,7 @@ class Scenario:
             )
         return canonical
 
-    def _check_grid(self) -> None:
+    def _check_grid(self, chosen: bool) -> None:
         t_end, h, limit = self.t_end, self.h, self.max_steps
         ratio = t_end / h
         if not ratio <= limit + 0.5:
@@ -584,7 +587,8 @@ class Scenario:
         if steps < 2 or abs(steps * h - t_end) > 1e-9 * t_end:
             raise ScenarioError(
                 f"t_end = {t_end!r} s must be a whole number (at least 2) of steps "
-                f"h = {h!r} s, got {ratio:.6g} steps",
+                f"h = {h!r} s, got {ratio:.6g} steps"
+                + (" (the default step; give h to choose another)" if chosen else ""),
                 "scenario",
                 "t_end",
             )
