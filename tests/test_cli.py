@@ -1,11 +1,13 @@
 """The qc-control command: output, one-line errors with exit status 2, and reproducible reports."""
 
+import ast
 import builtins
 import os
 import re
 import shlex
 import subprocess
 import sys
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -181,6 +183,26 @@ def test_ctrl_c_during_imports_is_one_line(monkeypatch, capsys):
     monkeypatch.setattr(builtins, "__import__", importing)
     assert main(["modes"]) == 130
     assert capsys.readouterr().err == "qc-control: interrupted\n"
+
+
+def test_cli_module_imports_only_the_standard_library():
+    """Everything heavy is imported inside main's handlers, so Ctrl-C there is one line.
+
+    (A Ctrl-C while `import qc_control` itself runs, before main, is the package's own
+    __init__'s to keep short.)
+    """
+    tree = ast.parse(Path(cli.__file__).read_text(encoding="utf-8"))
+    top = {
+        alias.name.split(".")[0]
+        for node in tree.body
+        if isinstance(node, ast.Import)
+        for alias in node.names
+    } | {
+        node.module.split(".")[0] if node.level == 0 and node.module else "qc_control"
+        for node in tree.body
+        if isinstance(node, ast.ImportFrom)
+    }
+    assert top <= set(sys.stdlib_module_names) | {"__future__"}, top
 
 
 # ------------------------------------------------------------ reproduce
