@@ -1,21 +1,26 @@
-"""The ``qc-control`` command: argument parsing only; the library does the work.
+"""The ``qc-control`` command: arguments become a `qc_control.Scenario`; the library runs it.
 
-Every bad input ends in one line on stderr and exit status 2, never a
-traceback.
+Exit status: 0 on success; 2 with one line on stderr for bad input (a bad
+option or config value, an unusable ``--out``); 130 with one line on Ctrl-C;
+1 with the traceback and a request to report it for anything else, which is
+a bug in qc-control and is never passed off as a usage error.
 """
 
 from __future__ import annotations
 
 import argparse
-import math
+import os
 import sys
-from dataclasses import fields
+import traceback
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
 
-from .model import QuarterCarParams, read_config
-
-__all__ = ["main"]
+__all__ = ["main", "build_parser", "scenario_from_args"]
 
 _PROG = "qc-control"
+#: The run's options of ``report``, as fields of `qc_control.Scenario`.
+_RUN_OPTIONS = ("t_end", "h", "x0", "methods", "max_steps")
 
 
 class UsageError(Exception):
@@ -27,7 +32,21 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
-def _add_params(parser: argparse.ArgumentParser) -> None:
+def _floats(text: str) -> list[float]:
+    """``'a,b,c'`` as floats (the count is checked by the Scenario)."""
+    try:
+        return [float(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated numbers, got {text!r}"
+        ) from None
+
+
+def _add_vehicle(parser: argparse.ArgumentParser) -> None:
+    from dataclasses import fields
+
+    from .model import QuarterCarParams
+
     group = parser.add_argument_group("vehicle (SI units; defaults: the seed's Table 1)")
     for f in fields(QuarterCarParams):
         group.add_argument(
@@ -36,192 +55,249 @@ def _add_params(parser: argparse.ArgumentParser) -> None:
     group.add_argument(
         "--config",
         metavar="FILE.toml",
-        help="TOML file with top-level ms, mu, ks, ku, zeta or cs"
-        " (and a [scenario] table for 'report')",
+        help="TOML file: the vehicle's ms, mu, ks, ku, zeta or cs at the top level, and for "
+        "'report' a [scenario] table and a [scenario.road] table (a report's scenario.toml)",
     )
 
 
-def _params(args) -> tuple[QuarterCarParams, dict]:
-    """The vehicle from ``--config`` and the options; options win."""
-    values, scenario = read_config(args.config) if args.config else ({}, {})
-    given = {
+def _add_road(parser: argparse.ArgumentParser) -> None:
+    """One option per road parameter, read from the road kinds' fields."""
+    from dataclasses import fields
+
+    from .scenario import ROADS, road_option
+
+    group = parser.add_argument_group(
+        "road input (default: none, the free response from --x0)",
+        "Each road parameter defaults to its function's default in qc_control.road, except "
+        "the speed, whose one default serves both bump and iso8608.",
+    )
+    group.add_argument(
+        "--road",
+        dest="road_kind",
+        metavar="KIND",
+        help=f"{', '.join(ROADS)}; under a road the car starts at rest unless --x0 is given",
+    )
+    options: dict[str, list] = {}
+    for kind, cls in ROADS.items():
+        for f in fields(cls):
+            options.setdefault(road_option(f), []).append((kind, f))
+    types: dict[str, Callable[[str], Any]] = {
+        "finite": float,
+        "positive": float,
+        "class": str,
+        "seed": int,
+        "band": _floats,
+    }
+    metavars = {"class": "A-H", "seed": "N", "band": "LO,HI"}
+    for option, uses in options.items():
+        f = uses[0][1]
+        unit = f" [{f.metadata['unit']}]" if f.metadata["unit"] else ""
+        defaults = ", ".join(f"{kind} {f.default!r}" for kind, f in uses)
+        group.add_argument(
+            option,
+            dest=f"road_{f.name}",
+            type=types[f.metadata["check"]],
+            metavar=metavars.get(f.metadata["check"], "X"),
+            help=f"{f.metadata['help']}{unit} (default: {defaults})",
+        )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``qc-control``."""
+    import control
+
+    from . import __version__
+
+    parser = _Parser(
+        prog=_PROG,
+        description="Quarter-car suspension tools on python-control.",
+        allow_abbrev=False,  # a reproduce command must mean the same in every version
+    )
+    parser.add_argument(
+        "--version",
+        action="version",
+        version=f"{_PROG} {__version__} (python-control {control.__version__})",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    modes = sub.add_parser(
+        "modes", help="print the modal table (frequencies, damping, shapes)", allow_abbrev=False
+    )
+    _add_vehicle(modes)
+    modes.set_defaults(run=_cmd_modes)
+
+    report = sub.add_parser(
+        "report",
+        help="compare the methods against the exact response and write the report",
+        allow_abbrev=False,
+    )
+    _add_vehicle(report)
+    sc = report.add_argument_group(
+        "scenario (defaults: the seed's, body released from 5 cm, 0-10 s at h = 0.01 s)"
+    )
+    sc.add_argument(
+        "--h",
+        type=float,
+        metavar="S",
+        help="step size [s] (default 0.01; under an ISO 8608 road, the largest of "
+        "10, 5, 2, 1, 0.5, ... ms that samples the road)",
+    )
+    sc.add_argument("--t-end", type=float, metavar="S", help="end time [s] (default 10)")
+    sc.add_argument(
+        "--x0",
+        metavar="VS,VU,XS,XU",
+        help="initial state [m/s, m/s, m, m] (default 0,0,0.05,0; at rest under a road)",
+    )
+    sc.add_argument(
+        "--methods", metavar="A,B,...", help="methods to compare (default euler,midpoint,heun,rk4)"
+    )
+    sc.add_argument(
+        "--max-steps",
+        type=int,
+        metavar="N",
+        help="refuse a run of more than N steps t_end/h per method (default 100000)",
+    )
+    _add_road(report)
+    report.add_argument(
+        "--out",
+        default="report",
+        metavar="DIR",
+        help="report directory (default report/); replaced only if it holds an earlier report",
+    )
+    report.add_argument(
+        "-q", "--quiet", action="store_true", help="no progress lines on stderr, only the summary"
+    )
+    report.set_defaults(run=_cmd_report)
+    return parser
+
+
+def scenario_from_args(args: argparse.Namespace):
+    """The `qc_control.Scenario` of parsed arguments: ``--config``, then the options over it."""
+    from dataclasses import fields
+
+    from .model import QuarterCarParams
+    from .scenario import ROADS, Scenario, ScenarioError
+
+    doc: dict = {
         f.name: getattr(args, f.name)
         for f in fields(QuarterCarParams)
-        if getattr(args, f.name) is not None
+        if getattr(args, f.name, None) is not None
     }
-    if {"cs", "zeta"} & set(given):  # damping on the command line replaces the file's
-        values.pop("cs", None)
-        values.pop("zeta", None)
-    return QuarterCarParams(**{**values, **given}), scenario
+    run = {k: getattr(args, k) for k in _RUN_OPTIONS if getattr(args, k, None) is not None}
+    road = {"kind": args.road_kind} if getattr(args, "road_kind", None) is not None else {}
+    for cls in ROADS.values():
+        for f in fields(cls):
+            value = getattr(args, f"road_{f.name}", None)
+            if value is not None:
+                road[f.name] = value
+    if road:
+        run["road"] = road
+    if run:
+        doc["scenario"] = run
+    try:
+        if args.config:
+            return Scenario.from_toml(args.config, overrides=doc)
+        return Scenario.from_mapping({}, overrides=doc)
+    except ScenarioError as exc:
+        raise UsageError(_in_options(exc, doc)) from None
+
+
+def _in_options(exc, doc: dict) -> str:
+    """The error in the words of the command line: '--h must be ...' for a bad --h."""
+    from dataclasses import fields
+
+    from .scenario import ROADS, road_option
+
+    key, section = exc.key, exc.section
+    run = doc.get("scenario", {})
+    if section is None and key in doc and key != "scenario":
+        option = f"--{key}"
+    elif section == "scenario" and key in run:
+        option = "--" + key.replace("_", "-")
+    elif section == "scenario.road" and key in run.get("road", {}):
+        option = (
+            "--road"
+            if key == "kind"
+            else next(
+                road_option(f) for cls in ROADS.values() for f in fields(cls) if f.name == key
+            )
+        )
+    else:
+        return str(exc)
+    for lead in (f"{key} = ", f"{key}: ", f"{key} "):
+        if exc.detail.startswith(lead):
+            return option + lead[len(key) :].replace(" = ", " ") + exc.detail[len(lead) :]
+    return str(exc)
 
 
 def _cmd_modes(args) -> int:
     from .modal import modal_analysis
 
-    params, _ = _params(args)
-    print(modal_analysis(params))
+    print(modal_analysis(scenario_from_args(args).vehicle))
     return 0
 
 
-_SCENARIO_KEYS = {"h", "t_end", "x0", "methods", "road", "road_class", "speed", "seed"}
-_ROADS = ("step", "bump", "sine", "iso8608")
-#: Default steps tried, largest first, when an ISO 8608 road needs a finer one.
-_NICE_STEPS = (0.01, 0.005, 0.002, 0.001, 5e-4, 2e-4, 1e-4)
+def _check_out(out: str) -> Path:
+    """``--out`` as a path the report can be written to, checked before any work.
 
+    It must be an empty directory or an earlier report (the report writer's
+    rule), or not exist yet; the directory that will hold it (the nearest
+    existing ancestor) must be a directory this user can write in.
+    """
+    from .report import MARKER
 
-def _floats(text: str, name: str, count: int) -> tuple[float, ...]:
+    path = Path(os.path.abspath(out))
+    writable = lambda d: os.access(d, os.W_OK | os.X_OK)  # noqa: E731
     try:
-        values = tuple(float(v) for v in str(text).split(","))
-    except ValueError:
-        raise UsageError(f"{name} must be {count} comma-separated numbers, got {text!r}") from None
-    if len(values) != count:
-        raise UsageError(
-            f"{name} must be {count} comma-separated numbers (vs,vu,xs,xu), "
-            f"got {len(values)} in {text!r}"
-        )
-    return values
-
-
-def _scenario(args, table: dict) -> dict:
-    """h, t_end, x0, methods from the options, else the config's [scenario], else defaults."""
-    from .compare import DEFAULT_H, DEFAULT_METHODS, DEFAULT_T_END, DEFAULT_X0
-    from .methods import get_method
-
-    unknown = sorted(set(table) - _SCENARIO_KEYS)
-    if unknown:
-        raise UsageError(
-            f"unknown [scenario] key {unknown[0]!r}; expected one of {sorted(_SCENARIO_KEYS)}"
-        )
-    pick = lambda name, default: (
-        getattr(args, name)
-        if getattr(args, name) is not None  # noqa
-        else table.get(name, default)
-    )
-    road = pick("road", None)
-    if road is not None and road not in _ROADS:
-        raise UsageError(f"--road must be one of {', '.join(_ROADS)}, got {road!r}")
-    road_class, speed, seed = pick("road_class", "C"), pick("speed", 20.0), pick("seed", 0)
-    if road != "iso8608" and (args.road_class is not None or args.seed is not None):
-        raise UsageError("--road-class and --seed apply to --road iso8608 only")
-    if (
-        isinstance(speed, bool)
-        or not isinstance(speed, (int, float))
-        or not math.isfinite(speed)
-        or speed <= 0
-    ):
-        raise UsageError(f"--speed must be a finite number > 0 m/s, got {speed!r}")
-    h = pick("h", None)
-    if h is None:
-        h = DEFAULT_H
-        if road == "iso8608":
-            from .road import largest_step
-
-            limit = largest_step(speed)
-            h = next((c for c in _NICE_STEPS if c <= limit), _NICE_STEPS[-1])
-    t_end = pick("t_end", DEFAULT_T_END)
-    for name, value in (("h", h), ("t-end", t_end)):
-        if (
-            isinstance(value, bool)
-            or not isinstance(value, (int, float))
-            or not math.isfinite(value)
-            or value <= 0
-        ):
-            raise UsageError(f"--{name} must be a finite number > 0 s, got {value!r}")
-    steps = round(t_end / h)
-    if steps < 2 or abs(steps * h - t_end) > 1e-9 * t_end:
-        raise UsageError(f"--t-end {t_end!r} s must be a whole number (>= 2) of steps --h {h!r} s")
-    x0 = pick("x0", DEFAULT_X0 if road is None else (0.0, 0.0, 0.0, 0.0))
-    x0 = _floats(x0 if isinstance(x0, str) else ",".join(map(str, x0)), "--x0", 4)
-    if not all(math.isfinite(v) for v in x0):
-        raise UsageError(f"--x0 must be finite, got {x0!r}")
-    methods = pick("methods", DEFAULT_METHODS)
-    if isinstance(methods, str):
-        methods = [m.strip() for m in methods.split(",") if m.strip()]
-    tabs = [get_method(m) for m in methods]
-    if not tabs:
-        raise UsageError("--methods must name at least one method")
-    return {
-        "h": float(h),
-        "t_end": float(t_end),
-        "steps": int(steps),
-        "x0": x0,
-        "methods": tuple(t.name for t in tabs),
-        "road": road,
-        "road_class": road_class,
-        "speed": float(speed),
-        "seed": seed,
-    }
-
-
-def _road_input(sc: dict, T):
-    """(zr samples, description) for the scenario's road, or (None, '')."""
-    from . import road
-
-    kind = sc["road"]
-    if kind is None:
-        return None, ""
-    if kind == "step":
-        return road.step(T), "a 5 cm road step at t = 0.5 s"
-    if kind == "bump":
-        return (
-            road.bump(T, speed=sc["speed"]),
-            f"a 5 cm, 1 m long 1 − cos bump at t = 0.5 s, at {sc['speed']:g} m/s",
-        )
-    if kind == "sine":
-        return road.sine(T), "a sinusoidal road, 1 cm amplitude at 1 Hz"
-    return (
-        road.iso8608(T, sc["road_class"], sc["speed"], sc["seed"]),
-        f"an ISO 8608 class {str(sc['road_class']).upper()} road at {sc['speed']:g} m/s "
-        f"(seed {sc['seed']})",
-    )
+        if path.exists():
+            if not path.is_dir():
+                raise UsageError(f"--out {out!r} is a file, not a report directory")
+            if any(path.iterdir()) and not (path / MARKER).exists():
+                raise UsageError(
+                    f"refusing to overwrite {out!r}: it is not a qc-control report "
+                    f"(no {MARKER} file); choose another --out"
+                )
+            # the new report replaces the old one by renames in the parent
+            for d in (path.parent, path):
+                if not writable(d):
+                    raise UsageError(
+                        f"--out {out!r} cannot be replaced: {str(d)!r} is not writable"
+                    )
+            return path
+        ancestor = path.parent
+        while not ancestor.exists():
+            ancestor = ancestor.parent
+        if not ancestor.is_dir():
+            raise UsageError(f"--out {out!r} cannot be made: {str(ancestor)!r} is not a directory")
+        if not writable(ancestor):
+            raise UsageError(f"--out {out!r} cannot be made: {str(ancestor)!r} is not writable")
+    except OSError as exc:
+        raise UsageError(f"--out {out!r} cannot be checked: {exc.strerror}") from None
+    return path
 
 
 def _cmd_report(args) -> int:
-    import shlex
+    scenario = scenario_from_args(args)
+    out = _check_out(args.out)  # before the work, not after it
 
-    import numpy as np
     import pandas as pd
 
-    from .compare import compare_methods
-    from .report import MARKER, ReportError, write_report
+    from .report import ReportError, write_report
 
-    params, table = _params(args)
-    sc = _scenario(args, table)
-    out = args.out
-    # fail before the work, not after it
-    from pathlib import Path
-
-    target = Path(out)
-    if target.exists() and (
-        not target.is_dir() or (any(target.iterdir()) and not (target / MARKER).exists())
-    ):
-        raise ReportError(
-            f"refusing to overwrite {out!r}: it is not a qc-control report "
-            f"(no {MARKER} file); choose another --out"
-        )
-    T = np.linspace(0.0, sc["t_end"], sc["steps"] + 1)
-    U, description = _road_input(sc, T)  # validated before any output
-
-    def progress(message):
-        print(f"  {message}", file=sys.stderr, flush=True)
-
-    print(
-        f"qc-control report: comparing {', '.join(sc['methods'])} at h = {sc['h']:g} s "
-        f"over 0-{sc['t_end']:g} s" + (f" on {description}" if description else ""),
-        file=sys.stderr,
-        flush=True,
+    say = (lambda message: None) if args.quiet else _progress
+    road = scenario.road.describe()
+    say(
+        f"qc-control report: {', '.join(scenario.methods)} at h = {scenario.h:g} s over "
+        f"0-{scenario.t_end:g} s" + (f" on {road}" if road else "") + "; each method is "
+        "also run at h/2, h/4, ... for the convergence and cost figures"
     )
-    cmp = compare_methods(
-        params,
-        T,
-        sc["x0"],
-        U=U,
-        methods=sc["methods"],
-        progress=progress,
-        input_description=description,
-    )
-    command = "qc-control " + shlex.join(args.argv)
-    path = write_report(cmp, out, command=command)
+    cmp = scenario.run(progress=None if args.quiet else lambda m: _progress(f"  {m}"))
+    try:
+        path = write_report(cmp, out, command=scenario.command())
+    except ReportError as exc:
+        raise UsageError(str(exc)) from None
+    except OSError as exc:
+        where = repr(exc.filename) if exc.filename else repr(args.out)
+        raise UsageError(f"cannot write the report: {where}: {exc.strerror or exc}") from None
     with pd.option_context(
         "display.width", 160, "display.max_columns", 20, "display.float_format", "{:.4g}".format
     ):
@@ -233,63 +309,45 @@ def _cmd_report(args) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog=_PROG, description="Quarter-car suspension tools on python-control.")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    modes = sub.add_parser("modes", help="print the modal table (frequencies, damping, shapes)")
-    _add_params(modes)
-    modes.set_defaults(run=_cmd_modes)
+def _progress(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
 
-    report = sub.add_parser(
-        "report", help="compare the methods against the exact response and write the report"
-    )
-    _add_params(report)
-    sc = report.add_argument_group("scenario (defaults: the seed's, body released from 5 cm)")
-    sc.add_argument("--h", type=float, metavar="S", help="step size [s] (default 0.01)")
-    sc.add_argument("--t-end", type=float, metavar="S", help="end time [s] (default 10)")
-    sc.add_argument(
-        "--x0", metavar="VS,VU,XS,XU", help="initial state [m/s, m/s, m, m] (default 0,0,0.05,0)"
-    )
-    sc.add_argument(
-        "--methods", metavar="A,B,...", help="methods to compare (default euler,midpoint,heun,rk4)"
-    )
-    rd = report.add_argument_group("road input (default: none, the free response)")
-    rd.add_argument(
-        "--road",
-        metavar="KIND",
-        help="step, bump, sine or iso8608; the car then starts at rest unless --x0 is given",
-    )
-    rd.add_argument("--road-class", metavar="A-H", help="ISO 8608 class (default C)")
-    rd.add_argument(
-        "--speed",
-        type=float,
-        metavar="M/S",
-        help="vehicle speed for bump and iso8608 [m/s] (default 20)",
-    )
-    rd.add_argument("--seed", type=int, metavar="N", help="ISO 8608 road seed (default 0)")
-    report.add_argument(
-        "--out",
-        default="report",
-        metavar="DIR",
-        help="report directory (default report/); replaced only if it holds an earlier report",
-    )
-    report.set_defaults(run=_cmd_report)
-    return parser
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
 
 
 def main(argv=None) -> int:
     """Entry point of ``qc-control``; returns the exit status."""
     try:
-        argv = sys.argv[1:] if argv is None else list(argv)
-        args = build_parser().parse_args(argv)
-        args.argv = argv
-        return args.run(args)
-    except (UsageError, ValueError, TypeError) as exc:
-        print(f"{_PROG}: error: {exc}", file=sys.stderr)
-        return 2
+        return _main(sys.argv[1:] if argv is None else list(argv))
     except KeyboardInterrupt:
         print(f"{_PROG}: interrupted", file=sys.stderr)
         return 130
+    except Exception:
+        traceback.print_exc()
+        print(
+            f"{_PROG}: internal error: this is a bug in qc-control, not a problem with your "
+            "input; please report it with the traceback above",
+            file=sys.stderr,
+        )
+        return 1
+
+
+def _main(argv: list[str]) -> int:
+    # The library is imported here, inside main's handlers, so that Ctrl-C during the
+    # imports is one line too.
+    from .scenario import ScenarioError
+
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        return args.run(args)
+    except SystemExit as exc:  # --help, --version
+        return exc.code if isinstance(exc.code, int) else 0
+    except (UsageError, ScenarioError) as exc:
+        print(f"{_PROG}: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":  # pragma: no cover

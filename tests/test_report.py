@@ -242,7 +242,7 @@ def test_road_report_has_the_ride_section(tmp_path, capsys):
         (["--road", "iso8608", "--road-class", "Z"], "unknown ISO 8608 road class 'Z'"),
         (["--road", "iso8608", "--speed", "-3"], "--speed must be a finite number > 0 m/s"),
         (["--road", "iso8608", "--h", "0.01"], "too coarse for an ISO 8608 road at 20 m/s"),
-        (["--road", "step", "--road-class", "B"], "apply to --road iso8608 only"),
+        (["--road", "step", "--road-class", "B"], "--road-class 'B' does not apply to a step road"),
     ],
 )
 def test_road_cli_bad_input(args, words, tmp_path, capsys):

@@ -1,0 +1,894 @@
+"""One comparison run as data: the vehicle, its start, the road, the grid and the methods.
+
+A `Scenario` is what ``qc-control report`` runs and what a report records.
+It is validated once, when it is made; it reads from and writes to TOML
+(`Scenario.from_toml`, `Scenario.to_toml`), and `Scenario.command` gives the
+exact command that redoes it. `Scenario.run` calls
+`qc_control.compare_methods` and returns its `MethodComparison` with
+``cmp.scenario`` set.
+
+The TOML layout (every key optional)::
+
+    ms = 301.2            # the vehicle's parameters at the top level:
+    zeta = 0.25           # ms, mu, ks, ku and zeta or cs (QuarterCarParams)
+
+    [scenario]
+    t_end = 10.0          # end time [s]
+    h = 0.01              # step [s]
+    x0 = [0.0, 0.0, 0.05, 0.0]          # [vs, vu, xs, xu] in m/s, m/s, m, m
+    methods = ["euler", "midpoint", "heun", "rk4"]
+    max_steps = 100000    # refuse a run of more steps t_end/h than this
+
+    [scenario.road]       # none, step, bump, sine or iso8608
+    kind = "bump"
+    height = 0.1          # [m]
+    length = 1.0          # [m]
+    speed = 15.0          # [m/s]
+    t0 = 0.5              # [s], when the car meets it
+
+The flat keys of earlier versions, ``road = "iso8608"``, ``road_class``,
+``speed`` and ``seed`` in ``[scenario]``, are still read.
+"""
+
+from __future__ import annotations
+
+import inspect
+import json
+import math
+import shlex
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, fields
+from typing import Any, ClassVar, cast
+
+import numpy as np
+
+from . import road as roads
+from .compare import (
+    DEFAULT_H,
+    DEFAULT_METHODS,
+    DEFAULT_T_END,
+    DEFAULT_X0,
+    MethodComparison,
+    compare_methods,
+)
+from .methods import METHODS, get_method
+from .model import STATES, QuarterCarParams, seed_matrices
+
+try:  # Python >= 3.11
+    import tomllib
+except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+    import tomli as tomllib  # type: ignore[no-redef]
+
+__all__ = [
+    "Scenario",
+    "ScenarioError",
+    "Road",
+    "NoRoad",
+    "StepRoad",
+    "BumpRoad",
+    "SineRoad",
+    "ISO8608Road",
+    "ROADS",
+    "MAX_STEPS",
+    "road_from_mapping",
+]
+
+#: The default limit on ``t_end / h``, the steps each method takes at h. The
+#: comparison also runs every method at h/2, h/4, ... for its convergence
+#: study, so the work is several times this. Measured on a 2-core machine:
+#: 10,000 steps took 19 s and 0.3 GB for RK4 alone; 100,000 steps are a few
+#: minutes and about 1.5 GB per method. Raise it per scenario (``max_steps``).
+MAX_STEPS = 100_000
+
+
+class ScenarioError(ValueError):
+    """A scenario's value is not valid. The message names the field and the value.
+
+    Attributes
+    ----------
+    detail : str
+        The message without its location.
+    section : str or None
+        The TOML table of the field (``'scenario'``, ``'scenario.road'``), or
+        None for a vehicle parameter (top level).
+    key : str or None
+        The field's name within its table, when one field is at fault.
+    source : str or None
+        The file the value came from, when it came from one.
+    """
+
+    def __init__(
+        self,
+        detail: str,
+        section: str | None = None,
+        key: str | None = None,
+        source: str | None = None,
+    ):
+        self.detail, self.section, self.key, self.source = detail, section, key, source
+        text = f"[{section}] {detail}" if section else detail
+        super().__init__(f"config file {source!r}: {text}" if source else text)
+
+
+def _default(func: Callable, name: str):
+    """The default of ``func``'s argument ``name``: defaults are read, never restated."""
+    return inspect.signature(func).parameters[name].default
+
+
+def _is_number(value) -> bool:
+    return not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
+
+
+def _number(section: str, key: str, value, unit: str, *, positive: bool) -> float:
+    if not _is_number(value) or not math.isfinite(value) or (positive and value <= 0):
+        what = f"a finite number > 0 {unit}" if positive else f"a finite number [{unit}]"
+        raise ScenarioError(f"{key} must be {what}, got {value!r}", section, key)
+    return float(value)
+
+
+def _length(metres: float) -> str:
+    """A road height for a sentence: '10 cm', '1.5 m'."""
+    return f"{metres * 100:.4g} cm" if abs(metres) < 1 else f"{metres:.4g} m"
+
+
+# ---------------------------------------------------------------- roads
+
+
+_ROAD_SECTION = "scenario.road"
+
+
+def _road_field(default, check: str, unit: str, help: str, option: str | None = None):
+    """A road parameter: its default, its check, its unit and its CLI option."""
+    return field(
+        default=default, metadata={"check": check, "unit": unit, "help": help, "option": option}
+    )
+
+
+def _road_value(f, value):
+    """A road parameter's value, checked by its kind of check, or a ScenarioError."""
+    check, unit, key = f.metadata["check"], f.metadata["unit"], f.name
+    if check in ("finite", "positive"):
+        return _number(_ROAD_SECTION, key, value, unit, positive=check == "positive")
+    if check == "class":
+        name = value.strip().upper() if isinstance(value, str) else None
+        if name not in roads.ISO8608_CLASSES:
+            raise ScenarioError(
+                f"unknown ISO 8608 road class {value!r}; expected one of "
+                f"{', '.join(roads.ISO8608_CLASSES)}",
+                _ROAD_SECTION,
+                key,
+            )
+        return name
+    if check == "seed":
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+            raise ScenarioError(
+                f"{key} must be a non-negative integer, got {value!r}", _ROAD_SECTION, key
+            )
+        return int(value)
+    if check == "band":
+        ok = isinstance(value, (list, tuple, np.ndarray)) and len(value) == 2
+        ok = ok and all(_is_number(v) and math.isfinite(v) for v in value)
+        if not ok or not 0 < value[0] < value[1]:
+            raise ScenarioError(
+                f"{key} must be [n_min, n_max] in {unit} with 0 < n_min < n_max, got {value!r}",
+                _ROAD_SECTION,
+                key,
+            )
+        return (float(value[0]), float(value[1]))
+    raise AssertionError(f"unknown check {check!r}")  # pragma: no cover - a bug here
+
+
+#: Help of the parameters that step and bump share.
+_HEIGHT, _T0 = "step or bump height", "time the step or bump starts"
+
+
+@dataclass(frozen=True)
+class Road:
+    """Base of the road specs: the kind of road and all its parameters.
+
+    Each kind is a frozen dataclass whose fields are its parameters, named
+    as the keyword arguments of its function in `qc_control.road`, with
+    that function's defaults. `ROADS` maps each ``kind`` to its class.
+    """
+
+    kind: ClassVar[str] = "none"
+    #: The road in a sentence's words: "a bump road".
+    noun: ClassVar[str] = "no road"
+
+    def __post_init__(self):
+        for f in fields(self):
+            object.__setattr__(self, f.name, _road_value(f, getattr(self, f.name)))
+
+    def params(self) -> dict[str, Any]:
+        """The parameters as a dict, in field order (without ``kind``)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def samples(self, T) -> np.ndarray | None:
+        """The road height zr [m] on the time grid ``T`` [s]; None for no road."""
+        return None
+
+    def describe(self) -> str:
+        """The road in words, from its actual parameters; '' for no road."""
+        return ""
+
+    def largest_step(self) -> float:
+        """The largest time step [s] that samples this road; inf if any step does."""
+        return math.inf
+
+    def sampled(self) -> str:
+        """What `largest_step` samples, in words."""
+        return self.noun
+
+
+@dataclass(frozen=True)
+class NoRoad(Road):
+    """No road input: the free response from ``x0``."""
+
+
+@dataclass(frozen=True)
+class StepRoad(Road):
+    """A road step (a kerb), `qc_control.road.step`."""
+
+    kind: ClassVar[str] = "step"
+    noun: ClassVar[str] = "a step road"
+    height: float = _road_field(_default(roads.step, "height"), "finite", "m", _HEIGHT)
+    t0: float = _road_field(_default(roads.step, "t0"), "finite", "s", _T0)
+
+    def samples(self, T) -> np.ndarray:
+        return roads.step(T, height=self.height, t0=self.t0)
+
+    def describe(self) -> str:
+        return f"a {_length(self.height)} road step at t = {self.t0:g} s"
+
+
+#: One speed default for every road that has a speed: `qc_control.road.iso8608`'s.
+_SPEED = _default(roads.iso8608, "speed")
+
+
+@dataclass(frozen=True)
+class BumpRoad(Road):
+    """A 1 − cos bump, `qc_control.road.bump`.
+
+    Its speed defaults to the ISO 8608 road's (`qc_control.road.iso8608`),
+    so that every road with a speed has the same default; `road.bump`'s own
+    default is not used.
+    """
+
+    kind: ClassVar[str] = "bump"
+    noun: ClassVar[str] = "a bump road"
+    height: float = _road_field(_default(roads.bump, "height"), "finite", "m", _HEIGHT)
+    length: float = _road_field(_default(roads.bump, "length"), "positive", "m", "bump length")
+    speed: float = _road_field(_SPEED, "positive", "m/s", "vehicle speed", "--speed")
+    t0: float = _road_field(_default(roads.bump, "t0"), "finite", "s", _T0)
+
+    def samples(self, T) -> np.ndarray:
+        return roads.bump(T, height=self.height, length=self.length, speed=self.speed, t0=self.t0)
+
+    def describe(self) -> str:
+        return (
+            f"a {_length(self.height)} high, {self.length:g} m long 1 − cos bump "
+            f"met at t = {self.t0:g} s at {self.speed:g} m/s"
+        )
+
+
+@dataclass(frozen=True)
+class SineRoad(Road):
+    """A sinusoidal road ``zr = amplitude · sin(2π f t)``, `qc_control.road.sine`."""
+
+    kind: ClassVar[str] = "sine"
+    noun: ClassVar[str] = "a sine road"
+    amplitude: float = _road_field(
+        _default(roads.sine, "amplitude"), "finite", "m", "sine amplitude"
+    )
+    frequency: float = _road_field(
+        _default(roads.sine, "frequency"), "positive", "Hz", "sine frequency"
+    )
+
+    def samples(self, T) -> np.ndarray:
+        return roads.sine(T, amplitude=self.amplitude, frequency=self.frequency)
+
+    def describe(self) -> str:
+        return f"a sinusoidal road, {_length(self.amplitude)} amplitude at {self.frequency:g} Hz"
+
+
+@dataclass(frozen=True)
+class ISO8608Road(Road):
+    """A random ISO 8608 road driven at ``speed``, `qc_control.road.iso8608`."""
+
+    kind: ClassVar[str] = "iso8608"
+    noun: ClassVar[str] = "an iso8608 road"
+    road_class: str = _road_field(
+        _default(roads.iso8608, "road_class"), "class", "", "ISO 8608 class A-H", "--road-class"
+    )
+    speed: float = _road_field(_SPEED, "positive", "m/s", "vehicle speed", "--speed")
+    seed: int = _road_field(_default(roads.iso8608, "seed"), "seed", "", "road seed", "--seed")
+    band: tuple[float, float] = _road_field(
+        _default(roads.iso8608, "band"), "band", "cycles/m", "ISO 8608 band n_min,n_max"
+    )
+
+    def samples(self, T) -> np.ndarray:
+        return roads.iso8608(T, self.road_class, speed=self.speed, seed=self.seed, band=self.band)
+
+    def describe(self) -> str:
+        lo, hi = self.band
+        return (
+            f"an ISO 8608 class {self.road_class} road at {self.speed:g} m/s "
+            f"(seed {self.seed}, band {lo:g}–{hi:g} cycles/m)"
+        )
+
+    def largest_step(self) -> float:
+        return roads.largest_step(self.speed, self.band)
+
+    def sampled(self) -> str:
+        return (
+            f"an ISO 8608 road at {self.speed:g} m/s, whose band reaches {self.band[1]:g} cycles/m"
+        )
+
+
+#: Every kind of road, by its ``kind``.
+ROADS: dict[str, type[Road]] = {
+    cls.kind: cls for cls in (NoRoad, StepRoad, BumpRoad, SineRoad, ISO8608Road)
+}
+
+
+def road_option(f) -> str:
+    """The ``qc-control report`` option of a road parameter (a field of a `Road`)."""
+    return f.metadata["option"] or "--road-" + f.name.replace("_", "-")
+
+
+def road_from_mapping(values: Mapping[str, Any]) -> Road:
+    """A `Road` from ``{'kind': ..., parameter: value, ...}``.
+
+    A missing ``kind`` means no road. A key that is a parameter of another
+    kind of road is refused, naming the kinds it applies to; any other key
+    is refused as unknown.
+    """
+    values = dict(values)
+    kind = values.pop("kind", "none")
+    if not isinstance(kind, str) or kind.lower() not in ROADS:
+        kinds = [k for k in ROADS if k != NoRoad.kind]
+        raise ScenarioError(
+            f"kind must be one of {', '.join(kinds)} or {NoRoad.kind}, got {kind!r}",
+            _ROAD_SECTION,
+            "kind",
+        )
+    cls = ROADS[kind.lower()]
+    allowed = [f.name for f in fields(cls)]
+    takes = (
+        f"{cls.noun} takes {', '.join(allowed)}"
+        if allowed
+        else "without a road (kind = 'none') no parameter applies; set the road's kind"
+    )
+    for key, value in values.items():
+        if key in allowed:
+            continue
+        users = [k for k, c in ROADS.items() if key in {f.name for f in fields(c)}]
+        if users:
+            where = "without a road" if cls is NoRoad else f"to {cls.noun}"
+            raise ScenarioError(
+                f"{key} = {value!r} does not apply {where}: it is a parameter of "
+                f"{' and '.join(users)} roads; {takes}",
+                _ROAD_SECTION,
+                key,
+            )
+        raise ScenarioError(f"unknown [scenario.road] key {key!r}; {takes}", None, key)
+    return cls(**values)
+
+
+# ------------------------------------------------------------- scenario
+
+
+#: Vehicle parameter types and their state names (the order of ``x0``).
+_STATES = {QuarterCarParams: STATES}
+_X0_UNITS = {QuarterCarParams: "m/s, m/s, m, m"}
+_VEHICLE_KEYS = tuple(f.name for f in fields(QuarterCarParams))
+_RUN_KEYS = ("t_end", "h", "x0", "methods", "max_steps")
+#: The flat road keys of the ``[scenario]`` table of earlier versions.
+_LEGACY_ROAD_KEYS = ("road", "road_class", "speed", "seed")
+
+
+def _vehicle(values) -> QuarterCarParams:
+    """The vehicle from its parameters, with a ScenarioError naming the one at fault."""
+    if isinstance(values, QuarterCarParams):
+        vehicle = values
+    elif isinstance(values, Mapping):
+        try:
+            vehicle = QuarterCarParams.from_mapping(values)
+        except ValueError as exc:
+            raise ScenarioError(str(exc), None, _culprit(values)) from None
+    else:
+        raise ScenarioError(
+            f"vehicle must be a QuarterCarParams or a mapping of its parameters, "
+            f"got {type(values).__name__}",
+            "scenario",
+            "vehicle",
+        )
+    resolved = vehicle.to_dict()
+    for name, value in resolved.items():
+        if not math.isfinite(value):
+            raise ScenarioError(
+                f"{name} = {value!r} overflows: derived from "
+                + ", ".join(f"{k}={v!r}" for k, v in resolved.items() if k != name)
+                + f"; give {name} directly, or smaller values",
+                None,
+                name,
+            )
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # checked next
+        A, b_road, b_act = seed_matrices(*(resolved[k] for k in ("ms", "mu", "ks", "ku", "cs")))
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b_road)) and np.all(np.isfinite(b_act))):
+        raise ScenarioError(
+            "the model's matrices overflow (a ratio such as ks/ms, cs/ms or ku/mu is not "
+            "finite) for " + ", ".join(f"{k}={v!r}" for k, v in resolved.items())
+        )
+    return vehicle
+
+
+def _culprit(values: Mapping) -> str | None:
+    """The first parameter that is bad on its own, if one is."""
+    for key in _VEHICLE_KEYS:
+        if key in values:
+            try:
+                QuarterCarParams(**{key: values[key]})
+            except (TypeError, ValueError):
+                return key
+    return None
+
+
+def _iso_step(limit: float) -> float:
+    """The largest step of the 1-2-5 series (…, 1, 2, 5, 10 ms, …) not above ``limit`` [s]."""
+    e = math.floor(math.log10(limit))
+    for exponent in (e + 1, e, e - 1):
+        for mantissa in (5, 2, 1):
+            step = float(f"{mantissa}e{exponent}")
+            if step <= limit:
+                return step
+    raise AssertionError(f"no 1-2-5 step below {limit!r}")  # pragma: no cover
+
+
+def _sequence(value) -> list | None:
+    """A list from a list, a tuple, an array or a comma-separated string; else None."""
+    if isinstance(value, str):
+        return [v.strip() for v in value.split(",") if v.strip()]
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return list(value)
+    return None
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One method comparison: vehicle, initial state, road, time grid and methods.
+
+    Every value is checked when the scenario is made; a bad one raises
+    `ScenarioError` (a ``ValueError``) naming the field, the value and what
+    was expected. Defaults left as None are resolved then, so a scenario
+    always holds the values it runs with.
+
+    Parameters
+    ----------
+    vehicle : QuarterCarParams or mapping, default the seed's vehicle
+        The vehicle's parameters (other vehicle types will plug in here).
+    road : Road or mapping, default `NoRoad`
+        The road input, with all its parameters: `StepRoad`, `BumpRoad`,
+        `SineRoad` or `ISO8608Road`; a mapping ``{'kind': 'bump', ...}``
+        is read by `road_from_mapping`.
+    x0 : sequence of float, optional
+        Initial state ``[vs, vu, xs, xu]`` [m/s, m/s, m, m]. Default: the car
+        at rest under a road, else `qc_control.compare.DEFAULT_X0` (the body
+        released from 5 cm).
+    t_end : float, default `qc_control.compare.DEFAULT_T_END`
+        End time [s]; a whole number (at least 2) of steps ``h``.
+    h : float, optional
+        Step [s]. Default `qc_control.compare.DEFAULT_H`; where the road
+        needs a finer step (an ISO 8608 road, whose band must be sampled:
+        `qc_control.road.largest_step`), the largest step of the 1-2-5
+        series (…, 10, 5, 2, 1, 0.5 ms, …) not above that limit, e.g. 5 ms
+        at 20 m/s on the standard band (limit 8.8 ms).
+    methods : sequence of str, default `qc_control.compare.DEFAULT_METHODS`
+        Method names (`qc_control.METHODS`), distinct. A comma-separated
+        string is split.
+    max_steps : int, default `MAX_STEPS`
+        The largest ``t_end / h`` accepted: a run beyond it is refused
+        before anything is allocated.
+
+    Examples
+    --------
+    >>> sc = Scenario(road=BumpRoad(height=0.1, speed=15.0))
+    >>> sc.h, sc.x0, sc.steps
+    (0.01, (0.0, 0.0, 0.0, 0.0), 1000)
+    >>> sc.road_input()[1]
+    'a 10 cm high, 1 m long 1 − cos bump met at t = 0.5 s at 15 m/s'
+    >>> Scenario.from_toml_string(sc.to_toml()) == sc
+    True
+    """
+
+    vehicle: QuarterCarParams = field(default_factory=QuarterCarParams)
+    road: Road = field(default_factory=NoRoad)
+    # None resolves to the default in __post_init__: the attribute is always set
+    x0: tuple[float, ...] = None  # type: ignore[assignment]
+    t_end: float = DEFAULT_T_END
+    h: float = None  # type: ignore[assignment]
+    methods: tuple[str, ...] = DEFAULT_METHODS
+    max_steps: int = MAX_STEPS
+
+    def __post_init__(self):
+        put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
+        put("vehicle", _vehicle(self.vehicle))
+        road = self.road
+        if road is None or isinstance(road, str):
+            road = {"kind": road or "none"}
+        if isinstance(road, Mapping):
+            road = road_from_mapping(road)
+        if not isinstance(road, Road):
+            raise ScenarioError(
+                f"road must be a Road (e.g. BumpRoad(height=0.1)) or a table with 'kind', "
+                f"got {road!r}",
+                "scenario",
+                "road",
+            )
+        put("road", road)
+        put("methods", self._methods(self.methods))
+        put("t_end", _number("scenario", "t_end", self.t_end, "s", positive=True))
+        limit = road.largest_step()
+        chosen = self.h is None
+        if chosen:
+            put("h", DEFAULT_H if DEFAULT_H <= limit else _iso_step(limit))
+        else:
+            put("h", _number("scenario", "h", self.h, "s", positive=True))
+        m = self.max_steps
+        if isinstance(m, bool) or not isinstance(m, (int, np.integer)) or m < 2:
+            raise ScenarioError(
+                f"max_steps must be an integer >= 2, got {m!r}", "scenario", "max_steps"
+            )
+        put("max_steps", int(m))
+        self._check_grid(chosen)
+        if self.h > limit * (1 + 1e-12):
+            raise ScenarioError(
+                f"h = {self.h!r} s is too coarse for {road.sampled()}: it must be <= "
+                f"{limit:.4g} s (give a smaller h, or narrow the band)",
+                "scenario",
+                "h",
+            )
+        put("x0", self._x0(self.x0))
+
+    def _methods(self, methods) -> tuple[str, ...]:
+        names = _sequence(methods)
+        if names is None or not all(isinstance(m, str) for m in names):
+            raise ScenarioError(
+                f"methods must be a list of method names, got {methods!r}", "scenario", "methods"
+            )
+        if not names:
+            raise ScenarioError("methods must name at least one method", "scenario", "methods")
+        unknown = [m for m in names if m.lower() not in METHODS]
+        if unknown:
+            raise ScenarioError(
+                f"methods: unknown method {unknown[0]!r}; known methods are {', '.join(METHODS)}",
+                "scenario",
+                "methods",
+            )
+        canonical = tuple(get_method(m).name for m in names)
+        if len(set(canonical)) != len(canonical):
+            raise ScenarioError(
+                f"methods must be distinct, got {list(names)!r}", "scenario", "methods"
+            )
+        return canonical
+
+    def _check_grid(self, chosen: bool) -> None:
+        t_end, h, limit = self.t_end, self.h, self.max_steps
+        ratio = t_end / h
+        if not ratio <= limit + 0.5:
+            count = f"{ratio:.3g}" if math.isfinite(ratio) else "more than 1.8e308"
+            raise ScenarioError(
+                f"t_end = {t_end:g} s at h = {h:g} s is {count} steps per method (and more "
+                f"for the refinements h/2, h/4, ...), above max_steps = {limit:,}; raise "
+                f"max_steps (--max-steps) only if the machine can hold such a run",
+                "scenario",
+                "t_end",
+            )
+        steps = round(ratio)
+        if steps < 2 or abs(steps * h - t_end) > 1e-9 * t_end:
+            raise ScenarioError(
+                f"t_end = {t_end!r} s must be a whole number (at least 2) of steps "
+                f"h = {h!r} s, got {ratio:.6g} steps"
+                + (" (the default step; give h to choose another)" if chosen else ""),
+                "scenario",
+                "t_end",
+            )
+
+    def _x0(self, x0) -> tuple[float, ...]:
+        names = _STATES[type(self.vehicle)]
+        if x0 is None:
+            return (
+                tuple(float(v) for v in DEFAULT_X0)
+                if isinstance(self.road, NoRoad)
+                else ((0.0,) * len(names))
+            )
+        values = _sequence(x0)
+        if values is not None and all(isinstance(v, str) for v in values):
+            try:
+                values = [float(v) for v in values]
+            except ValueError:
+                values = None
+        if (
+            values is None
+            or len(values) != len(names)
+            or not all(_is_number(v) and math.isfinite(v) for v in values)
+        ):
+            raise ScenarioError(
+                f"x0 must be {len(names)} comma-separated numbers, all finite: "
+                f"{', '.join(names)} [{_X0_UNITS[type(self.vehicle)]}]; got {x0!r}",
+                "scenario",
+                "x0",
+            )
+        return tuple(float(v) for v in values)
+
+    # ------------------------------------------------------------ running
+
+    @property
+    def steps(self) -> int:
+        """The number of steps ``t_end / h`` of the grid."""
+        return round(self.t_end / self.h)
+
+    def time_grid(self) -> np.ndarray:
+        """The uniform output grid ``0, h, ..., t_end`` [s] (``steps + 1`` points)."""
+        return np.linspace(0.0, self.t_end, self.steps + 1)
+
+    def road_input(self, T=None) -> tuple[np.ndarray | None, str]:
+        """``(zr samples on T, description)``; ``(None, '')`` without a road.
+
+        The description is written from the road's actual parameters.
+        ``T`` defaults to `time_grid`.
+        """
+        T = self.time_grid() if T is None else T
+        return self.road.samples(T), self.road.describe()
+
+    def run(self, progress: Callable[[str], None] | None = None) -> MethodComparison:
+        """Run the comparison: `qc_control.compare_methods` on this scenario.
+
+        Returns its `MethodComparison`, with ``cmp.scenario`` set to this
+        scenario (the report records it and its `command`).
+        """
+        T = self.time_grid()
+        U, description = self.road_input(T)
+        cmp = compare_methods(
+            self.vehicle,
+            T,
+            np.asarray(self.x0),
+            U=U,
+            methods=self.methods,
+            progress=progress,
+            input_description=description,
+        )
+        cmp.scenario = self  # type: ignore[attr-defined]  # until MethodComparison has the field
+        return cmp
+
+    # ------------------------------------------------------ reading, writing
+
+    @classmethod
+    def from_mapping(
+        cls,
+        values: Mapping[str, Any],
+        *,
+        overrides: Mapping[str, Any] | None = None,
+        source: str | None = None,
+    ) -> Scenario:
+        """A scenario from a TOML-shaped mapping (see the module's layout).
+
+        Parameters
+        ----------
+        values : mapping
+            Vehicle parameters at the top level, a ``'scenario'`` table with
+            the run's keys and a ``'road'`` table (``[scenario.road]``), or the
+            earlier flat road keys.
+        overrides : mapping, optional
+            The same layout, applied over ``values`` (the command-line options
+            over a config file). Damping given here (``zeta`` or ``cs``)
+            replaces both of ``values``'; a road of another ``kind`` replaces
+            ``values``' road, a road of the same kind (or none given) updates it.
+        source : str, optional
+            Where ``values`` came from: errors in values not overridden
+            name it.
+
+        Raises
+        ------
+        ScenarioError
+            For an unknown key, a key that does not apply (a road parameter
+            of another kind of road), or a bad value.
+        """
+        over = _canonical(overrides or {})
+        try:
+            base = _canonical(values)
+        except ScenarioError as exc:
+            raise ScenarioError(exc.detail, exc.section, exc.key, source) from None
+        vehicle = dict(base["vehicle"])
+        if {"zeta", "cs"} & set(over["vehicle"]):
+            vehicle.pop("zeta", None)
+            vehicle.pop("cs", None)
+        vehicle.update(over["vehicle"])
+        run = {**base["run"], **over["run"]}
+        road = base["road"]
+        if "kind" in over["road"] and over["road"]["kind"] != road.get("kind", "none"):
+            road = dict(over["road"])
+        else:
+            road = {**road, **over["road"]}
+        given = {None: over["vehicle"], "scenario": over["run"], _ROAD_SECTION: over["road"]}
+        try:
+            return cls(vehicle=cast(Any, vehicle), road=cast(Any, road), **run)
+        except ScenarioError as exc:
+            from_overrides = exc.key is not None and exc.key in given.get(exc.section, {})
+            section = exc.section
+            if section == _ROAD_SECTION and not from_overrides:
+                section = base["road_section"]
+            raise ScenarioError(
+                exc.detail, section, exc.key, None if from_overrides else source
+            ) from None
+
+    @classmethod
+    def from_toml(cls, path, *, overrides: Mapping[str, Any] | None = None) -> Scenario:
+        """Read a scenario from a TOML file; errors name the file.
+
+        ``overrides`` as in `from_mapping`.
+        """
+        path = str(path)
+        try:
+            with open(path, "rb") as fh:
+                data = fh.read()
+        except OSError as exc:
+            raise ScenarioError(f"config file {path!r} cannot be read: {exc.strerror}") from None
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise ScenarioError(
+                f"config file {path!r} is not a TOML text file (not UTF-8: byte "
+                f"{data[exc.start]:#04x} at position {exc.start})"
+            ) from None
+        return cls.from_toml_string(text, overrides=overrides, source=path)
+
+    @classmethod
+    def from_toml_string(
+        cls, text: str, *, overrides: Mapping[str, Any] | None = None, source: str | None = None
+    ) -> Scenario:
+        """A scenario from TOML text, e.g. `to_toml`'s."""
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            where = f"config file {source!r}" if source else "the scenario"
+            raise ScenarioError(f"{where} is not valid TOML: {exc}") from None
+        return cls.from_mapping(data, overrides=overrides, source=source)
+
+    def to_toml(self) -> str:
+        """The scenario as TOML, in the layout `from_toml` reads.
+
+        Floats are written with ``repr``, so they read back bit for bit:
+        ``Scenario.from_toml_string(s.to_toml()) == s``. Both ``zeta`` and
+        ``cs`` are written (they agree), so the damping is exact.
+        """
+        lines = [
+            "# A qc-control scenario (qc_control.Scenario): one comparison run.",
+            "# Redo it with: qc-control report --config <this file>",
+            "# Floats are written exactly (repr). zeta and cs are both given, and agree;",
+            "# to change the damping, keep only one of them.",
+            "",
+            *(f"{k} = {_toml_value(v)}" for k, v in self.vehicle.to_dict().items()),
+            "",
+            "[scenario]",
+            f"t_end = {_toml_value(self.t_end)}",
+            f"h = {_toml_value(self.h)}",
+            f"x0 = {_toml_value(self.x0)}",
+            f"methods = {_toml_value(self.methods)}",
+        ]
+        if self.max_steps != MAX_STEPS:
+            lines.append(f"max_steps = {self.max_steps}")
+        if not isinstance(self.road, NoRoad):
+            lines += ["", f"[{_ROAD_SECTION}]", f"kind = {_toml_value(self.road.kind)}"]
+            lines += [f"{k} = {_toml_value(v)}" for k, v in self.road.params().items()]
+        return "\n".join(lines) + "\n"
+
+    def command(self, *, out=None, config=None) -> str:
+        """The ``qc-control report`` command that redoes this run exactly.
+
+        Parameters
+        ----------
+        out : path, optional
+            Add ``--out out``; by default the command writes ``report/``.
+        config : path, optional
+            Read the scenario from this TOML file (`to_toml`'s) instead of
+            giving every value as an option.
+
+        Every value is written with ``repr``, so the command gives the same
+        numbers; defaults are written out, so it does not depend on them.
+        """
+        args = ["qc-control", "report"]
+        if config is not None:
+            args += ["--config", str(config)]
+        else:
+            for name, value in self.vehicle.to_dict().items():
+                args += _option(f"--{name}", repr(value))
+            args += _option("--t-end", repr(self.t_end))
+            args += _option("--h", repr(self.h))
+            args += _option("--x0", ",".join(map(repr, self.x0)))
+            args += _option("--methods", ",".join(self.methods))
+            if self.max_steps != MAX_STEPS:
+                args += _option("--max-steps", str(self.max_steps))
+            if not isinstance(self.road, NoRoad):
+                args += _option("--road", self.road.kind)
+                for f in fields(self.road):
+                    value = getattr(self.road, f.name)
+                    text = (
+                        ",".join(map(repr, value))
+                        if isinstance(value, tuple)
+                        else value
+                        if isinstance(value, str)
+                        else repr(value)
+                    )
+                    args += _option(road_option(f), text)
+        if out is not None:
+            args += _option("--out", str(out))
+        return shlex.join(args)
+
+
+def _option(name: str, value: str) -> list[str]:
+    """``[--name, value]``, or ``[--name=value]`` for a value argparse would take for an option."""
+    return [f"{name}={value}"] if value.startswith("-") else [name, value]
+
+
+def _toml_value(value) -> str:
+    """A TOML value: floats by repr (exact), strings as JSON (a TOML basic string)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, (tuple, list)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"cannot write {value!r} as TOML")  # pragma: no cover - a bug here
+
+
+def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
+    """``{'vehicle', 'run', 'road', 'road_section'}`` from any supported layout."""
+    if not isinstance(doc, Mapping):
+        raise ScenarioError(f"a scenario must be a table (a mapping), got {doc!r}")
+    vehicle, table = {}, {}
+    for key, value in doc.items():
+        if key in _VEHICLE_KEYS:
+            vehicle[key] = value
+        elif key == "scenario":
+            if not isinstance(value, Mapping):
+                raise ScenarioError(f"'scenario' must be a table, got {value!r}", None, key)
+            table = dict(value)
+        else:
+            hint = " (put the road in a [scenario.road] table)" if key == "road" else ""
+            raise ScenarioError(
+                f"unknown key {key!r}{hint}; expected the vehicle's parameters "
+                f"{', '.join(_VEHICLE_KEYS)} and a [scenario] table",
+                None,
+                key,
+            )
+    road, section = table.pop("road", None), _ROAD_SECTION
+    legacy = {k: table.pop(k) for k in _LEGACY_ROAD_KEYS[1:] if k in table}
+    unknown = sorted(set(table) - set(_RUN_KEYS))
+    if unknown:
+        raise ScenarioError(
+            f"unknown [scenario] key {unknown[0]!r}; expected {', '.join(_RUN_KEYS)} and a "
+            f"road (a [scenario.road] table with kind and its parameters)",
+            None,
+            unknown[0],
+        )
+    if isinstance(road, Mapping):
+        if legacy:
+            key = next(iter(legacy))
+            raise ScenarioError(
+                f"{key} beside a [scenario.road] table: put it in the table", "scenario", key
+            )
+        road = dict(road)
+    elif road is None or isinstance(road, str):  # the flat layout of earlier versions
+        road = {**({"kind": road} if road is not None else {}), **legacy}
+        section = "scenario"
+    else:
+        raise ScenarioError(
+            f'road must be a [scenario.road] table (or a kind such as "bump"), got {road!r}',
+            "scenario",
+            "road",
+        )
+    return {"vehicle": vehicle, "run": table, "road": road, "road_section": section}
