@@ -54,6 +54,9 @@ __all__ = [
 STATES = ("vs", "vu", "xs", "xu")
 #: Output names, in order.
 OUTPUTS = ("xs", "xu", "susp_travel", "tire_defl", "body_acc")
+#: The largest ratio of the fastest to the slowest of a vehicle's rates
+#: (sqrt(k/m), c/m) that `QuarterCarParams` accepts; see its validation.
+MAX_RATE_SPAN = 1e7
 #: The seed's initial state: the body released from 5 cm, at rest [m/s, m/s, m, m].
 SEED_X0 = (0.0, 0.0, 0.05, 0.0)
 #: The SI unit of every signal of the quarter car.
@@ -183,6 +186,28 @@ class QuarterCarParams:
                     f"{what} overflows to {value!r} for ms={self.ms!r}, mu={self.mu!r}, "
                     f"ks={self.ks!r}, ku={self.ku!r}: the model's matrix would not be finite"
                 )
+        # The model's rates [1/s]: its eigenvalues lie among them. A's entries are
+        # rates and squared rates, so eigenvalues come out of double precision with a
+        # relative error of about eps·(fastest/slowest)²: beyond MAX_RATE_SPAN the
+        # slow mode loses its digits, and a fixed step resolving the fast one would
+        # need more steps than any run can take.
+        rates = {
+            "sqrt(ks/ms)": math.sqrt(ratios["ks/ms"]),
+            "sqrt(ks/mu)": math.sqrt(ratios["ks/mu"]),
+            "sqrt(ku/mu)": math.sqrt(ratios["ku/mu"]),
+            "cs/ms": ratios["cs/ms"],
+            "cs/mu": ratios["cs/mu"],
+        }
+        # light damping is harmless (a slow decay), so the slowest is a stiffness rate
+        fast = max(rates, key=rates.__getitem__)
+        slow = min(list(rates)[:3], key=rates.__getitem__)
+        if rates[fast] > MAX_RATE_SPAN * rates[slow]:
+            raise ValueError(
+                f"the vehicle's time scales span more than {MAX_RATE_SPAN:.0e}: {fast} = "
+                f"{rates[fast]:.3g} 1/s against {slow} = {rates[slow]:.3g} 1/s (ms="
+                f"{self.ms!r}, mu={self.mu!r}, ks={self.ks!r}, ku={self.ku!r}, "
+                f"cs={self.cs:.6g}); its modes cannot be resolved in double precision"
+            )
 
     @property
     def system(self) -> control.StateSpace:

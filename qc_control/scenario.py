@@ -52,7 +52,7 @@ from .compare import (
     compare_methods,
 )
 from .methods import METHODS, get_method
-from .model import STATES, QuarterCarParams, seed_matrices
+from .model import STATES, QuarterCarParams
 
 try:  # Python >= 3.11
     import tomllib
@@ -402,23 +402,6 @@ def _vehicle(values) -> QuarterCarParams:
             "scenario",
             "vehicle",
         )
-    resolved = vehicle.to_dict()
-    for name, value in resolved.items():
-        if not math.isfinite(value):
-            raise ScenarioError(
-                f"{name} = {value!r} overflows: derived from "
-                + ", ".join(f"{k}={v!r}" for k, v in resolved.items() if k != name)
-                + f"; give {name} directly, or smaller values",
-                None,
-                name,
-            )
-    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # checked next
-        A, b_road, b_act = seed_matrices(*(resolved[k] for k in ("ms", "mu", "ks", "ku", "cs")))
-    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b_road)) and np.all(np.isfinite(b_act))):
-        raise ScenarioError(
-            "the model's matrices overflow (a ratio such as ks/ms, cs/ms or ku/mu is not "
-            "finite) for " + ", ".join(f"{k}={v!r}" for k, v in resolved.items())
-        )
     return vehicle
 
 
@@ -657,7 +640,7 @@ class Scenario:
             progress=progress,
             input_description=description,
         )
-        cmp.scenario = self  # type: ignore[attr-defined]  # until MethodComparison has the field
+        cmp.scenario = self
         return cmp
 
     # ------------------------------------------------------ reading, writing
