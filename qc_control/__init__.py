@@ -1,40 +1,179 @@
 """qc_control: quarter-car suspension models on python-control.
 
-The quarter car of the seed paper as a `control.StateSpace`, its modal
-analysis, the seed's four fixed-step methods (Euler, Midpoint, Heun, RK4)
-as python-control-compatible responses measured against the exact response,
-fast LTI and sweep engines, ISO 8608 roads and ISO 2631-1 ride metrics.
+Quickstart
+----------
+The quarter car of the seed paper (Table 1) is a `control.StateSpace`:
+
+>>> import control
+>>> import numpy as np
+>>> import qc_control as qc
+>>> params = qc.QuarterCarParams()
+>>> sys = qc.quarter_car(params)
+>>> sys.state_labels
+['vs', 'vu', 'xs', 'xu']
+
+Its modal analysis names the two modes by their shape:
+
+>>> modes = qc.modal_analysis(sys)
+>>> [(mode.name, round(mode.fn, 3), round(mode.zeta, 4)) for mode in modes.modes]
+[('body bounce', 1.087, 0.0677), ('wheel hop', 3.997, 0.3802)]
+
+Each of the seed's four fixed-step methods gives a response shaped like
+`control.initial_response`'s, here against that exact response (body
+released from 5 cm, 0-10 s, h = 0.01 s):
+
+>>> T = np.linspace(0, 10, 1001)
+>>> X0 = [0.0, 0.0, 0.05, 0.0]
+>>> exact = control.initial_response(sys, T, X0)
+>>> xs = list(sys.output_labels).index("xs")
+>>> for method in ["euler", "midpoint", "heun", "rk4"]:
+...     resp = qc.initial_response(sys, T, X0, method=method)
+...     error = np.max(np.abs(resp.outputs[xs] - exact.outputs[xs]))
+...     print(f"{method:9s}{error:.2e} m")
+euler    1.14e-02 m
+midpoint 1.92e-04 m
+heun     1.92e-04 m
+rk4      2.28e-07 m
+
+`compare_methods` computes every number of the comparison once (errors,
+observed orders, cost, stability limits, numerical modes), and
+`write_report` turns it into the report (Markdown, HTML, CSV and figures):
+
+>>> comparison = qc.compare_methods(params, repeats=1)
+>>> comparison.table["observed order"].round(1).to_dict()
+{'euler': 1.2, 'midpoint': 2.0, 'heun': 2.0, 'rk4': 4.0}
+>>> qc.write_report(comparison, "report")  # doctest: +SKIP
+
+Beyond the seed: ISO 8608 roads (`qc_control.road`), ISO 2631-1 ride
+metrics (`ride_metrics`, `transmissibility`), the LTI engine behind the
+responses, and sweeps over thousands of designs (`sweep`). The command
+``qc-control report`` writes the same report from the shell.
+
+Names are loaded from their modules on first use, so ``import qc_control``
+stays light: it imports neither python-control nor matplotlib until a name
+that needs them is used.
 """
 
-from . import road
-from .compare import MethodComparison, compare_methods
-from .integrate import DivergenceWarning, Solution, integrate
-from .methods import METHODS, ButcherTableau, get_method
-from .metrics import Metric, RideSignals
-from .modal import ModalAnalysis, Mode, modal_analysis
-from .model import (
-    OUTPUTS,
-    STATES,
-    QuarterCarParams,
-    load_config,
-    quarter_car,
-    quarter_car_model,
-    read_config,
-)
-from .response import FixedStepResponse, forced_response, initial_response
-from .ride import (
-    Transmissibility,
-    ride_metrics,
-    ride_metrics_spectral,
-    transmissibility,
-    wk_filter,
-    wk_weighted,
-)
-from .stability import max_stable_step, numerical_modes, stability_function
-from .sweeps import DEFAULT_METRICS, METRICS, SweepChunk, SweepResult, design_grid, sweep
-from .vehicle import Corner, SignalRoles, VehicleModel
+from __future__ import annotations
 
-__version__ = "0.1.0"
+import importlib
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _distribution_version
+from typing import TYPE_CHECKING, Any
+
+# The function shares its name with its module. Importing the submodule
+# qc_control.integrate (which the responses and sweeps do) binds the package
+# attribute ``integrate`` to the module, so the function is bound here,
+# eagerly; the module needs only numpy.
+from .integrate import integrate
+
+try:
+    # The version is written once, in pyproject.toml; this reads it back
+    # from the installed distribution's metadata.
+    __version__: str = _distribution_version("qc-control")
+except PackageNotFoundError:  # pragma: no cover - a source tree that was never installed
+    __version__ = "0+unknown"
+
+if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
+    from . import road
+    from .compare import MethodComparison, compare_methods
+    from .integrate import DivergenceWarning, Solution
+    from .methods import METHODS, ButcherTableau, get_method
+    from .metrics import Metric, RideSignals
+    from .modal import ModalAnalysis, Mode, modal_analysis
+    from .model import (
+        OUTPUTS,
+        STATES,
+        QuarterCarParams,
+        load_config,
+        quarter_car,
+        quarter_car_model,
+        read_config,
+    )
+    from .report import write_report
+    from .response import FixedStepResponse, forced_response, initial_response
+    from .ride import (
+        Transmissibility,
+        ride_metrics,
+        ride_metrics_spectral,
+        transmissibility,
+        wk_filter,
+        wk_weighted,
+    )
+    from .scenario import Scenario, ScenarioError
+    from .stability import max_stable_step, numerical_modes, stability_function
+    from .sweeps import DEFAULT_METRICS, METRICS, SweepChunk, SweepResult, design_grid, sweep
+    from .vehicle import Corner, SignalRoles, VehicleModel
+
+#: Public name -> the submodule that defines it (``"road"`` is a submodule).
+#: tests/test_tooling.py checks that this map, the TYPE_CHECKING imports above
+#: and ``__all__`` name the same things.
+_LAZY: dict[str, str] = {
+    "road": "road",
+    "MethodComparison": "compare",
+    "compare_methods": "compare",
+    "DivergenceWarning": "integrate",
+    "Solution": "integrate",
+    "METHODS": "methods",
+    "ButcherTableau": "methods",
+    "get_method": "methods",
+    "ModalAnalysis": "modal",
+    "Mode": "modal",
+    "modal_analysis": "modal",
+    "OUTPUTS": "model",
+    "STATES": "model",
+    "QuarterCarParams": "model",
+    "load_config": "model",
+    "quarter_car": "model",
+    "read_config": "model",
+    "quarter_car_model": "model",
+    "Metric": "metrics",
+    "RideSignals": "metrics",
+    "write_report": "report",
+    "Scenario": "scenario",
+    "ScenarioError": "scenario",
+    "Corner": "vehicle",
+    "SignalRoles": "vehicle",
+    "VehicleModel": "vehicle",
+    "FixedStepResponse": "response",
+    "forced_response": "response",
+    "initial_response": "response",
+    "Transmissibility": "ride",
+    "ride_metrics": "ride",
+    "ride_metrics_spectral": "ride",
+    "transmissibility": "ride",
+    "wk_filter": "ride",
+    "wk_weighted": "ride",
+    "max_stable_step": "stability",
+    "numerical_modes": "stability",
+    "stability_function": "stability",
+    "DEFAULT_METRICS": "sweeps",
+    "METRICS": "sweeps",
+    "SweepChunk": "sweeps",
+    "SweepResult": "sweeps",
+    "design_grid": "sweeps",
+    "sweep": "sweeps",
+}
+
+
+if not TYPE_CHECKING:  # hidden from type checkers, so a misspelt name stays an error
+
+    def __getattr__(name: str) -> Any:
+        """Import a public name from its module on first use (PEP 562)."""
+        try:
+            module_name = _LAZY[name]
+        except KeyError:
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+        module = importlib.import_module(f"{__name__}.{module_name}")
+        value = module if name == module_name else getattr(module, name)
+        globals()[name] = value  # later lookups find it without this hook
+        return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
 __all__ = [
     "QuarterCarParams",
     "quarter_car",
@@ -45,6 +184,8 @@ __all__ = [
     "Metric",
     "RideSignals",
     "write_report",
+    "Scenario",
+    "ScenarioError",
     "load_config",
     "read_config",
     "STATES",
@@ -80,12 +221,3 @@ __all__ = [
     "wk_filter",
     "wk_weighted",
 ]
-
-
-def __getattr__(name: str):
-    # the report needs matplotlib: load it only when asked for
-    if name == "write_report":
-        from .report import write_report
-
-        return write_report
-    raise AttributeError(f"module 'qc_control' has no attribute {name!r}")

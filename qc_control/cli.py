@@ -3,7 +3,8 @@
 Exit status: 0 on success; 2 with one line on stderr for bad input (a bad
 option or config value, an unusable ``--out``); 130 with one line on Ctrl-C;
 1 with the traceback and a request to report it for anything else, which is
-a bug in qc-control and is never passed off as a usage error.
+a bug in qc-control and is never passed off as a usage error. The last two
+are `qc_control.console`'s, the entry point that imports this module.
 """
 
 from __future__ import annotations
@@ -11,12 +12,20 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import traceback
 from collections.abc import Callable
+from dataclasses import fields
+from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
-__all__ = ["main", "build_parser", "scenario_from_args"]
+import pandas as pd
+
+from .modal import modal_analysis
+from .model import QuarterCarParams
+from .report import MARKER, ReportError, write_report
+from .scenario import ROADS, Scenario, ScenarioError, road_option
+
+__all__ = ["run", "build_parser", "scenario_from_args", "UsageError"]
 
 _PROG = "qc-control"
 #: The run's options of ``report``, as fields of `qc_control.Scenario`.
@@ -43,9 +52,6 @@ def _floats(text: str) -> list[float]:
 
 
 def _add_vehicle(parser: argparse.ArgumentParser) -> None:
-    from dataclasses import fields
-
-    from .model import QuarterCarParams
 
     group = parser.add_argument_group("vehicle (SI units; defaults: the seed's Table 1)")
     for f in fields(QuarterCarParams):
@@ -62,9 +68,6 @@ def _add_vehicle(parser: argparse.ArgumentParser) -> None:
 
 def _add_road(parser: argparse.ArgumentParser) -> None:
     """One option per road parameter, read from the road kinds' fields."""
-    from dataclasses import fields
-
-    from .scenario import ROADS, road_option
 
     group = parser.add_argument_group(
         "road input (default: none, the free response from --x0)",
@@ -104,10 +107,6 @@ def _add_road(parser: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``qc-control``."""
-    import control
-
-    from . import __version__
-
     parser = _Parser(
         prog=_PROG,
         description="Quarter-car suspension tools on python-control.",
@@ -116,7 +115,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--version",
         action="version",
-        version=f"{_PROG} {__version__} (python-control {control.__version__})",
+        version=f"{_PROG} {version('qc-control')} (python-control {version('control')})",
     )
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     modes = sub.add_parser(
@@ -172,11 +171,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def scenario_from_args(args: argparse.Namespace):
     """The `qc_control.Scenario` of parsed arguments: ``--config``, then the options over it."""
-    from dataclasses import fields
-
-    from .model import QuarterCarParams
-    from .scenario import ROADS, Scenario, ScenarioError
-
     doc: dict = {
         f.name: getattr(args, f.name)
         for f in fields(QuarterCarParams)
@@ -203,9 +197,6 @@ def scenario_from_args(args: argparse.Namespace):
 
 def _in_options(exc, doc: dict) -> str:
     """The error in the words of the command line: '--h must be ...' for a bad --h."""
-    from dataclasses import fields
-
-    from .scenario import ROADS, road_option
 
     key, section = exc.key, exc.section
     run = doc.get("scenario", {})
@@ -230,7 +221,6 @@ def _in_options(exc, doc: dict) -> str:
 
 
 def _cmd_modes(args) -> int:
-    from .modal import modal_analysis
 
     print(modal_analysis(scenario_from_args(args).vehicle))
     return 0
@@ -243,7 +233,6 @@ def _check_out(out: str) -> Path:
     rule), or not exist yet; the directory that will hold it (the nearest
     existing ancestor) must be a directory this user can write in.
     """
-    from .report import MARKER
 
     path = Path(os.path.abspath(out))
     writable = lambda d: os.access(d, os.W_OK | os.X_OK)  # noqa: E731
@@ -279,10 +268,6 @@ def _cmd_report(args) -> int:
     scenario = scenario_from_args(args)
     out = _check_out(args.out)  # before the work, not after it
 
-    import pandas as pd
-
-    from .report import ReportError, write_report
-
     say = (lambda message: None) if args.quiet else _progress
     road = scenario.road.describe()
     say(
@@ -317,28 +302,13 @@ def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split())
 
 
-def main(argv=None) -> int:
-    """Entry point of ``qc-control``; returns the exit status."""
-    try:
-        return _main(sys.argv[1:] if argv is None else list(argv))
-    except KeyboardInterrupt:
-        print(f"{_PROG}: interrupted", file=sys.stderr)
-        return 130
-    except Exception:
-        traceback.print_exc()
-        print(
-            f"{_PROG}: internal error: this is a bug in qc-control, not a problem with your "
-            "input; please report it with the traceback above",
-            file=sys.stderr,
-        )
-        return 1
+def run(argv: list[str]) -> int:
+    """Run ``qc-control`` with the arguments ``argv``; returns the exit status.
 
-
-def _main(argv: list[str]) -> int:
-    # The library is imported here, inside main's handlers, so that Ctrl-C during the
-    # imports is one line too.
-    from .scenario import ScenarioError
-
+    Bad input (a `UsageError` or `ScenarioError`) is one line on stderr and
+    status 2. The entry point, `qc_control.console.main`, handles Ctrl-C and
+    internal errors around this call and around importing this module.
+    """
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -351,4 +321,6 @@ def _main(argv: list[str]) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
+    from .console import main
+
     sys.exit(main())

@@ -21,6 +21,9 @@ valid_params = st.builds(
     zeta=st.floats(0.01, 2.0),
 )
 
+#: Doctests that run a whole comparison, by node id (a docstring can't carry a marker).
+SLOW_DOCTESTS = {"qc_control/__init__.py::qc_control"}  # the quickstart: about 3 s
+
 
 @pytest.fixture
 def seed_params():
@@ -37,3 +40,9 @@ def _close_figures():
 
 def pytest_configure(config):
     os.environ.setdefault("MPLBACKEND", "Agg")
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.nodeid in SLOW_DOCTESTS:
+            item.add_marker(pytest.mark.slow)

@@ -1,14 +1,48 @@
-"""The benchmark script runs (smoke mode only: speed is never a test)."""
+"""The benchmark script runs (smoke mode only: speed is never a test), and
+what it writes is checked: every section, ratios that are numbers, and the
+accuracy columns against values computed here."""
 
+import math
+import re
 import subprocess
 import sys
 from pathlib import Path
 
+import control
+import numpy as np
+import pytest
+
+import qc_control as qc
+
 SCRIPT = Path(__file__).parent.parent / "benchmarks" / "run.py"
 
+pytestmark = pytest.mark.slow  # the quick benchmark run takes about 8 s
 
-def test_benchmarks_quick_smoke(tmp_path):
-    out = tmp_path / "RESULTS.md"
+
+def _cells(line: str) -> list[str]:
+    """A Markdown table row's cells; ``\\|`` is a pipe inside a cell."""
+    cells = re.split(r"(?<!\\)\|", line.strip())[1:-1]
+    return [cell.strip().replace("\\|", "|") for cell in cells]
+
+
+def _table(text: str, column: str) -> list[dict[str, str]]:
+    """The rows of the Markdown table whose header has ``column``."""
+    lines = text.splitlines()
+    for i, line in enumerate(lines):
+        cells = _cells(line) if line.startswith("|") else []
+        if column in cells:
+            rows = []
+            for row in lines[i + 2 :]:  # skip the |---| line
+                if not row.startswith("|"):
+                    break
+                rows.append(dict(zip(cells, _cells(row))))
+            return rows
+    raise AssertionError(f"no table with a {column!r} column in RESULTS.md")
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    out = tmp_path_factory.mktemp("bench") / "RESULTS.md"
     run = subprocess.run(
         [sys.executable, str(SCRIPT), "--quick", "--out", str(out)],
         capture_output=True,
@@ -16,7 +50,10 @@ def test_benchmarks_quick_smoke(tmp_path):
         timeout=600,
     )
     assert run.returncode == 0, run.stderr
-    text = out.read_text()
+    return out.read_text(encoding="utf-8")
+
+
+def test_benchmarks_quick_smoke(results):
     for section in (
         "## Problem",
         "## Reference",
@@ -25,5 +62,39 @@ def test_benchmarks_quick_smoke(tmp_path):
         "## Conclusion",
         "## Versions and command",
     ):
-        assert section in text
-    assert "× control.initial_response" in text and "ratio (target ≥ 100)" in text
+        assert section in results
+    assert "× control.initial_response" in results and "ratio (target ≥ 100)" in results
+
+
+def test_ratios_are_numbers(results):
+    """Each ratio cell parses as a positive finite number (its size is the
+    benchmark's business, never a test's)."""
+    rows = _table(results, "× control.initial_response")
+    assert {row["method"] for row in rows} >= {"euler", "midpoint", "heun", "rk4"}
+    sweep = _table(results, "ratio (target ≥ 100)")
+    assert sweep
+    ratios = [float(row["× control.initial_response"]) for row in rows]
+    ratios += [float(row["ratio (target ≥ 100)"]) for row in sweep]
+    assert all(math.isfinite(r) and r > 0 for r in ratios), ratios
+
+
+def test_accuracy_columns_match_an_independent_run(results):
+    """Accuracy, unlike speed, is deterministic: RK4's error at h = 10 ms
+    in the work-precision table equals the one computed here from
+    python-control's exact response, and the LTI engine equals the
+    step-by-step stepper to the 1e-12 its docstring promises."""
+    sys_ = qc.quarter_car(qc.QuarterCarParams())
+    T = np.linspace(0, 10, 1001)
+    X0 = [0.0, 0.0, 0.05, 0.0]
+    xs = list(sys_.output_labels).index("xs")
+    exact = control.initial_response(sys_, T, X0).outputs[xs]
+    rk4 = qc.initial_response(sys_, T, X0, method="rk4").outputs[xs]
+    expected = np.max(np.abs(rk4 - exact))
+
+    rows = _table(results, "max |xs error| [m]")
+    (row,) = [r for r in rows if r["method"] == "rk4" and r["setting"] == "h = 10 ms"]
+    # The table prints three significant figures: half a unit in the third.
+    assert float(row["max |xs error| [m]"]) == pytest.approx(expected, rel=5e-3)
+
+    for row in _table(results, "LTI vs generic (rel.)"):
+        assert float(row["LTI vs generic (rel.)"]) < 1e-12, row

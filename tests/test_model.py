@@ -158,6 +158,7 @@ def test_static_gain_road_to_body_is_one():
     assert abs(gain[4, 0]) < 1e-12
 
 
+@pytest.mark.slow  # control.bode_plot draws a figure: 1.3-3.9 s measured
 def test_works_with_python_control_functions():
     sys = quarter_car(road=True)
     T = np.linspace(0, 2, 201)

@@ -8,7 +8,7 @@ import pytest
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.cli import main
+from qc_control.console import main
 from qc_control.report import MARKER, ReportError, figures, write_report
 
 PNG = b"\x89PNG\r\n\x1a\n"

@@ -100,6 +100,7 @@ def test_chunking_and_executors_do_not_change_results(grid_result):
     np.testing.assert_allclose(other[cols].to_numpy(), ref[cols].to_numpy(), rtol=1e-13)
 
 
+@pytest.mark.slow  # starts a two-process Dask cluster: about 6 s
 def test_dask_local_cluster(grid_result):
     distributed = pytest.importorskip("dask.distributed")
     with (
