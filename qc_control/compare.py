@@ -267,7 +267,7 @@ def _limiting_mode(method, modes: ModalAnalysis) -> str:
         m.name: max_stable_step(method, [m.eigenvalue, m.eigenvalue.conjugate()])
         for m in modes.modes
     }
-    return min(limits, key=limits.get)
+    return min(limits, key=limits.__getitem__)
 
 
 @dataclass(frozen=True, eq=False)

@@ -211,7 +211,7 @@ _ALL = (
            _rms_tire_load, per_corner=True),
     Metric("lift_off", "", "whether the dynamic load ever exceeds the static wheel load "
            "(the wheel would leave the road; a linear model does not represent it)",
-           lambda s, i: _lifted(s, i).any(axis=-1), per_corner=True),
+           lambda s, i: np.asarray(_lifted(s, i).any(axis=-1)), per_corner=True),
     Metric("lift_off_duration", "s", "total time the wheel would be off the road",
            lambda s, i: np.count_nonzero(_lifted(s, i), axis=-1) * s.dt, per_corner=True),
 )

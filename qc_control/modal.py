@@ -235,7 +235,7 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
             )
         )
     modes.sort(key=lambda m: m.name != BODY)
-    return ModalAnalysis(tuple(modes), _damping_note(modes[0], MinvK))
+    return ModalAnalysis((modes[0], modes[1]), _damping_note(modes[0], MinvK))
 
 
 def _shape(v: np.ndarray) -> complex:

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import functools
 import math
+import sys
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -30,9 +31,9 @@ import numpy as np
 
 from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel
 
-try:  # Python >= 3.11
+if sys.version_info >= (3, 11):
     import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 __all__ = [
@@ -171,6 +172,7 @@ class QuarterCarParams:
                 f"cs={self.cs!r} and zeta={self.zeta!r} disagree: "
                 f"cs = 2*zeta*sqrt(ks*ms) = {self.zeta * critical:.6g}; give only one"
             )
+        assert self.cs is not None and self.zeta is not None  # resolved above
         # every entry of A must be a finite number, or no method can step the model
         ratios = {
             "cs": self.cs,
@@ -343,7 +345,7 @@ def quarter_car_abcd(ms, mu, ks, ku, cs, *, road: bool = False, actuator: bool =
     C[..., 0, 2] = C[..., 1, 3] = C[..., 2, 2] = C[..., 3, 3] = 1.0
     C[..., 2, 3] = -1.0
     C[..., 4, :] = A[..., 0, :]
-    D = np.zeros(batch + (5, B.shape[-1]))
+    D = np.zeros(batch + (5, int(np.shape(B)[-1])))
     if road:
         D[..., 3, 0] = -1.0
     D[..., 4, :] = B[..., 0, :]

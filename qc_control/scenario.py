@@ -36,6 +36,7 @@ import inspect
 import json
 import math
 import shlex
+import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar, cast
@@ -54,10 +55,10 @@ from .compare import (
 from .methods import METHODS, get_method
 from .model import STATES, QuarterCarParams
 
-try:  # Python >= 3.11
+if sys.version_info >= (3, 11):
     import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-    import tomli as tomllib  # type: ignore[no-redef]
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
 
 __all__ = [
     "Scenario",
@@ -495,7 +496,7 @@ class Scenario:
     def __post_init__(self):
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
         put("vehicle", _vehicle(self.vehicle))
-        road = self.road
+        road: Any = self.road
         if road is None or isinstance(road, str):
             road = {"kind": road or "none"}
         if isinstance(road, Mapping):

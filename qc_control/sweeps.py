@@ -298,7 +298,11 @@ def sweep(
 
     params, errors = _validate(designs, type(model.params))
     good = [i for i, p in enumerate(params) if p is not None]
-    batch = model.batch([params[i] for i in good]) if good else None
+    batch = (
+        model.batch([params[i] for i in good])
+        if good
+        else BatchedModel(*(np.zeros((0, 1, 1)),) * 4, (), ())
+    )
     chunks = [
         (good[s : s + chunk_size], slice(s, s + chunk_size))
         for s in range(0, len(good), chunk_size)
