@@ -12,7 +12,13 @@ from .integrate import DivergenceWarning, Solution, integrate
 from .methods import METHODS, ButcherTableau, get_method
 from .modal import ModalAnalysis, Mode, modal_analysis
 from .model import OUTPUTS, STATES, QuarterCarParams, load_config, quarter_car, read_config
-from .response import FixedStepResponse, forced_response, initial_response
+from .response import (
+    FixedStepResponse,
+    forced_response,
+    impulse_response,
+    initial_response,
+    step_response,
+)
 from .ride import (
     Transmissibility,
     ride_metrics,
@@ -43,6 +49,8 @@ __all__ = [
     "DivergenceWarning",
     "initial_response",
     "forced_response",
+    "step_response",
+    "impulse_response",
     "FixedStepResponse",
     "stability_function",
     "max_stable_step",
