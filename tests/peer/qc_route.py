@@ -1,0 +1,212 @@
+"""pytest plugin: route python-control's responses to qc_control, and record who called them.
+
+Loaded with ``-p qc_route`` into a pytest run of python-control's own test
+files (see `run_peer.py`). ``QC_PEER_MODE`` chooses what the two functions
+``control.initial_response`` and ``control.forced_response`` do:
+
+``record``
+    call python-control itself, and record which tests called them (this
+    is how `peer_tests.txt`, the checked-in denominator, is made);
+``qc``
+    call ``qc_control``'s function of the same name with RK4 at a fine
+    step: each interval of ``T`` is split into the fewest substeps with
+    ``h·|λ|max <= QC_PEER_HLAM`` (default 0.01).
+
+Both names are replaced in ``control`` and in ``control.timeresp`` (test
+files import them from either). ``QC_PEER_SCOPE`` says which calls count:
+``direct`` (default) routes and records every call except those from
+python-control's other response functions in ``control.timeresp``
+(``step_response``, ``impulse_response``, ``initial_response`` are built on
+``forced_response``; they keep control's own); ``all`` routes those too. ``QC_PEER_REPORT``
+names a JSON file that receives ``{"called": [...], "outcomes": {...}}``.
+
+Why h·|λ|max = 0.01: RK4's local error on a mode is ``|hλ|⁵/120`` of its
+size per step, 8.3e-13 at 0.01, so after ``t|λ| = 100`` (a mode decayed far
+below anything a test looks at) the relative error is at most ~1e-8.
+"""
+
+from __future__ import annotations
+
+import inspect
+import json
+import math
+import os
+import sys
+import warnings
+
+import control
+import control.timeresp as ct_timeresp
+import numpy as np
+import pytest
+
+import qc_control.response as qc_response
+
+MODE = os.environ.get("QC_PEER_MODE", "qc")
+SCOPE = os.environ.get("QC_PEER_SCOPE", "direct")
+REPORT = os.environ.get("QC_PEER_REPORT")
+H_LAMBDA = float(os.environ.get("QC_PEER_HLAM", "0.01"))
+
+_ORIGINAL = {
+    "forced_response": ct_timeresp.forced_response,
+    "initial_response": ct_timeresp.initial_response,
+}
+_SIGNATURE = {name: inspect.signature(f) for name, f in _ORIGINAL.items()}
+_ALIASES = {"timepts": "T", "timepts_num": "T_num"}
+
+COMPARE = os.environ.get("QC_PEER_COMPARE", "1") == "1"
+
+_current: str | None = None
+called: set[str] = set()
+outcomes: dict[str, str] = {}
+refused: set[str] = set()  # tests in which qc_control refused a nonlinear system
+errors: dict[str, float] = {}  # largest relative difference from control, per test
+
+
+def _record_refusal(original):
+    def refuse(sys, *args, **kwargs):
+        if _current is not None:
+            refused.add(_current)
+        return original(sys, *args, **kwargs)
+
+    return refuse
+
+
+def _relative_difference(ours, theirs) -> float:
+    """max |ours - control| / max |control|, over outputs and states of every response."""
+    pairs = zip(ours, theirs) if isinstance(theirs, list) else [(ours, theirs)]
+    worst = 0.0
+    for a, b in pairs:
+        for name in ("y", "x"):
+            va, vb = getattr(a, name, None), getattr(b, name, None)
+            if vb is None or np.asarray(vb).size == 0:
+                continue
+            va, vb = np.asarray(va, dtype=complex), np.asarray(vb, dtype=complex)
+            if va.shape != vb.shape:
+                return math.inf
+            scale = float(np.max(np.abs(vb)))
+            diff = float(np.max(np.abs(va - vb)))
+            if not math.isfinite(diff):
+                return math.inf
+            worst = max(worst, diff / scale if scale > 0 else diff)
+    return worst
+
+
+def _compare(original, ours_result, args, kwargs) -> None:
+    """Run control's own function on the same call and keep the difference."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            theirs = original(*args, **kwargs)
+    except Exception:
+        return
+    err = _relative_difference(ours_result, theirs)
+    if _current is not None:
+        errors[_current] = max(errors.get(_current, 0.0), err)
+
+
+def _argument(name: str, args, kwargs, key: str):
+    """The value of control's parameter ``key`` (or its alias) in this call."""
+    bound = _SIGNATURE[name].bind_partial(*args, **kwargs).arguments
+    if key in bound:
+        return bound[key]
+    extra = bound.get("kwargs", {})
+    return extra.get(key, extra.get(_ALIASES.get(key, key)))
+
+
+def _fine_substeps(name: str, args, kwargs) -> int:
+    """Fewest substeps with h·|λ|max <= H_LAMBDA on every continuous system in the call."""
+    sysdata = _argument(name, args, kwargs, "sysdata")
+    systems = sysdata if isinstance(sysdata, (list, tuple)) else [sysdata]
+    T = _argument(name, args, kwargs, "timepts")
+    if T is None or np.ndim(T) == 0 or np.size(T) == 1:
+        if name != "initial_response":
+            return 1
+        try:
+            T = ct_timeresp._default_time_vector(
+                sysdata, N=_argument(name, args, kwargs, "timepts_num"), tfinal=T, is_step=False
+            )
+        except Exception:
+            return 1  # qc_control raises control's own error for this call
+    try:
+        H = float(np.max(np.diff(np.asarray(T, dtype=float).reshape(-1))))
+    except (TypeError, ValueError):
+        return 1
+    need = 1
+    for system in systems:
+        if not isinstance(system, control.LTI) or not control.isctime(system, strict=True):
+            continue
+        A = np.asarray(control.ss(system).A, dtype=float)
+        if A.size and np.all(np.isfinite(A)) and math.isfinite(H) and H > 0:
+            lam = float(np.max(np.abs(np.linalg.eigvals(A))))
+            need = max(need, math.ceil(H * lam / H_LAMBDA))
+    return need
+
+
+def _routed(name: str):
+    original = _ORIGINAL[name]
+    ours = getattr(qc_response, name)
+
+    def call(*args, **kwargs):
+        caller = sys._getframe(1).f_globals.get("__name__", "")
+        if SCOPE == "direct" and caller == "control.timeresp":
+            # python-control's step/impulse/initial responses built on forced_response
+            return original(*args, **kwargs)
+        if _current is not None:
+            called.add(_current)
+        if MODE == "record":
+            return original(*args, **kwargs)
+        substeps = _fine_substeps(name, args, kwargs)
+        result = ours(*args, method="rk4", substeps=substeps, **kwargs)
+        if COMPARE:
+            _compare(original, result, args, kwargs)
+        return result
+
+    call.__name__ = call.__qualname__ = name
+    call.__doc__ = original.__doc__
+    call.__wrapped__ = original
+    return call
+
+
+def pytest_configure(config):
+    qc_response._nonlinear_response = _record_refusal(qc_response._nonlinear_response)
+    for name in _ORIGINAL:
+        routed = _routed(name)
+        setattr(control, name, routed)
+        setattr(ct_timeresp, name, routed)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    global _current
+    _current = item.nodeid
+    yield
+    _current = None
+
+
+def pytest_runtest_logreport(report):
+    if report.failed:
+        outcomes[report.nodeid] = "failed"
+    elif report.skipped and hasattr(report, "wasxfail"):
+        outcomes.setdefault(report.nodeid, "xfailed")
+    elif report.skipped:
+        outcomes.setdefault(report.nodeid, "skipped")
+    elif report.when == "call":
+        outcomes.setdefault(report.nodeid, "passed")
+
+
+def pytest_sessionfinish(session, exitstatus):
+    if REPORT:
+        with open(REPORT, "w", encoding="utf-8") as f:
+            json.dump(
+                {
+                    "mode": MODE,
+                    "scope": SCOPE,
+                    "h_lambda": H_LAMBDA,
+                    "called": sorted(called),
+                    "outcomes": outcomes,
+                    "refused_nonlinear": sorted(refused),
+                    "relative_difference": errors,
+                },
+                f,
+                indent=0,
+            )
