@@ -27,6 +27,7 @@ Which systems go where:
 from __future__ import annotations
 
 import bisect
+import inspect
 import math
 import warnings
 
@@ -52,7 +53,7 @@ from .integrate import (
     uniform_step,
 )
 from .lti import lti_trajectory
-from .methods import ButcherTableau, get_method
+from .methods import METHODS, ButcherTableau, get_method
 from .stability import amplification, max_stable_step, stability_coefficients
 
 __all__ = [
@@ -335,6 +336,31 @@ def _generic(A, B, T, u_samples, x0, tab, substeps, warn):
         return integrate(rhs, T, x0, tab, substeps=substeps)
 
 
+def _not_a_method(value, name: str) -> None:
+    """A method given where python-control has another positional: say so.
+
+    ``method`` was the 4th positional of qc's responses before they took
+    python-control's exact signature; ``qc.initial_response(sys, T, X0,
+    'rk4')`` would now ask for output 'rk4' (and ``forced_response``'s 5th
+    positional is ``transpose``, where 'rk4' is silently true).
+    """
+    if isinstance(value, ButcherTableau) or (
+        isinstance(value, str) and value.strip().lower() in METHODS
+    ):
+        raise TypeError(
+            f"{name}={value!r} looks like a method: method is keyword-only "
+            f"(method={value!r}); here {name} means what it means in python-control"
+        )
+
+
+def _stacklevel() -> int:
+    """The ``stacklevel`` that points a warning at the caller's line, outside this module."""
+    frame, level = inspect.currentframe(), 0
+    while frame is not None and frame.f_code.co_filename == __file__:
+        frame, level = frame.f_back, level + 1
+    return level
+
+
 class _Options:
     """The keyword-only additions, checked once per call."""
 
@@ -378,7 +404,7 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
             f"h = {h:.6g} s exceeds the stability limit {h_max:.6g} s of "
             f"{tab.name} for system {ss.name!r}: the response grows"
         )
-        warnings.warn(message, DivergenceWarning, stacklevel=4)
+        warnings.warn(message, DivergenceWarning, stacklevel=_stacklevel())
     uniform = uniform_step(T) is not None
     if opts.engine == "lti" and not uniform:
         raise ValueError("engine='lti' needs a uniformly spaced T")
@@ -434,12 +460,14 @@ def _wrap(data: control.TimeResponseData, **meta) -> FixedStepResponse:
 # ---------------------------------------------------------------- systems
 
 
-def _nonlinear_response(sys, *args, **kwargs):
+def _nonlinear_response(sys, T, U, X0, *, params, transpose, return_x, squeeze, opts, auto):
     """NONLINEAR ENGINE HOOK (issue 11): the one place nonlinear systems go.
 
-    python-control hands a `control.NonlinearIOSystem` to
-    `control.input_output_response`. The fixed-step nonlinear engine is not
-    there yet; when it lands, replace this refusal by a call to it.
+    python-control's `forced_response` (and so its initial and step
+    responses) hands a `control.NonlinearIOSystem` to
+    `control.input_output_response` with these arguments. The fixed-step
+    nonlinear engine is not there yet; when it lands, replace this refusal
+    by a call to it that returns a `FixedStepResponse`.
     """
     raise NotImplementedError(
         f"system {sys.name!r} is a nonlinear {type(sys).__name__}: the fixed-step "
@@ -448,16 +476,20 @@ def _nonlinear_response(sys, *args, **kwargs):
     )
 
 
+def _is_nonlinear(sys) -> bool:
+    # StateSpace derives from NonlinearIOSystem in python-control 0.10
+    return isinstance(sys, control.NonlinearIOSystem) and not isinstance(sys, control.StateSpace)
+
+
 def _check_system(sys) -> None:
-    """Refuse what cannot be simulated here, as python-control does."""
-    if isinstance(sys, (control.StateSpace, control.TransferFunction)):
-        return
-    if isinstance(sys, control.NonlinearIOSystem):
-        _nonlinear_response(sys)
-    # python-control's own words (its tests expect them)
-    raise TypeError(
-        f"Parameter `sys`: must be a `StateSpace` or `TransferFunction`, got {type(sys).__name__}"
-    )
+    """Refuse what python-control refuses, in its own words (its tests expect them)."""
+    if not isinstance(sys, (control.StateSpace, control.TransferFunction)) and not _is_nonlinear(
+        sys
+    ):
+        raise TypeError(
+            "Parameter `sys`: must be a `StateSpace` or `TransferFunction`, "
+            f"got {type(sys).__name__}"
+        )
 
 
 def _as_statespace(sys) -> control.StateSpace:
@@ -492,6 +524,23 @@ def _time_grid(sysdata, T, T_num, is_step: bool):
 def _forced(sys, T, U, X0, transpose, params, interpolate, return_x, squeeze, opts, auto=False):
     """`forced_response` for one system."""
     _check_system(sys)
+    if _is_nonlinear(sys):
+        if interpolate:  # as python-control
+            warnings.warn(
+                "interpolation not supported for nonlinear I/O systems", stacklevel=_stacklevel()
+            )
+        return _nonlinear_response(
+            sys,
+            T,
+            U,
+            X0,
+            params=params,
+            transpose=transpose,
+            return_x=return_x,
+            squeeze=squeeze,
+            opts=opts,
+            auto=auto,
+        )
     if return_x is None:
         return_x = control.config.defaults["forced_response.return_x"]
     if not control.isctime(sys, strict=True):
@@ -512,14 +561,14 @@ def _forced(sys, T, U, X0, transpose, params, interpolate, return_x, squeeze, op
             warnings.warn(
                 "return_x specified for a transfer function system. Internal "
                 "conversion to state space used; results may meaningless.",
-                stacklevel=3,
+                stacklevel=_stacklevel(),
             )
         if np.any(np.asarray(X0) != 0):
             warnings.warn(
                 "Non-zero initial condition given for transfer function system. "
                 "Internal conversion to state space used; may not be consistent "
                 "with given X0.",
-                stacklevel=3,
+                stacklevel=_stacklevel(),
             )
     ss = _as_statespace(sys)
     if T is None:
@@ -710,6 +759,7 @@ def forced_response(
         initial_state=(initial_state, 0.0),
         return_states=(return_states, None),
     )
+    _not_a_method(transpose, "transpose")
     opts = _Options(method, substeps, engine)
     T, U, X0, return_x = v["timepts"], v["inputs"], v["initial_state"], v["return_states"]
     if isinstance(sysdata, (list, tuple)):
@@ -806,6 +856,7 @@ def initial_response(
         return_states=(return_states, False),
         timepts_num=(timepts_num, None),
     )
+    _not_a_method(v["output_indices"], "output_indices")
     opts = _Options(method, substeps, engine)
     T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=False)
     args = (v["initial_state"], v["output_indices"], params, transpose, v["return_states"])
@@ -845,10 +896,10 @@ def _initial(sys, T, auto, X0, output, params, transpose, return_x, squeeze, opt
 _META = ("method", "h", "substeps", "steps", "nfev", "step_rule", "note", "_eigenvalues")
 
 
-def _single_index(index, given, what: str):
+def _single_index(index, what: str):
     """python-control's rule: one input/output index, not a list or a name."""
     if isinstance(index, (list, tuple)):
-        if len(given) > 1:
+        if len(index) > 1:
             raise NotImplementedError(f"list of {what} indices not allowed")
         return index[0]
     if isinstance(index, str):
@@ -862,9 +913,9 @@ def _traces(kind, sys, T, auto, X0_of, U_of, inputs, output, opts, params):
     noutputs = sys.noutputs if output is None else 1
     yout = np.empty((noutputs, ninputs, T.size))
     xout = np.empty((sys.nstates, ninputs, T.size))
-    uout = np.empty((ninputs, ninputs, T.size)) if kind == "step" else None
-    if kind == "impulse":
-        uout = np.full((ninputs, ninputs, T.size), None)
+    # python-control leaves the impulse's inputs undefined (None): it has no samples
+    fill = None if kind == "impulse" else 0.0
+    uout = np.full((ninputs, ninputs, T.size), fill, dtype=object if fill is None else float)
     parts, labels = [], []
     for i in range(sys.ninputs):
         if isinstance(inputs, int) and i != inputs:
@@ -959,6 +1010,7 @@ def step_response(
         return_states=(return_states, False),
         timepts_num=(timepts_num, None),
     )
+    _not_a_method(v["input_indices"], "input_indices")
     opts = _Options(method, substeps, engine)
     T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=True)
     T = np.atleast_1d(T).reshape(-1)
@@ -975,12 +1027,12 @@ def _step(sys, T, auto, X0, inputs, output, transpose, return_x, squeeze, params
             "Non-zero initial condition given for transfer function system. "
             "Internal conversion to state space used; may not be consistent "
             "with given X0.",
-            stacklevel=3,
+            stacklevel=_stacklevel(),
         )
     _check_system(sys)
     sys = _as_lti_statespace(sys)
-    inputs = _single_index(inputs, inputs, "input")
-    output = _single_index(output, output, "output")
+    inputs = _single_index(inputs, "input")
+    output = _single_index(output, "output")
 
     def U_of(i):
         U = np.zeros((sys.ninputs, T.size))
@@ -1110,6 +1162,7 @@ def impulse_response(
         return_states=(return_states, False),
         timepts_num=(timepts_num, None),
     )
+    _not_a_method(v["input_indices"], "input_indices")
     opts = _Options(method, substeps, engine)
     T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=False)
     T = np.atleast_1d(T).reshape(-1)
@@ -1129,10 +1182,10 @@ def _impulse(sys, T, auto, inputs, output, transpose, return_x, squeeze, opts):
         warnings.warn(
             "System has direct feedthrough: `D != 0`. The infinite impulse at "
             "`t=0` does not appear in the output.\nResults may be meaningless!",
-            stacklevel=3,
+            stacklevel=_stacklevel(),
         )
-    inputs = _single_index(inputs, inputs, "input")
-    output = _single_index(output, output, "output")
+    inputs = _single_index(inputs, "input")
+    output = _single_index(output, "output")
 
     def X0_of(i):
         return np.asarray(sys.B)[:, i] if continuous else 0

@@ -46,16 +46,21 @@ SCOPE = os.environ.get("QC_PEER_SCOPE", "direct")
 REPORT = os.environ.get("QC_PEER_REPORT")
 H_LAMBDA = float(os.environ.get("QC_PEER_HLAM", "0.01"))
 
-_ORIGINAL = {
-    "forced_response": ct_timeresp.forced_response,
-    "initial_response": ct_timeresp.initial_response,
-}
+#: Which functions to route: the two of the issue, or (QC_PEER_FUNCS=all) also
+#: step_response and impulse_response, to try qc_control's versions of those.
+FUNCS = (
+    ["forced_response", "initial_response", "step_response", "impulse_response"]
+    if os.environ.get("QC_PEER_FUNCS") == "all"
+    else ["forced_response", "initial_response"]
+)
+_ORIGINAL = {name: getattr(ct_timeresp, name) for name in FUNCS}
 _SIGNATURE = {name: inspect.signature(f) for name, f in _ORIGINAL.items()}
 _ALIASES = {"timepts": "T", "timepts_num": "T_num"}
 
 COMPARE = os.environ.get("QC_PEER_COMPARE", "1") == "1"
 
 _current: str | None = None
+_comparing = False
 called: set[str] = set()
 outcomes: dict[str, str] = {}
 refused: set[str] = set()  # tests in which qc_control refused a nonlinear system
@@ -93,12 +98,16 @@ def _relative_difference(ours, theirs) -> float:
 
 def _compare(original, ours_result, args, kwargs) -> None:
     """Run control's own function on the same call and keep the difference."""
+    global _comparing
+    _comparing = True
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             theirs = original(*args, **kwargs)
     except Exception:
         return
+    finally:
+        _comparing = False
     err = _relative_difference(ours_result, theirs)
     if _current is not None:
         errors[_current] = max(errors.get(_current, 0.0), err)
@@ -119,11 +128,14 @@ def _fine_substeps(name: str, args, kwargs) -> int:
     systems = sysdata if isinstance(sysdata, (list, tuple)) else [sysdata]
     T = _argument(name, args, kwargs, "timepts")
     if T is None or np.ndim(T) == 0 or np.size(T) == 1:
-        if name != "initial_response":
+        if name == "forced_response":
             return 1
         try:
             T = ct_timeresp._default_time_vector(
-                sysdata, N=_argument(name, args, kwargs, "timepts_num"), tfinal=T, is_step=False
+                sysdata,
+                N=_argument(name, args, kwargs, "timepts_num"),
+                tfinal=T,
+                is_step=name == "step_response",
             )
         except Exception:
             return 1  # qc_control raises control's own error for this call
@@ -148,8 +160,9 @@ def _routed(name: str):
 
     def call(*args, **kwargs):
         caller = sys._getframe(1).f_globals.get("__name__", "")
-        if SCOPE == "direct" and caller == "control.timeresp":
-            # python-control's step/impulse/initial responses built on forced_response
+        if _comparing or (SCOPE == "direct" and caller == "control.timeresp"):
+            # control's own run of a call, for the comparison; or python-control's
+            # step/impulse/initial responses built on forced_response
             return original(*args, **kwargs)
         if _current is not None:
             called.add(_current)

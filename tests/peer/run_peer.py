@@ -1,17 +1,23 @@
 """Run python-control's own tests with its responses routed to qc_control.
 
 python-control 0.10.2 ships its test suite inside the package
-(``control/tests``). This script runs the test files that call
-``control.initial_response`` or ``control.forced_response`` in a separate
-pytest process, with the `qc_route` plugin replacing those two functions
-by ``qc_control``'s (RK4 at ``h·|λ|max <= 0.01``), and scores the tests
-listed in ``peer_tests.txt``: the tests that call them, recorded from a run
-of unmodified python-control (``--record``).
+(``control/tests``). This script runs the test files that call its time
+responses in a separate pytest process, with the `qc_route` plugin
+replacing them by ``qc_control``'s (RK4 at ``h·|λ|max <= 0.01``), and
+scores the tests that call them, as recorded from a run of unmodified
+python-control (``--record``). Two routings:
+
+``two`` (the issue's measure)
+    ``control.initial_response`` and ``control.forced_response``; the
+    callers are listed in ``peer_tests.txt``;
+``all``
+    also ``control.step_response`` and ``control.impulse_response``;
+    listed in ``peer_tests_all.txt``.
 
 Usage::
 
-    python tests/peer/run_peer.py            # score qc_control, list the failures
-    python tests/peer/run_peer.py --record   # rewrite peer_tests.txt from control itself
+    python tests/peer/run_peer.py [--funcs all]            # score, list the failures
+    python tests/peer/run_peer.py --record [--funcs all]   # rewrite the list from control
 """
 
 from __future__ import annotations
@@ -28,8 +34,8 @@ import control
 
 HERE = Path(__file__).resolve().parent
 CONTROL_DIR = Path(control.__file__).resolve().parent
-LIST = HERE / "peer_tests.txt"
-NOT_APPLICABLE = HERE / "not_applicable.txt"
+LISTS = {"two": HERE / "peer_tests.txt", "all": HERE / "peer_tests_all.txt"}
+KNOWN_FAILURES = HERE / "known_failures.txt"
 
 #: The test files of python-control 0.10.2 that call the two functions.
 FILES = [
@@ -47,11 +53,18 @@ FILES = [
 ]
 
 
-def run(mode: str = "qc", tests: list[str] | None = None) -> dict:
-    """Run the peer tests under ``mode`` ('qc' or 'record'); the plugin's JSON report.
+def run(mode: str = "qc", tests: list[str] | None = None, funcs: str = "two") -> dict:
+    """Run the peer tests; the `qc_route` plugin's JSON report.
 
-    ``tests``: node ids to run (relative to the control package); by default
-    every test in `FILES`.
+    Parameters
+    ----------
+    mode : {'qc', 'record'}
+        Route to qc_control, or call python-control and record the callers.
+    tests : list of str, optional
+        Node ids to run (relative to the control package); by default every
+        test in `FILES`.
+    funcs : {'two', 'all'}
+        Which of control's responses to route (see the module docstring).
     """
     with tempfile.TemporaryDirectory() as tmp:
         report = Path(tmp) / "report.json"
@@ -62,6 +75,7 @@ def run(mode: str = "qc", tests: list[str] | None = None) -> dict:
         env = dict(os.environ)
         env.update(
             QC_PEER_MODE=mode,
+            QC_PEER_FUNCS=funcs,
             QC_PEER_REPORT=str(report),
             PYTHONPATH=os.pathsep.join(filter(None, [str(HERE), env.get("PYTHONPATH")])),
             MPLBACKEND="Agg",
@@ -79,7 +93,6 @@ def run(mode: str = "qc", tests: list[str] | None = None) -> dict:
             "-p",
             "no:cacheprovider",
             "-q",
-            "-rN",
             "--tb=no",
             "-W",
             "ignore::DeprecationWarning",
@@ -96,14 +109,15 @@ def run(mode: str = "qc", tests: list[str] | None = None) -> dict:
             )
         result = json.loads(report.read_text(encoding="utf-8"))
         result["returncode"] = proc.returncode
-        result["summary"] = proc.stdout.strip().splitlines()[-1:] if proc.stdout else []
         return result
 
 
-def read_list(path: Path = LIST) -> list[str]:
+def read_list(path: Path) -> list[str]:
     """Node ids in a checked-in list (``#`` starts a comment)."""
     lines = path.read_text(encoding="utf-8").splitlines()
-    return [line.split("#")[0].strip() for line in lines if line.split("#")[0].strip()]
+    return [
+        line.split("  #")[0].strip() for line in lines if line.strip() and not line.startswith("#")
+    ]
 
 
 def score(result: dict, tests: list[str]) -> dict:
@@ -131,28 +145,37 @@ def score(result: dict, tests: list[str]) -> dict:
         "compared": len(diffs),
         "max_relative_difference": worst[1],
         "worst_test": worst[0],
-        "unlisted_callers": sorted(set(result["called"]) - set(tests)),
     }
+
+
+def record(funcs: str) -> list[str]:
+    """The tests that call the routed functions and pass under python-control itself."""
+    result = run("record", funcs=funcs)
+    ok = ("passed", "xfailed")
+    return [t for t in result["called"] if result["outcomes"].get(t) in ok]
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--record", action="store_true", help="rewrite peer_tests.txt")
+    parser.add_argument("--record", action="store_true", help="rewrite the list of callers")
+    parser.add_argument("--funcs", choices=("two", "all"), default="two")
     args = parser.parse_args(argv)
+    path = LISTS[args.funcs]
     if args.record:
-        result = run("record")
-        called = [t for t in result["called"] if result["outcomes"].get(t) in ("passed", "xfailed")]
-        header = (
-            f"# python-control {control.__version__}: the tests that call\n"
-            "# control.initial_response or control.forced_response and pass under control itself.\n"
-            "# Written by `python tests/peer/run_peer.py --record`; do not edit by hand.\n"
+        called = record(args.funcs)
+        names = "initial_response, forced_response" + (
+            ", step_response, impulse_response" if args.funcs == "all" else ""
         )
-        LIST.write_text(header + "\n".join(called) + "\n", encoding="utf-8")
-        print(f"{len(called)} tests written to {LIST}")
+        header = (
+            f"# python-control {control.__version__}: the tests that call control.{{{names}}}\n"
+            "# and pass under python-control itself. Written by\n"
+            f"# `python tests/peer/run_peer.py --record --funcs {args.funcs}`; do not edit.\n"
+        )
+        path.write_text(header + "\n".join(called) + "\n", encoding="utf-8")
+        print(f"{len(called)} tests written to {path}")
         return 0
-    tests = read_list()
-    result = run("qc", tests)
-    s = score(result, tests)
+    tests = read_list(path)
+    s = score(run("qc", tests, args.funcs), tests)
     n_pending = len(s["pending_nonlinear"])
     print(f"{s['passed']} of {s['total']} peer tests pass ({100 * s['rate']:.1f}%)")
     print(
