@@ -224,7 +224,7 @@ def _rounding_free(eig: np.ndarray, A: np.ndarray) -> np.ndarray:
     ``(0, 10 n ε ||A||₁]`` is within that error of the imaginary axis and
     is taken as 0, so that an undamped mode is judged as undamped.
     """
-    if not eig.size:
+    if not eig.size or not np.any(eig.real > 0):
         return eig
     tol = 10 * eig.size * np.finfo(float).eps * np.linalg.norm(A, 1)
     fuzzy = (eig.real > 0) & (eig.real <= tol)
@@ -426,6 +426,13 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
     return meta
 
 
+def _all_finite(v: np.ndarray) -> bool:
+    """No NaN or inf in ``v``: its min and max propagate both, without a mask array."""
+    if v.size == 0 or v.dtype == object:
+        return True
+    return bool(np.isfinite(v.min()) and np.isfinite(v.max()))
+
+
 def _finalise(resp: FixedStepResponse) -> FixedStepResponse:
     """The one response-level check: any NaN or inf makes ``success`` False.
 
@@ -435,7 +442,7 @@ def _finalise(resp: FixedStepResponse) -> FixedStepResponse:
     bad = [
         name
         for name, v in (("outputs", resp.y), ("states", resp.x))
-        if v is not None and np.asarray(v).dtype != object and not np.all(np.isfinite(v))
+        if v is not None and not _all_finite(np.asarray(v))
     ]
     if bad:
         where = np.asarray(resp.x if "states" in bad else resp.y)
