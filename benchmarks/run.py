@@ -163,13 +163,14 @@ def main(argv=None) -> int:
     t_cf = best_of(lambda: control.forced_response(sys_road, T, U, X0), repeats)
     rows, lti_times = [], {}
     for m in qc.METHODS:
-        t_lf = best_of(lambda: qc.initial_response(sys_free, T, X0, m), repeats)
-        t_lr = best_of(lambda: qc.forced_response(sys_road, T, U, X0, m), repeats)
+        t_lf = best_of(lambda: qc.initial_response(sys_free, T, X0, method=m), repeats)
+        t_lr = best_of(lambda: qc.forced_response(sys_road, T, U, X0, method=m), repeats)
         t_gf = best_of(
-            lambda: qc.initial_response(sys_free, T, X0, m, engine="generic"), max(1, repeats // 3)
+            lambda: qc.initial_response(sys_free, T, X0, method=m, engine="generic"),
+            max(1, repeats // 3),
         )
-        lti = qc.initial_response(sys_free, T, X0, m)
-        gen = qc.initial_response(sys_free, T, X0, m, engine="generic")
+        lti = qc.initial_response(sys_free, T, X0, method=m)
+        gen = qc.initial_response(sys_free, T, X0, method=m, engine="generic")
         gap = float(np.max(np.abs(lti.states - gen.states)) / np.max(np.abs(gen.states)))
         lti_times[m] = t_lf
         rows.append(
@@ -231,9 +232,9 @@ def main(argv=None) -> int:
         ex = control.initial_response(sys_free, Th, X0).outputs[0]
         wp_T[hh] = (Th, ex)
         for m in qc.METHODS:
-            r = qc.initial_response(sys_free, Th, X0, m)
+            r = qc.initial_response(sys_free, Th, X0, method=m)
             err = float(np.max(np.abs(r.outputs[0] - ex)))
-            t_run = best_of(lambda: qc.initial_response(sys_free, Th, X0, m), repeats)
+            t_run = best_of(lambda: qc.initial_response(sys_free, Th, X0, method=m), repeats)
             rows.append([m, f"h = {hh * 1e3:g} ms", g(err), str(r.nfev), g(t_run * 1e3)])
     ivp = {}
     Tq, exq = wp_T[min(wp_T)]
@@ -265,7 +266,10 @@ def main(argv=None) -> int:
     # solve_ivp at the tolerance that first reaches RK4's error on the default grid
     rk4_err = float(
         np.max(
-            np.abs(qc.initial_response(sys_free, T, X0, "rk4").outputs[0] - exact_free.outputs[0])
+            np.abs(
+                qc.initial_response(sys_free, T, X0, method="rk4").outputs[0]
+                - exact_free.outputs[0]
+            )
         )
     )
     rows = []

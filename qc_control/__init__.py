@@ -91,7 +91,13 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         read_config,
     )
     from .report import write_report
-    from .response import FixedStepResponse, forced_response, initial_response
+    from .response import (
+        FixedStepResponse,
+        forced_response,
+        impulse_response,
+        initial_response,
+        step_response,
+    )
     from .ride import (
         Transmissibility,
         ride_metrics,
@@ -138,6 +144,8 @@ _LAZY: dict[str, str] = {
     "FixedStepResponse": "response",
     "forced_response": "response",
     "initial_response": "response",
+    "step_response": "response",
+    "impulse_response": "response",
     "Transmissibility": "ride",
     "ride_metrics": "ride",
     "ride_metrics_spectral": "ride",
@@ -201,6 +209,8 @@ __all__ = [
     "DivergenceWarning",
     "initial_response",
     "forced_response",
+    "step_response",
+    "impulse_response",
     "FixedStepResponse",
     "stability_function",
     "max_stable_step",

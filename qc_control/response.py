@@ -1,18 +1,48 @@
 """Fixed-step time responses with python-control's call shape and return type.
 
-``qc.initial_response(sys, T, X0, method='heun')`` is a drop-in for
-``control.initial_response(sys, T, X0)``: the same arguments, the same
-`control.TimeResponseData` (labels, ``.plot()``, ``.to_pandas()``), but the
-trajectory is the one the chosen fixed-step method computes.
+``qc.initial_response``, ``qc.forced_response``, ``qc.step_response`` and
+``qc.impulse_response`` take exactly the arguments of python-control
+0.10.2's functions of the same names (positional order, keywords, aliases
+such as ``T``/``U``/``X0``/``T_num``, `control.config.defaults`) and return
+the same `control.TimeResponseData` (labels, ``.plot()``, ``.to_pandas()``,
+tuple unpacking), or a `control.TimeResponseList` for a list of systems.
+The difference is the trajectory: for a continuous-time system it is the
+one the chosen fixed-step method computes. ``method``, ``substeps`` and
+``engine`` are keyword-only additions.
+
+Which systems go where:
+
+* continuous-time `control.StateSpace`: the fixed-step method;
+* continuous-time `control.TransferFunction`: converted with `control.ss`
+  (its signal names carry over), then as above;
+* discrete-time systems (``dt > 0`` or ``dt=True``) and ``dt=None`` systems
+  have nothing to integrate. python-control simulates them by their own
+  difference equation (``dt=None`` with the grid's spacing as the sample
+  time), and so do these functions, through python-control itself; the
+  result's ``note`` says that no method was applied;
+* `control.NonlinearIOSystem`: refused for now, in one place
+  (`_nonlinear_response`), until the fixed-step nonlinear engine lands.
 """
 
 from __future__ import annotations
 
 import bisect
+import inspect
+import math
 import warnings
 
 import control
 import numpy as np
+
+# python-control's own argument handling and default time grid, reused so
+# that every alias, legacy keyword, default and automatic grid means exactly
+# what it means in control (these are private names of control 0.10.2).
+from control.config import _process_kwargs, _process_param
+from control.timeresp import _default_time_vector, _timeresp_aliases
+
+# Captured at import, so that a caller who routes control's function to this
+# module (as tests/peer does) still reaches control's own difference equation.
+from control.timeresp import forced_response as _control_forced_response
 
 from .integrate import (
     DivergenceWarning,
@@ -23,12 +53,28 @@ from .integrate import (
     uniform_step,
 )
 from .lti import lti_trajectory
-from .methods import ButcherTableau, get_method
-from .stability import amplification, max_stable_step
+from .methods import METHODS, ButcherTableau, get_method
+from .stability import amplification, max_stable_step, stability_coefficients
 
-__all__ = ["FixedStepResponse", "initial_response", "forced_response"]
+__all__ = [
+    "FixedStepResponse",
+    "initial_response",
+    "forced_response",
+    "step_response",
+    "impulse_response",
+    "auto_step",
+    "check_initial_state",
+    "check_input_samples",
+]
 
-_ALIASES = {"timepts": "T", "inputs": "U", "initial_state": "X0", "return_states": "return_x"}
+#: Local error per step that the automatic step allows: RK4's at h|λ| = 0.1,
+#: ``0.1**5 / 5!`` (see `auto_step`).
+AUTO_STEP_LOCAL_ERROR = 0.1**5 / math.factorial(5)
+
+#: The automatic step is at most this fraction of the stability limit.
+AUTO_STEP_STABILITY_FRACTION = 0.5
+
+_ENGINES = ("auto", "lti", "generic")
 
 
 class FixedStepResponse(control.TimeResponseData):
@@ -36,70 +82,104 @@ class FixedStepResponse(control.TimeResponseData):
 
     Attributes (besides those of `control.TimeResponseData`)
     ----------------------------------------------------------
-    method : ButcherTableau
-        The method that computed the response.
-    h : float
-        The largest step taken [s].
+    method : ButcherTableau or None
+        The method that computed the response; None when no method was
+        applied (a discrete-time or ``dt=None`` system).
+    h : float or None
+        The largest step taken [s] (an interval of ``T`` over ``substeps``).
+    substeps : int
+        Steps per interval of the time grid.
     steps, nfev : int
-        Steps taken and right-hand-side evaluations (``stages * steps``).
-    max_stable_step : float
+        Steps taken and right-hand-side evaluations (``stages * steps``),
+        summed over the traces of a step or impulse response.
+    step_rule : str or None
+        When the time grid was chosen automatically (``T`` None or a final
+        time): which rule set ``h`` (see `auto_step`).
+    note : str or None
+        Anything else the reader should know, e.g. that a discrete-time
+        system was simulated by its difference equation, no method applied.
+    max_stable_step : float or None
         The method's stability limit for this system [s] (see
-        `qc_control.max_stable_step`).
+        `qc_control.max_stable_step`), computed when asked.
+    success, message
+        As in python-control. ``success`` is False whenever the step
+        exceeds the method's stability limit, the run diverged, or any
+        state or output is NaN or inf.
     """
 
-    method: ButcherTableau
-    h: float
-    steps: int
-    nfev: int
-    _eigenvalues: np.ndarray
+    method: ButcherTableau | None = None
+    h: float | None = None
+    substeps: int = 1
+    steps: int = 0
+    nfev: int = 0
+    step_rule: str | None = None
+    note: str | None = None
+    _eigenvalues: np.ndarray | None = None
 
     @property
-    def max_stable_step(self) -> float:
+    def max_stable_step(self) -> float | None:
         """The method's stability limit for this system [s], computed when asked."""
+        if self.method is None or self._eigenvalues is None:
+            return None
         return max_stable_step(self.method, self._eigenvalues)
 
 
-def _take_aliases(kwargs: dict, values: dict) -> dict:
-    for alias, name in _ALIASES.items():
-        if alias in kwargs:
-            values[name] = kwargs.pop(alias)
-    if kwargs:
-        raise TypeError(f"unrecognized keyword(s): {', '.join(sorted(kwargs))}")
-    return values
+# ---------------------------------------------------------------- input checks
 
 
-def _check_system(sys) -> None:
-    if not isinstance(sys, control.StateSpace):
-        raise TypeError(f"sys must be a control.StateSpace, got {type(sys).__name__}")
-    if not control.isctime(sys, strict=True):
+def check_initial_state(X0, n: int) -> np.ndarray:
+    """``X0`` as a finite real array of shape ``(n,)``.
+
+    A number fills every state; ``(n, 1)`` and ``(1, n)`` are flattened,
+    as python-control accepts them.
+
+    Raises
+    ------
+    ValueError
+        Naming the shape or the values when they do not fit.
+    """
+    raw = np.asarray(X0)
+    if raw.dtype.kind == "c":
         raise ValueError(
-            f"system {sys.name!r} must be continuous-time for a fixed-step "
-            f"method, got dt={sys.dt!r}"
+            f"X0 must be real: the fixed-step engines integrate real states, got {raw.tolist()}"
         )
-
-
-def _initial_state(X0, n: int) -> np.ndarray:
-    x0 = np.asarray(X0, dtype=float)
+    try:
+        x0 = np.asarray(X0, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"X0 must be numbers, got {X0!r}") from None
     if x0.ndim == 0:
         x0 = np.full(n, float(x0))
     elif x0.shape in ((n, 1), (1, n)):
         x0 = x0.reshape(n)
     if x0.shape != (n,):
-        raise ValueError(
-            f"X0 must have shape ({n},) for a system with {n} states, got {np.asarray(X0).shape}"
-        )
+        raise ValueError(f"X0 must have shape ({n},) for a system with {n} states, got {raw.shape}")
     if not np.all(np.isfinite(x0)):
         raise ValueError(f"X0 must be finite, got {x0.tolist()}")
     return x0
 
 
-def _input_samples(U, ninputs: int, nsteps: int) -> np.ndarray:
-    """``U`` as a ``(ninputs, nsteps)`` array, with python-control's shapes."""
-    u = np.asarray(0.0 if U is None else U, dtype=float)
+def check_input_samples(U, ninputs: int, nsteps: int) -> np.ndarray:
+    """``U`` as a finite real ``(ninputs, nsteps)`` array, with python-control's shapes.
+
+    A number (or None, meaning 0) holds every input at that value; one
+    input may be given as ``(nsteps,)``.
+
+    Raises
+    ------
+    ValueError
+        Naming the expected and the given shape, or the bad values.
+    """
+    raw = np.asarray(0.0 if U is None else U)
+    if raw.dtype.kind == "c":
+        raise ValueError("U must be real: the fixed-step engines integrate real states")
+    try:
+        u = np.asarray(raw, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"U must be numbers, got an array of {raw.dtype}") from None
     if u.ndim == 0:
         if ninputs == 0 and u != 0:
             raise ValueError(
-                "U is given but the system has no inputs "
+                f"U = {float(u)!r} is given but the system has no inputs "
                 "(build it with quarter_car(road=True) or actuator=True)"
             )
         u = np.full((ninputs, nsteps), float(u))
@@ -109,11 +189,115 @@ def _input_samples(U, ninputs: int, nsteps: int) -> np.ndarray:
         want = f"({nsteps},) or (1, {nsteps})" if ninputs == 1 else f"({ninputs}, {nsteps})"
         raise ValueError(
             f"U must have shape {want} to match T (len {nsteps}) and the "
-            f"system's {ninputs} input(s), got {np.asarray(U).shape}"
+            f"system's {ninputs} input(s), got {raw.shape}"
         )
     if not np.all(np.isfinite(u)):
-        raise ValueError("U must be finite")
+        first = np.argwhere(~np.isfinite(u))[0].tolist()
+        raise ValueError(f"U must be finite; first bad sample at index {first}")
     return u
+
+
+# ---------------------------------------------------------------- the automatic step
+
+
+def _error_constant(tab: ButcherTableau) -> tuple[int, float]:
+    """``(p, C)`` with ``R(z) - e^z = -C z^{p+1} + O(z^{p+2})`` on the method's R."""
+    coef = stability_coefficients(tab)
+    p = 0
+    while p + 1 < coef.size and abs(coef[p + 1] * math.factorial(p + 1) - 1) <= 1e-12:
+        p += 1
+    r_next = coef[p + 1] if p + 1 < coef.size else 0.0
+    return p, abs(r_next - 1 / math.factorial(p + 1))
+
+
+def _rounding_free(eig: np.ndarray, A: np.ndarray) -> np.ndarray:
+    """Eigenvalues with real parts that rounding pushed just above 0 set to 0.
+
+    The eigenvalue solver is backward stable: it returns the exact
+    eigenvalues of ``A + E`` with ``||E|| ~ n ε ||A||`` (Golub & Van Loan,
+    *Matrix Computations*, 4th ed., §7.5.6). A real part in
+    ``(0, 10 n ε ||A||₁]`` is within that error of the imaginary axis and
+    is taken as 0, so that an undamped mode is judged as undamped.
+    """
+    if not eig.size or not np.any(eig.real > 0):
+        return eig
+    tol = 10 * eig.size * np.finfo(float).eps * np.linalg.norm(A, 1)
+    fuzzy = (eig.real > 0) & (eig.real <= tol)
+    return np.where(fuzzy, 1j * eig.imag, eig) if fuzzy.any() else eig
+
+
+def auto_step(method, eigenvalues) -> tuple[float, str]:
+    """The step the automatic time grid allows for ``method``, and why.
+
+    Two rules; the step is the smaller:
+
+    * **accuracy** — the local error of one step on the fastest mode is at
+      most RK4's at ``h|λ|max = 0.1``. On ``x' = λx`` one step multiplies
+      by ``R(hλ)`` instead of ``e^{hλ}``, so the local error is
+      ``|R(z) - e^z| ≈ C |z|^{p+1}`` with ``z = hλ``, ``p`` the order and
+      ``C`` the error constant (Hairer, Nørsett & Wanner, *Solving ODEs I*,
+      §II.3; for the stability function, Hairer & Wanner, *Solving ODEs
+      II*, §IV.2: ``R(z) = e^z + O(z^{p+1})``). Setting
+      ``C |z|^{p+1} = 0.1⁵/5! ≈ 8.3e-8`` gives
+
+      .. math:: h\\,|\\lambda|_{max} \\le \\Big(\\frac{0.1^5/5!}{C}\\Big)^{1/(p+1)}
+
+      which is 0.1 for RK4 (``C = 1/120``), 7.9e-3 for Midpoint and Heun
+      (``C = 1/6``) and 4.1e-4 for Euler (``C = 1/2``). ``p`` and ``C`` are
+      read from the tableau's stability polynomial, so a user's tableau
+      gets its own bound.
+    * **stability** — at most half the method's stability limit
+      (`qc_control.max_stable_step`). When no step is stable (an undamped
+      mode under Euler, Midpoint or Heun) this rule is dropped, and the
+      response reports the growth (``success`` False).
+
+    The local error per step is then the same for every method; the global
+    error, about ``(t/h)`` local errors, is not. On the seed vehicle released
+    from 5 cm, over python-control's own grid (14.95 s), the states differ
+    from the exact response by 7.1e-7 (RK4), 2.0e-5 (Midpoint, Heun) and
+    3.7e-4 (Euler) of their largest value.
+
+    Parameters
+    ----------
+    method : str or ButcherTableau
+    eigenvalues : array_like
+        The continuous-time system's eigenvalues [1/s].
+
+    Returns
+    -------
+    h : float
+        ``inf`` when neither rule bounds the step (every eigenvalue is 0).
+    rule : str
+        Which rule set ``h``, in words.
+
+    Examples
+    --------
+    >>> h, rule = auto_step("rk4", [-1.0 + 10j, -1.0 - 10j])
+    >>> round(h * abs(-1 + 10j), 6), rule.split(":")[0]
+    (0.1, 'accuracy')
+    """
+    tab = get_method(method)
+    lam = np.atleast_1d(np.asarray(eigenvalues, dtype=complex))
+    p, C = _error_constant(tab)
+    rho = (AUTO_STEP_LOCAL_ERROR / C) ** (1 / (p + 1)) if C > 0 else math.inf
+    lam_max = float(np.max(np.abs(lam))) if lam.size else 0.0
+    h_acc = rho / lam_max if lam_max > 0 else math.inf
+    h_lim = max_stable_step(tab, lam) if lam_max > 0 else math.inf
+    h_stab = AUTO_STEP_STABILITY_FRACTION * h_lim if h_lim > 0 else math.inf
+    if h_acc <= h_stab:
+        if not math.isfinite(h_acc):
+            return math.inf, "none: every eigenvalue is 0, the grid's own spacing is used"
+        return h_acc, (
+            f"accuracy: h·|λ|max = {rho:.3g} for {tab.name} (order {p}, local error "
+            f"{AUTO_STEP_LOCAL_ERROR:.2g} per step on the fastest mode, |λ|max = {lam_max:.4g} 1/s)"
+        )
+    return h_stab, (
+        f"stability: half of {tab.name}'s stability limit {h_lim:.4g} s "
+        f"(the accuracy rule allowed {h_acc:.4g} s)"
+    )
+
+
+# ---------------------------------------------------------------- engines
 
 
 def linear_input(T: np.ndarray, U: np.ndarray):
@@ -153,18 +337,64 @@ def _generic(A, B, T, u_samples, x0, tab, substeps, warn):
         return integrate(rhs, T, x0, tab, substeps=substeps)
 
 
-def _simulate(sys, T, U, X0, method, substeps, kind, transpose, return_x, squeeze, engine="auto"):
-    _check_system(sys)
-    tab = get_method(method)
-    T = check_time_grid(T, "T")
-    A, B = np.asarray(sys.A, dtype=float), np.asarray(sys.B, dtype=float)
-    C, D = np.asarray(sys.C, dtype=float), np.asarray(sys.D, dtype=float)
-    x0 = _initial_state(X0, sys.nstates)
-    u_samples = _input_samples(U, sys.ninputs, T.size)
+def _not_a_method(value, name: str) -> None:
+    """A method given where python-control has another positional: say so.
 
-    steps = np.diff(T)
-    h = float(steps.max()) / check_substeps(substeps)
-    eig = np.linalg.eigvals(A)
+    ``method`` was the 4th positional of qc's responses before they took
+    python-control's exact signature; ``qc.initial_response(sys, T, X0,
+    'rk4')`` would now ask for output 'rk4' (and ``forced_response``'s 5th
+    positional is ``transpose``, where 'rk4' is silently true).
+    """
+    if isinstance(value, ButcherTableau) or (
+        isinstance(value, str) and value.strip().lower() in METHODS
+    ):
+        raise TypeError(
+            f"{name}={value!r} looks like a method: method is keyword-only "
+            f"(method={value!r}); here {name} means what it means in python-control"
+        )
+
+
+def _stacklevel() -> int:
+    """The ``stacklevel`` that points a warning at the caller's line, outside this module."""
+    frame, level = inspect.currentframe(), 0
+    while frame is not None and frame.f_code.co_filename == __file__:
+        frame, level = frame.f_back, level + 1
+    return level
+
+
+class _Options:
+    """The keyword-only additions, checked once per call."""
+
+    def __init__(self, method, substeps, engine):
+        self.tab = get_method(method)
+        self.substeps = check_substeps(substeps)
+        if engine not in _ENGINES:
+            raise ValueError(f"engine must be 'auto', 'lti' or 'generic', got {engine!r}")
+        self.engine = engine
+
+
+def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
+    """Run the fixed-step method on a continuous-time StateSpace."""
+    tab = opts.tab
+    A, B = np.asarray(ss.A, dtype=float), np.asarray(ss.B, dtype=float)
+    C, D = np.asarray(ss.C, dtype=float), np.asarray(ss.D, dtype=float)
+    H = float(np.diff(T).max())
+    eig = _rounding_free(np.linalg.eigvals(A), A) if A.size else np.empty(0, complex)
+    substeps, step_rule = opts.substeps, None
+    if auto:
+        h_rule, step_rule = auto_step(tab, eig)
+        if math.isfinite(h_rule):
+            # the smallest count whose step meets the rule (never fewer than asked)
+            substeps = max(substeps, math.ceil(H / h_rule * (1 - 1e-12)))
+    h = H / substeps
+    meta = {"method": tab, "h": h, "substeps": substeps, "step_rule": step_rule, "eig": eig}
+    if not eig.size:  # a static gain: nothing to integrate
+        x = np.zeros((0, T.size))
+        y = D @ u_samples if u_samples.size else np.zeros((C.shape[0], T.size))
+        meta.update(t=T, x=x, y=y, u=u_samples, steps=0, nfev=0, success=True, message="")
+        meta["note"] = "the system has no states: y = D u, nothing was integrated"
+        return meta
+
     success, message = True, ""
     # The trajectory grows iff the step map R(hA) amplifies a mode; the full
     # root-finding for h_max runs only to word the warning (or when asked).
@@ -173,17 +403,15 @@ def _simulate(sys, T, U, X0, method, substeps, kind, transpose, return_x, squeez
         success = False
         message = (
             f"h = {h:.6g} s exceeds the stability limit {h_max:.6g} s of "
-            f"{tab.name} for system {sys.name!r}: the response grows"
+            f"{tab.name} for system {ss.name!r}: the response grows"
         )
-        warnings.warn(message, DivergenceWarning, stacklevel=3)
-    # python-control's own test of an even grid: np.allclose(np.diff(T), dt)
-    uniform = uniform_step(T, rtol=1e-5, atol=1e-8) is not None
-    if engine not in ("auto", "lti", "generic"):
-        raise ValueError(f"engine must be 'auto', 'lti' or 'generic', got {engine!r}")
-    if engine == "lti" and not uniform:
+        warnings.warn(message, DivergenceWarning, stacklevel=_stacklevel())
+    uniform = uniform_step(T) is not None
+    if opts.engine == "lti" and not uniform:
         raise ValueError("engine='lti' needs a uniformly spaced T")
-    if engine == "lti" or (engine == "auto" and uniform and success):
-        x = lti_trajectory(tab, A, B, T, u_samples, x0, substeps)
+    if opts.engine == "lti" or (opts.engine == "auto" and uniform and success):
+        with np.errstate(over="ignore", invalid="ignore"):
+            x = lti_trajectory(tab, A, B, T, u_samples, x0, substeps)
         n_steps = (T.size - 1) * substeps
         sol = Solution(T, x, tab.stages * n_steps, n_steps, tab, "success", "")
     else:
@@ -192,65 +420,318 @@ def _simulate(sys, T, U, X0, method, substeps, kind, transpose, return_x, squeez
         success, message = False, "; ".join(filter(None, [message, sol.message]))
     N = sol.t.size
     x, u = sol.x, u_samples[:, :N]
-    y = C @ x + D @ u if np.any(u) else C @ x
-    resp = FixedStepResponse(
-        sol.t,
-        y,
-        x,
-        u if kind == "forced" else None,
-        issiso=sys.issiso(),
-        output_labels=sys.output_labels,
-        input_labels=sys.input_labels if kind == "forced" else None,
-        state_labels=sys.state_labels,
-        sysname=sys.name,
-        plot_inputs=kind == "forced",
-        title=f"{kind.capitalize()} response for {sys.name} ({tab.name}, h = {h:.4g} s)",
-        trace_types=[kind],
-        transpose=transpose,
-        return_x=return_x,
-        squeeze=squeeze,
-        success=success,
-        message=message or None,
-    )
-    resp.method, resp.h, resp.steps, resp.nfev = tab, h, sol.steps, sol.nfev
-    resp._eigenvalues = eig
+    with np.errstate(over="ignore", invalid="ignore"):
+        y = C @ x + D @ u if np.any(u) else C @ x
+    meta.update(t=sol.t, x=x, y=y, u=u, steps=sol.steps, nfev=sol.nfev)
+    meta.update(success=success, message=message, note=None)
+    return meta
+
+
+def _all_finite(v: np.ndarray) -> bool:
+    """No NaN or inf in ``v``: its min and max propagate both, without a mask array."""
+    if v.size == 0 or v.dtype == object:
+        return True
+    return bool(np.isfinite(v.min()) and np.isfinite(v.max()))
+
+
+def _finalise(resp: FixedStepResponse) -> FixedStepResponse:
+    """The one response-level check: any NaN or inf makes ``success`` False.
+
+    Every result passes here, whichever engine (LTI scan, generic stepper,
+    python-control's difference equation) computed it.
+    """
+    bad = [
+        name
+        for name, v in (("outputs", resp.y), ("states", resp.x))
+        if v is not None and not _all_finite(np.asarray(v))
+    ]
+    if bad:
+        where = np.asarray(resp.x if "states" in bad else resp.y)
+        first = int(np.argmax(~np.isfinite(where).reshape(-1, where.shape[-1]).all(axis=0)))
+        note = (
+            f"the response's {' and '.join(bad)} hold NaN or inf "
+            f"(first at t = {float(resp.t[first]):.6g} s)"
+        )
+        resp.success = False
+        resp.message = "; ".join(filter(None, [resp.message, note]))
     return resp
 
 
-def initial_response(
-    sys,
-    T=None,
-    X0=0.0,
+def _wrap(data: control.TimeResponseData, **meta) -> FixedStepResponse:
+    """A python-control result as a FixedStepResponse (no method applied)."""
+    resp = FixedStepResponse.__new__(FixedStepResponse)
+    resp.__dict__.update(data.__dict__)
+    resp.__dict__.update(meta)
+    return _finalise(resp)
+
+
+# ---------------------------------------------------------------- systems
+
+
+def _nonlinear_response(sys, T, U, X0, *, params, transpose, return_x, squeeze, opts, auto):
+    """NONLINEAR ENGINE HOOK (issue 11): the one place nonlinear systems go.
+
+    python-control's `forced_response` (and so its initial and step
+    responses) hands a `control.NonlinearIOSystem` to
+    `control.input_output_response` with these arguments. The fixed-step
+    nonlinear engine is not there yet; when it lands, replace this refusal
+    by a call to it that returns a `FixedStepResponse`.
+    """
+    raise NotImplementedError(
+        f"system {sys.name!r} is a nonlinear {type(sys).__name__}: the fixed-step "
+        "nonlinear engine is not there yet (issue 11). Use "
+        "control.input_output_response for now, or linearise the system."
+    )
+
+
+def _is_nonlinear(sys) -> bool:
+    # StateSpace derives from NonlinearIOSystem in python-control 0.10
+    return isinstance(sys, control.NonlinearIOSystem) and not isinstance(sys, control.StateSpace)
+
+
+def _check_system(sys) -> None:
+    """Refuse what python-control refuses, in its own words (its tests expect them)."""
+    if not isinstance(sys, (control.StateSpace, control.TransferFunction)) and not _is_nonlinear(
+        sys
+    ):
+        raise TypeError(
+            "Parameter `sys`: must be a `StateSpace` or `TransferFunction`, "
+            f"got {type(sys).__name__}"
+        )
+
+
+def _as_statespace(sys) -> control.StateSpace:
+    """A continuous TransferFunction as a StateSpace, keeping its name and signal names."""
+    if isinstance(sys, control.StateSpace):
+        return sys
+    return control.ss(sys, name=sys.name)
+
+
+def _discrete_note(sys) -> str:
+    if sys.dt is None:
+        kind, how = (
+            "of unspecified timebase (dt=None)",
+            "with the grid's spacing as its sample time",
+        )
+    else:
+        kind, how = "discrete-time", f"(dt={sys.dt!r})"
+    return (
+        f"system {sys.name!r} is {kind}: "
+        f"simulated by its own difference equation {how}, as python-control does; "
+        "no fixed-step method was applied"
+    )
+
+
+def _time_grid(sysdata, T, T_num, is_step: bool):
+    """``(T, auto)``: python-control's own default grid when T is None or a final time."""
+    if T is None or np.asarray(T).size == 1:
+        return _default_time_vector(sysdata, N=T_num, tfinal=T, is_step=is_step), True
+    return T, False
+
+
+def _forced(sys, T, U, X0, transpose, params, interpolate, return_x, squeeze, opts, auto=False):
+    """`forced_response` for one system."""
+    _check_system(sys)
+    if _is_nonlinear(sys):
+        if interpolate:  # as python-control
+            warnings.warn(
+                "interpolation not supported for nonlinear I/O systems", stacklevel=_stacklevel()
+            )
+        return _nonlinear_response(
+            sys,
+            T,
+            U,
+            X0,
+            params=params,
+            transpose=transpose,
+            return_x=return_x,
+            squeeze=squeeze,
+            opts=opts,
+            auto=auto,
+        )
+    if return_x is None:
+        return_x = control.config.defaults["forced_response.return_x"]
+    if not control.isctime(sys, strict=True):
+        data = _control_forced_response(
+            sys,
+            T,
+            U,
+            X0,
+            transpose=transpose,
+            params=params,
+            interpolate=interpolate,
+            return_states=return_x,
+            squeeze=squeeze,
+        )
+        return _wrap(data, note=_discrete_note(sys))
+    if isinstance(sys, control.TransferFunction):  # python-control's warnings
+        if return_x:
+            warnings.warn(
+                "return_x specified for a transfer function system. Internal "
+                "conversion to state space used; results may meaningless.",
+                stacklevel=_stacklevel(),
+            )
+        if np.any(np.asarray(X0) != 0):
+            warnings.warn(
+                "Non-zero initial condition given for transfer function system. "
+                "Internal conversion to state space used; may not be consistent "
+                "with given X0.",
+                stacklevel=_stacklevel(),
+            )
+    ss = _as_statespace(sys)
+    if T is None:
+        raise ValueError("Parameter `T` is mandatory for continuous time systems.")
+    T = np.asarray(T)
+    if transpose:
+        T = T.T
+    if T.ndim == 2 and 1 in T.shape:
+        T = T.reshape(-1)
+    T = check_time_grid(T, "T")
+    x0 = check_initial_state(X0, ss.nstates)
+    u = np.asarray(0.0 if U is None else U)
+    if transpose and u.ndim == 2:
+        u = u.T
+    u = check_input_samples(u, ss.ninputs, T.size)
+    run = _simulate(ss, T, u, x0, opts, auto)
+    resp = FixedStepResponse(
+        run["t"],
+        run["y"],
+        run["x"],
+        run["u"],
+        params=params,
+        issiso=ss.issiso(),
+        output_labels=ss.output_labels,
+        input_labels=ss.input_labels,
+        state_labels=ss.state_labels,
+        sysname=ss.name,
+        plot_inputs=True,
+        title=_title("Forced", ss.name),
+        trace_types=["forced"],
+        transpose=transpose,
+        return_x=return_x,
+        squeeze=squeeze,
+        success=run["success"],
+        message=run["message"] or None,
+    )
+    return _finalise(_set_meta(resp, run))
+
+
+def _title(kind: str, name: str) -> str:
+    """python-control's title, word for word (its plots and tests rely on it)."""
+    return f"{kind} response for {name}"
+
+
+def _set_meta(resp: FixedStepResponse, run: dict) -> FixedStepResponse:
+    resp.method, resp.h, resp.substeps = run["method"], run["h"], run["substeps"]
+    resp.steps, resp.nfev = run["steps"], run["nfev"]
+    resp.step_rule, resp.note, resp._eigenvalues = run["step_rule"], run["note"], run["eig"]
+    return resp
+
+
+def _meta_of(resp: FixedStepResponse) -> dict:
+    return {
+        "method": resp.method,
+        "h": resp.h,
+        "substeps": resp.substeps,
+        "steps": resp.steps,
+        "nfev": resp.nfev,
+        "step_rule": resp.step_rule,
+        "note": resp.note,
+        "eig": resp._eigenvalues,
+    }
+
+
+def _combine(parts: list[FixedStepResponse]) -> dict:
+    """One record of how several traces (inputs of a step response) were computed."""
+    meta = _meta_of(parts[-1])
+    meta["steps"] = sum(p.steps for p in parts)
+    meta["nfev"] = sum(p.nfev for p in parts)
+    messages = []
+    for p in parts:
+        if p.message and p.message not in messages:
+            messages.append(p.message)
+    meta["success"] = all(p.success for p in parts)
+    meta["message"] = "; ".join(messages) or None
+    return meta
+
+
+# ---------------------------------------------------------------- public functions
+
+
+def _with_aliases(kwargs: dict, **named) -> dict:
+    """python-control's keyword processing: aliases, legacy names and their errors."""
+    _process_kwargs(kwargs, _timeresp_aliases)
+    values = {
+        name: _process_param(name, value, kwargs, _timeresp_aliases, sigval=sigval)
+        for name, (value, sigval) in named.items()
+    }
+    if kwargs:
+        raise TypeError(f"unrecognized keyword(s): {', '.join(sorted(kwargs))}")
+    return values
+
+
+def forced_response(
+    sysdata,
+    timepts=None,
+    inputs=0.0,
+    initial_state=0.0,
+    transpose=False,
+    params=None,
+    interpolate=False,
+    return_states=None,
+    squeeze=None,
+    *,
     method="rk4",
     substeps: int = 1,
-    *,
     engine="auto",
-    transpose=False,
-    return_x=False,
-    squeeze=None,
     **kwargs,
 ):
-    """Initial-condition response computed by a fixed-step method.
+    """Forced response computed by a fixed-step method.
 
-    The same call as ``control.initial_response(sys, T, X0)``; the
-    trajectory is ``x_{n+1} = x_n + h Σ b_i k_i`` of the chosen method
-    rather than the exact ``e^{Ah} x_n``.
+    The same call as python-control 0.10.2's `control.forced_response`
+    (every positional and keyword argument, the aliases ``T``, ``U``,
+    ``X0``, ``return_x`` and the `control.config.defaults` it honours). For
+    a continuous-time system the input is linear between its samples,
+    python-control's own assumption, so the stage at time ``t + c_i h``
+    sees ``u(t + c_i h)``:
+
+    .. math::
+
+        k_i = A\\Big(x + h\\sum_{j<i} a_{ij}k_j\\Big) + B\\,u(t + c_i h)
 
     Parameters
     ----------
-    sys : control.StateSpace
-        A continuous-time system.
-    T : array_like
-        Output times [s], strictly increasing. Each interval is one step
-        (or ``substeps`` steps). Alias: ``timepts``.
-    X0 : array_like or float, default 0
-        Initial state, shape ``(nstates,)``; a number fills every state.
-        Alias: ``initial_state``.
-    method : str or ButcherTableau, default ``'rk4'``
+    sysdata : StateSpace, TransferFunction or list of them
+        A list gives a `control.TimeResponseList`, one response per system.
+        Discrete-time and ``dt=None`` systems are simulated by their own
+        difference equation, as python-control does (no method applied;
+        see the result's ``note``). Nonlinear systems are refused for now.
+    timepts (or T) : array_like
+        Sample times [s], strictly increasing. Each interval is one step
+        (or ``substeps`` steps); unlike python-control, a non-uniform grid
+        is accepted and stepped interval by interval. Mandatory for
+        continuous-time systems, as in python-control.
+    inputs (or U) : array_like or float, default 0
+        Input samples, shape ``(ninputs, len(T))`` or ``(len(T),)`` for
+        one input; a number holds every input at that value.
+    initial_state (or X0) : array_like or float, default 0
+        Initial state; a number fills every state.
+    transpose : bool, default False
+        Inputs and outputs time-first (MATLAB's convention), as in control.
+    params : dict, optional
+        Stored in the result (linear systems have no parameters).
+    interpolate : bool, default False
+        For discrete-time systems, as in python-control; no effect otherwise.
+    return_states (or return_x) : bool, optional
+        Whether the result unpacks to ``(t, y, x)``; default
+        ``control.config.defaults['forced_response.return_x']``.
+    squeeze : bool, optional
+        As in python-control.
+    method : str or ButcherTableau, default ``'rk4'``, keyword-only
         ``'euler'``, ``'midpoint'``, ``'heun'``, ``'rk4'`` or a tableau.
-    substeps : int, default 1
+    substeps : int, default 1, keyword-only
         Steps per interval of ``T``.
-    engine : {'auto', 'lti', 'generic'}, default 'auto'
+    engine : {'auto', 'lti', 'generic'}, default 'auto', keyword-only
         How the method's trajectory is computed. ``'lti'``: the step map
         ``x_{k+1} = R(hA) x_k + Γ₀u_k + Γ₁u_{k+1}`` solved by a blocked scan
         (`qc_control.lti`), no Python loop per step; needs a uniform ``T``.
@@ -258,12 +739,98 @@ def initial_response(
         agree to rounding (1e-12 relative). ``'auto'`` uses ``'lti'`` on a
         uniform grid within the stability limit, ``'generic'`` otherwise
         (it stops a blow-up at its first non-finite sample).
-    transpose, return_x, squeeze
-        As in python-control.
 
     Returns
     -------
-    FixedStepResponse
+    FixedStepResponse or control.TimeResponseList
+        With outputs ``y = C x + D u``, the inputs as given, and the
+        ``method``, ``h``, ``substeps``, ``nfev`` that produced them. If
+        ``h`` exceeds the method's stability limit a `DivergenceWarning` is
+        issued and ``success`` is False; any NaN or inf also makes
+        ``success`` False.
+
+    Examples
+    --------
+    A 5 cm road step at t = 0.5 s; the body settles within 20 s
+    (its mode decays as e^{-0.46 t}):
+
+    >>> import numpy as np, qc_control as qc
+    >>> T = np.linspace(0, 20, 2001)
+    >>> r = qc.forced_response(qc.quarter_car(road=True), T, np.where(T >= 0.5, 0.05, 0.0))
+    >>> round(float(r.outputs[0, -1]), 3)   # the body ends up 5 cm higher
+    0.05
+    """
+    v = _with_aliases(
+        kwargs,
+        timepts=(timepts, None),
+        inputs=(inputs, 0.0),
+        initial_state=(initial_state, 0.0),
+        return_states=(return_states, None),
+    )
+    _not_a_method(transpose, "transpose")
+    opts = _Options(method, substeps, engine)
+    T, U, X0, return_x = v["timepts"], v["inputs"], v["initial_state"], v["return_states"]
+    if isinstance(sysdata, (list, tuple)):
+        return control.TimeResponseList(
+            _forced(s, T, U, X0, transpose, params, interpolate, return_x, squeeze, opts)
+            for s in sysdata
+        )
+    return _forced(sysdata, T, U, X0, transpose, params, interpolate, return_x, squeeze, opts)
+
+
+def initial_response(
+    sysdata,
+    timepts=None,
+    initial_state=0,
+    output_indices=None,
+    timepts_num=None,
+    params=None,
+    transpose=False,
+    return_states=False,
+    squeeze=None,
+    *,
+    method="rk4",
+    substeps: int = 1,
+    engine="auto",
+    **kwargs,
+):
+    """Initial-condition response computed by a fixed-step method.
+
+    The same call as python-control 0.10.2's `control.initial_response`;
+    for a continuous-time system the trajectory is
+    ``x_{n+1} = x_n + h Σ b_i k_i`` of the chosen method rather than the
+    exact ``e^{Ah} x_n``.
+
+    Parameters
+    ----------
+    sysdata : StateSpace, TransferFunction or list of them
+        As in `forced_response`.
+    timepts (or T) : array_like or float, optional
+        Output times [s], strictly increasing; or a final time; or None.
+        Given as an array, each interval is one step (or ``substeps``
+        steps). None or a final time: the output grid is python-control's
+        own (``control.timeresp._default_time_vector``: the final time
+        from the slowest relevant mode, at most 5000 points), and each
+        interval is split into the fewest substeps whose step ``h`` meets
+        `auto_step`'s rule (the result's ``h``, ``substeps`` and
+        ``step_rule`` say what was chosen).
+    initial_state (or X0) : array_like or float, default 0
+        Initial state, shape ``(nstates,)``; a number fills every state.
+    output_indices (or output) : int, optional
+        Keep only this output.
+    timepts_num (or T_num) : int, optional
+        Number of output times when ``T`` is None or a final time.
+    params, transpose, squeeze
+        As in python-control.
+    return_states (or return_x) : bool, default False
+        Whether the result unpacks to ``(t, y, x)``.
+    method, substeps, engine : keyword-only
+        As in `forced_response`. With an automatic grid, ``substeps`` is a
+        lower bound.
+
+    Returns
+    -------
+    FixedStepResponse or control.TimeResponseList
         A `control.TimeResponseData` with the system's labels, outputs
         ``y = C x``, and ``method``, ``h``, ``nfev``. If ``h`` exceeds the
         method's stability limit a `DivergenceWarning` is issued and
@@ -289,93 +856,370 @@ def initial_response(
     >>> bool(np.max(abs(rk4.outputs[0] - exact.outputs[0])) < 1e-8)
     True
     """
-    values = _take_aliases(kwargs, {"T": T, "X0": X0, "return_x": return_x})
-    return _simulate(
-        sys,
-        values["T"],
-        0.0,
-        values["X0"],
-        method,
-        substeps,
-        "initial",
-        transpose,
-        values["return_x"],
-        squeeze,
-        engine,
+    v = _with_aliases(
+        kwargs,
+        timepts=(timepts, None),
+        initial_state=(initial_state, 0.0),
+        output_indices=(output_indices, None),
+        return_states=(return_states, False),
+        timepts_num=(timepts_num, None),
     )
+    _not_a_method(v["output_indices"], "output_indices")
+    opts = _Options(method, substeps, engine)
+    T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=False)
+    args = (v["initial_state"], v["output_indices"], params, transpose, v["return_states"])
+    if isinstance(sysdata, (list, tuple)):
+        return control.TimeResponseList(_initial(s, T, auto, *args, squeeze, opts) for s in sysdata)
+    return _initial(sysdata, T, auto, *args, squeeze, opts)
 
 
-def forced_response(
-    sys,
-    T=None,
-    U=0.0,
-    X0=0.0,
+def _initial(sys, T, auto, X0, output, params, transpose, return_x, squeeze, opts):
+    response = _forced(sys, T, 0, X0, False, params, False, None, None, opts, auto=auto)
+    issiso = sys.issiso() or output is not None
+    yout = response.y if output is None else response.y[output]
+    output_labels = sys.output_labels if output is None else sys.output_labels[output]
+    resp = FixedStepResponse(
+        response.t,
+        yout,
+        response.x,
+        None,
+        params=params,
+        issiso=issiso,
+        output_labels=output_labels,
+        input_labels=None,
+        state_labels=sys.state_labels,
+        sysname=sys.name,
+        title=_title("Initial", sys.name),
+        trace_types=["initial"],
+        transpose=transpose,
+        return_x=return_x,
+        squeeze=squeeze,
+        success=response.success,
+        message=response.message,
+    )
+    resp.__dict__.update({k: getattr(response, k) for k in _META})
+    return _finalise(resp)
+
+
+_META = ("method", "h", "substeps", "steps", "nfev", "step_rule", "note", "_eigenvalues")
+
+
+def _single_index(index, what: str):
+    """python-control's rule: one input/output index, not a list or a name."""
+    if isinstance(index, (list, tuple)):
+        if len(index) > 1:
+            raise NotImplementedError(f"list of {what} indices not allowed")
+        return index[0]
+    if isinstance(index, str):
+        raise NotImplementedError(f"named {what}s not allowed")
+    return index
+
+
+def _traces(kind, sys, T, auto, X0_of, U_of, inputs, output, opts, params):
+    """Simulate each selected input of ``sys``; python-control's layout (output, input, time)."""
+    ninputs = sys.ninputs if inputs is None else 1
+    noutputs = sys.noutputs if output is None else 1
+    yout = np.empty((noutputs, ninputs, T.size))
+    xout = np.empty((sys.nstates, ninputs, T.size))
+    # python-control leaves the impulse's inputs undefined (None): it has no samples
+    fill = None if kind == "impulse" else 0.0
+    uout = np.full((ninputs, ninputs, T.size), fill, dtype=object if fill is None else float)
+    parts, labels = [], []
+    for i in range(sys.ninputs):
+        if isinstance(inputs, int) and i != inputs:
+            continue
+        labels.append(f"From {sys.input_labels[i]}")
+        U = U_of(i)
+        r = _forced(sys, T, U, X0_of(i), False, params, False, None, True, opts, auto=auto)
+        if r.t.size != T.size:  # the generic engine cut a blow-up short: pad
+            r = _padded(r, T)
+        k = i if inputs is None else 0
+        yout[:, k, :] = r.y if output is None else r.y[output]
+        xout[:, k, :] = r.x
+        uout[:, k, :] = U if inputs is None else U[i]
+        parts.append(r)
+    return yout, xout, uout, parts, labels
+
+
+def _padded(r: FixedStepResponse, T: np.ndarray) -> FixedStepResponse:
+    """A cut-short response on the full grid, NaN after the cut (for stacking traces)."""
+    n = r.t.size
+    for name in ("y", "x"):
+        v = getattr(r, name)
+        full = np.full(v.shape[:-1] + (T.size,), np.nan)
+        full[..., :n] = v
+        setattr(r, name, full)
+    r.t = T
+    return r
+
+
+def _as_lti_statespace(sys):
+    """python-control converts a TransferFunction before a step or impulse response."""
+    if isinstance(sys, control.TransferFunction):
+        return control.ss(sys, name=sys.name)
+    return sys
+
+
+def step_response(
+    sysdata,
+    timepts=None,
+    initial_state=0.0,
+    input_indices=None,
+    output_indices=None,
+    timepts_num=None,
+    transpose=False,
+    return_states=False,
+    squeeze=None,
+    params=None,
+    *,
     method="rk4",
     substeps: int = 1,
-    *,
     engine="auto",
-    transpose=False,
-    return_x=None,
-    squeeze=None,
     **kwargs,
 ):
-    """Forced response computed by a fixed-step method.
+    """Step response computed by a fixed-step method.
 
-    The same call as ``control.forced_response(sys, T, U, X0)``. The input
-    is linear between its samples, python-control's own assumption, so the
-    stage at time ``t + c_i h`` sees ``u(t + c_i h)``:
-
-    .. math::
-
-        k_i = A\\Big(x + h\\sum_{j<i} a_{ij}k_j\\Big) + B\\,u(t + c_i h)
+    The same call as python-control 0.10.2's `control.step_response`: a
+    unit step on each input in turn (or only on ``input``), all others 0,
+    each trace a `forced_response` of the chosen method. The result is
+    indexed (output, input, time), as python-control's.
 
     Parameters
     ----------
-    sys : control.StateSpace
-        A continuous-time system.
-    T : array_like
-        Sample times [s], strictly increasing. Alias: ``timepts``.
-    U : array_like or float, default 0
-        Input samples, shape ``(ninputs, len(T))`` or ``(len(T),)`` for
-        one input; a number holds every input at that value.
-        Alias: ``inputs``.
-    X0 : array_like or float, default 0
-        Initial state. Alias: ``initial_state``.
-    method, substeps, engine, transpose, return_x, squeeze
-        As in `initial_response`.
+    sysdata : StateSpace, TransferFunction or list of them
+    timepts (or T) : array_like or float, optional
+        As in `initial_response` (automatic grid when None or a final time).
+    initial_state (or X0) : array_like or float, default 0
+    input_indices (or input), output_indices (or output) : int, optional
+        Keep only this input / output.
+    timepts_num (or T_num) : int, optional
+    transpose, return_states (or return_x), squeeze, params
+        As in python-control.
+    method, substeps, engine : keyword-only
+        As in `forced_response`.
 
     Returns
     -------
-    FixedStepResponse
-        With outputs ``y = C x + D u`` and the inputs as given.
+    FixedStepResponse or control.TimeResponseList
 
     Examples
     --------
-    A 5 cm road step at t = 0.5 s; the body settles within 20 s
-    (its mode decays as e^{-0.46 t}):
-
-    >>> import numpy as np, qc_control as qc
-    >>> T = np.linspace(0, 20, 2001)
-    >>> r = qc.forced_response(qc.quarter_car(road=True), T, np.where(T >= 0.5, 0.05, 0.0))
-    >>> round(float(r.outputs[0, -1]), 3)   # the body ends up 5 cm higher
-    0.05
+    >>> import control, qc_control as qc
+    >>> r = qc.step_response(control.tf([1], [1, 2, 1]), 20.0)   # final time 20 s
+    >>> round(float(r.outputs[-1]), 6), r.method.name, r.substeps
+    (1.0, 'rk4', 2)
     """
-    values = _take_aliases(kwargs, {"T": T, "U": U, "X0": X0, "return_x": return_x})
-    return _simulate(
+    v = _with_aliases(
+        kwargs,
+        timepts=(timepts, None),
+        initial_state=(initial_state, 0.0),
+        input_indices=(input_indices, None),
+        output_indices=(output_indices, None),
+        return_states=(return_states, False),
+        timepts_num=(timepts_num, None),
+    )
+    _not_a_method(v["input_indices"], "input_indices")
+    opts = _Options(method, substeps, engine)
+    T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=True)
+    T = np.atleast_1d(T).reshape(-1)
+    args = (v["initial_state"], v["input_indices"], v["output_indices"])
+    rest = (transpose, v["return_states"], squeeze, params, opts)
+    if isinstance(sysdata, (list, tuple)):
+        return control.TimeResponseList(_step(s, T, auto, *args, *rest) for s in sysdata)
+    return _step(sysdata, T, auto, *args, *rest)
+
+
+def _step(sys, T, auto, X0, inputs, output, transpose, return_x, squeeze, params, opts):
+    if isinstance(sys, control.TransferFunction) and np.any(np.asarray(X0) != 0):
+        warnings.warn(
+            "Non-zero initial condition given for transfer function system. "
+            "Internal conversion to state space used; may not be consistent "
+            "with given X0.",
+            stacklevel=_stacklevel(),
+        )
+    _check_system(sys)
+    sys = _as_lti_statespace(sys)
+    inputs = _single_index(inputs, "input")
+    output = _single_index(output, "output")
+
+    def U_of(i):
+        U = np.zeros((sys.ninputs, T.size))
+        U[i, :] = 1.0
+        return U
+
+    yout, xout, uout, parts, labels = _traces(
+        "step", sys, T, auto, lambda i: X0, U_of, inputs, output, opts, params
+    )
+    return _multi_trace(
+        "Step",
         sys,
-        values["T"],
-        values["U"],
-        values["X0"],
-        method,
-        substeps,
-        "forced",
+        T,
+        yout,
+        xout,
+        uout,
+        parts,
+        labels,
+        inputs,
+        output,
         transpose,
-        values["return_x"],
+        return_x,
         squeeze,
-        engine,
+        params,
     )
 
 
-#: The input checks, public for the layers above (compare); see the functions.
-check_initial_state = _initial_state
-check_input_samples = _input_samples
+def _multi_trace(
+    kind,
+    sys,
+    T,
+    yout,
+    xout,
+    uout,
+    parts,
+    labels,
+    inputs,
+    output,
+    transpose,
+    return_x,
+    squeeze,
+    params,
+):
+    issiso = sys.issiso() or (inputs is not None and output is not None)
+    input_labels = sys.input_labels if inputs is None else sys.input_labels[inputs]
+    output_labels = sys.output_labels if output is None else sys.output_labels[output]
+    meta = _combine(parts) if parts else {}
+    resp = FixedStepResponse(
+        T if not parts else parts[-1].t,
+        yout,
+        xout,
+        uout,
+        issiso=issiso,
+        output_labels=output_labels,
+        input_labels=input_labels,
+        state_labels=sys.state_labels,
+        title=_title(kind, sys.name),
+        transpose=transpose,
+        return_x=return_x,
+        squeeze=squeeze,
+        sysname=sys.name,
+        params=params,
+        trace_labels=labels,
+        trace_types=[kind.lower()] * len(labels),
+        plot_inputs=False,
+        success=meta.get("success", True),
+        message=meta.get("message"),
+    )
+    if parts:
+        resp.method, resp.h, resp.substeps = meta["method"], meta["h"], meta["substeps"]
+        resp.steps, resp.nfev = meta["steps"], meta["nfev"]
+        resp.step_rule, resp.note, resp._eigenvalues = meta["step_rule"], meta["note"], meta["eig"]
+    return _finalise(resp)
+
+
+def impulse_response(
+    sysdata,
+    timepts=None,
+    input_indices=None,
+    output_indices=None,
+    timepts_num=None,
+    transpose=False,
+    return_states=False,
+    squeeze=None,
+    *,
+    method="rk4",
+    substeps: int = 1,
+    engine="auto",
+    **kwargs,
+):
+    """Impulse response computed by a fixed-step method.
+
+    The same call as python-control 0.10.2's `control.impulse_response`.
+    For a continuous-time system the impulse on input ``i`` becomes the
+    initial state ``x(0) = B[:, i]`` with no input, as python-control
+    does; a discrete-time system gets a unit-area pulse ``1/dt`` at the
+    first sample, simulated by its difference equation.
+
+    Parameters
+    ----------
+    sysdata : StateSpace, TransferFunction or list of them
+    timepts (or T) : array_like or float, optional
+        As in `initial_response` (automatic grid when None or a final time).
+    input_indices (or input), output_indices (or output) : int, optional
+    timepts_num (or T_num) : int, optional
+    transpose, return_states (or return_x), squeeze
+        As in python-control.
+    method, substeps, engine : keyword-only
+        As in `forced_response`.
+
+    Returns
+    -------
+    FixedStepResponse or control.TimeResponseList
+
+    Examples
+    --------
+    >>> import control, qc_control as qc
+    >>> r = qc.impulse_response(control.tf([1], [1, 1]), [0.0, 0.5, 1.0], substeps=20)
+    >>> [round(float(y), 6) for y in r.outputs]   # e^{-t}
+    [1.0, 0.606531, 0.367879]
+    """
+    v = _with_aliases(
+        kwargs,
+        timepts=(timepts, None),
+        input_indices=(input_indices, None),
+        output_indices=(output_indices, None),
+        return_states=(return_states, False),
+        timepts_num=(timepts_num, None),
+    )
+    _not_a_method(v["input_indices"], "input_indices")
+    opts = _Options(method, substeps, engine)
+    T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=False)
+    T = np.atleast_1d(T).reshape(-1)
+    args = (v["input_indices"], v["output_indices"], transpose, v["return_states"], squeeze)
+    if isinstance(sysdata, (list, tuple)):
+        return control.TimeResponseList(_impulse(s, T, auto, *args, opts) for s in sysdata)
+    return _impulse(sysdata, T, auto, *args, opts)
+
+
+def _impulse(sys, T, auto, inputs, output, transpose, return_x, squeeze, opts):
+    if not isinstance(sys, control.LTI):
+        raise ValueError("system must be LTI system for impulse response")
+    _check_system(sys)
+    sys = _as_lti_statespace(sys)
+    continuous = control.isctime(sys)
+    if continuous and np.any(np.asarray(sys.D) != 0):
+        warnings.warn(
+            "System has direct feedthrough: `D != 0`. The infinite impulse at "
+            "`t=0` does not appear in the output.\nResults may be meaningless!",
+            stacklevel=_stacklevel(),
+        )
+    inputs = _single_index(inputs, "input")
+    output = _single_index(output, "output")
+
+    def X0_of(i):
+        return np.asarray(sys.B)[:, i] if continuous else 0
+
+    def U_of(i):
+        U = np.zeros((sys.ninputs, T.size))
+        if not continuous:
+            U[i, 0] = 1.0 / sys.dt  # unit area (dt=True counts as 1)
+        return U
+
+    yout, xout, uout, parts, labels = _traces(
+        "impulse", sys, T, auto, X0_of, U_of, inputs, output, opts, None
+    )
+    return _multi_trace(
+        "Impulse",
+        sys,
+        T,
+        yout,
+        xout,
+        uout,
+        parts,
+        labels,
+        inputs,
+        output,
+        transpose,
+        return_x,
+        squeeze,
+        None,
+    )

@@ -26,8 +26,8 @@ def test_lti_equals_generic(method, substeps):
     T = np.linspace(0, 10, 10001)
     U = np.vstack([np.where(T >= 0.5, 0.05, 0.0), 200 * np.sin(2 * np.pi * 2 * T)])
     for call in (
-        lambda e: qc.initial_response(sys, T, X0, method, substeps, engine=e),
-        lambda e: qc.forced_response(sys, T, U, X0, method, substeps, engine=e),
+        lambda e: qc.initial_response(sys, T, X0, method=method, substeps=substeps, engine=e),
+        lambda e: qc.forced_response(sys, T, U, X0, method=method, substeps=substeps, engine=e),
     ):
         lti, generic = call("lti"), call("generic")
         assert rel(lti.states, generic.states) < 1e-12
@@ -63,7 +63,9 @@ def test_step_matrices_against_the_stages():
         np.testing.assert_allclose(phi, expected, rtol=1e-13, atol=1e-15)
         # a step from x = 0 with u going 1 -> 0 (or 0 -> 1) isolates Γ0 (or Γ1)
         for gain, U in ((g0, [1.0, 0.0]), (g1, [0.0, 1.0])):
-            step = qc.forced_response(sys, [0.0, h], U, 0.0, tab, engine="generic").states[:, 1]
+            step = qc.forced_response(sys, [0.0, h], U, 0.0, method=tab, engine="generic").states[
+                :, 1
+            ]
             np.testing.assert_allclose(gain[:, 0], step, rtol=1e-13, atol=1e-16)
 
 
