@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .methods import ButcherTableau, get_method
+from .methods import ButcherTableau, _show, get_method
 
 __all__ = [
     "Solution",
@@ -17,11 +17,22 @@ __all__ = [
     "check_time_grid",
     "check_substeps",
     "uniform_step",
+    "UNIFORM_RTOL",
 ]
 
 #: Intervals between checks for a non-finite state. Checking every step would
 #: cost about as much as a stage; a blow-up is still cut at its first bad sample.
-_CHECK_EVERY = 64
+_CHECK_EVERY = 128
+
+#: `uniform_step`'s tolerance, in units of ``eps·max|T|``: a grid point may
+#: sit this far from ``T[0] + k·dt`` and the grid still counts as uniform.
+UNIFORM_RTOL = 4
+
+#: Step sizes whose coefficient plans `_run` keeps (a linspace grid has ~20).
+_PLANS = 64
+
+#: Grid points `uniform_step` checks per vectorised chunk (bounds its memory).
+_CHUNK = 1 << 20
 
 
 class DivergenceWarning(RuntimeWarning):
@@ -30,7 +41,7 @@ class DivergenceWarning(RuntimeWarning):
 
 @dataclass(frozen=True, eq=False)
 class Solution:
-    """The result of `integrate`.
+    """The result of `integrate` (and of the LTI engine, `qc_control.lti.lti_solve`).
 
     Attributes
     ----------
@@ -38,6 +49,7 @@ class Solution:
         The output times: the grid given, cut at divergence.
     x : ndarray, shape (n, N), or (m, n, N) for a batch
         The state at each output time (time last, as in python-control).
+        Real, or complex when ``x0`` is complex.
     nfev : int
         Right-hand-side evaluations made: ``stages * steps`` (one call of
         ``f`` per stage, whatever the batch size).
@@ -47,6 +59,11 @@ class Solution:
     status : str
         ``'success'`` or ``'diverged'``.
     message : str
+
+    Notes
+    -----
+    A Solution whose ``x`` holds a nan or an inf is never a success: it
+    is built with ``status='diverged'`` whatever status it was given.
     """
 
     t: np.ndarray
@@ -57,20 +74,36 @@ class Solution:
     status: str
     message: str
 
+    def __post_init__(self):
+        if self.status not in ("success", "diverged"):
+            raise ValueError(f"status must be 'success' or 'diverged', got {self.status!r}")
+        if self.status == "success" and not np.all(np.isfinite(self.x)):
+            object.__setattr__(self, "status", "diverged")
+            note = "the state holds non-finite values"
+            object.__setattr__(self, "message", "; ".join(filter(None, [self.message, note])))
+
     @property
     def success(self) -> bool:
         return self.status == "success"
 
 
 def check_time_grid(t, name: str = "T") -> np.ndarray:
-    """``t`` as a float array: 1-D, at least 2 points, finite, increasing."""
-    t = np.asarray(t, dtype=float)
+    """``t`` as a float array: 1-D, at least 2 points, finite, increasing.
+
+    Raises
+    ------
+    ValueError
+        Naming ``name`` and the offending value.
+    """
+    try:
+        t = np.asarray(t, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be an array of real times [s], got {_show(t)}") from None
     if t.ndim != 1 or t.size < 2:
         raise ValueError(f"{name} must be a 1-D array of at least 2 times, got shape {t.shape}")
     if not np.all(np.isfinite(t)):
-        raise ValueError(
-            f"{name} must be finite; first bad value at index {int(np.argmin(np.isfinite(t)))}"
-        )
+        i = int(np.argmin(np.isfinite(t)))
+        raise ValueError(f"{name} must be finite; {name}[{i}] = {float(t[i])!r}")
     steps = np.diff(t)
     if np.any(steps <= 0):
         i = int(np.argmax(steps <= 0))
@@ -81,71 +114,156 @@ def check_time_grid(t, name: str = "T") -> np.ndarray:
     return t
 
 
-def _loop_source(tab: ButcherTableau, substeps: bool) -> str:
-    """Python source of the stepping loop for one tableau, stages unrolled.
+def uniform_step(T, *, rtol=None, atol=None) -> float | None:
+    r"""The step of an evenly spaced grid ``T``, or None.
 
-    The coefficients are data, but a loop over them per step costs as much
-    as a stage; writing them into the code once gives the loop a hand-written
-    one would have. Stages of equal weight share one multiplication.
+    ``T`` is uniform when every point lies on the line through its ends
+    to within the rounding of the points themselves:
+
+    .. math::
+
+        \max_k \big|T_k - (T_0 + k\,\Delta t)\big| \le 4\,\varepsilon \max_k |T_k|,
+        \qquad \Delta t = \frac{T_{N-1} - T_0}{N - 1}
+
+    (``ε`` the double-precision machine epsilon; the factor is
+    `UNIFORM_RTOL`). Every step then equals ``Δt`` to within twice that.
+    A grid built as ``np.linspace``, ``np.arange`` or ``T0 + k*dt`` sits
+    within about one unit in the last place (``≤ ε max|T|``) of that line,
+    at any length: ``np.linspace(0, 1e6, 10**8 + 1)`` is uniform. A grid
+    that was jittered, or summed step by step (``np.cumsum``, whose
+    rounding drifts by hundreds of ulps), is not.
+
+    The bound is on the points, not only on the steps, so that stepping
+    with ``Δt`` puts every sample within ``4 ε max|T|`` of its time in
+    ``T``. The LTI engine, which assumes ``Δt``, then reproduces the
+    generic stepper on ``T`` to about ``|λ|max · 4 ε max|T|`` relative
+    (about 2e-13 for the seed's car over 10 s), besides rounding.
+
+    Parameters
+    ----------
+    T : array_like, shape (N,)
+        Times, checked by `check_time_grid`.
+    rtol, atol : ignored
+        Accepted only while callers written for the old signature are
+        updated; they have no effect, since the tolerance is the grid's own
+        rounding. To be removed.
+
+    Returns
+    -------
+    float or None
+        ``Δt``, or None when ``T`` is not uniform.
+
+    Examples
+    --------
+    >>> uniform_step(np.linspace(0, 1, 101))
+    0.01
+    >>> T = np.linspace(0, 1, 101)
+    >>> T[50] += 1e-9
+    >>> uniform_step(T) is None
+    True
     """
-    s = tab.stages
-    a, b, c = tab.a.tolist(), tab.b.tolist(), tab.c.tolist()
-    coef = []
-    lines = [
-        "def run(f, tt, x, out, start, stop, substeps):",
-        "    h_prev = None",
-        "    for n in range(start, stop):",
-        "        t = tt[n]",
-        "        h = (tt[n + 1] - t) / substeps" if substeps else "        h = tt[n + 1] - t",
-        "        if h != h_prev:",
-        "            h_prev = h",
-    ]
-    for i in range(s):
-        if c[i] not in (0.0, 1.0):
-            coef.append(f"            hc{i} = h * {c[i]!r}")
-        for j in range(i):
-            if a[i][j]:
-                coef.append(f"            ha{i}_{j} = h * {a[i][j]!r}")
-    weights: dict[float, list[int]] = {}
-    for i in range(s):
-        if b[i]:
-            weights.setdefault(b[i], []).append(i)
-    for g, w in enumerate(weights):
-        coef.append(f"            hb{g} = h * {w!r}")
-    lines += coef
-    body = []
-    if substeps:
-        body += [
-            "        t0 = t",
-            "        for sub in range(substeps):",
-            "            t = t0 + sub * h",
-        ]
-    pad = "            " if substeps else "        "
-    for i in range(s):
-        ti = "t" if c[i] == 0.0 else "t + h" if c[i] == 1.0 else f"t + hc{i}"
-        xi = "x" + "".join(f" + ha{i}_{j} * k{j}" for j in range(i) if a[i][j])
-        body.append(f"{pad}k{i} = f({ti}, {xi})")
-    terms = []
-    for g, idx in enumerate(weights.values()):
-        ks = " + ".join(f"k{i}" for i in idx)
-        terms.append(f"hb{g} * ({ks})" if len(idx) > 1 else f"hb{g} * {ks}")
-    body.append(f"{pad}x = x + " + " + ".join(terms))
-    lines += body + ["        out[n + 1] = x", "    return x", ""]
-    return "\n".join(lines)
+    T = check_time_grid(T, "T")
+    N = T.size
+    dt = (T[-1] - T[0]) / (N - 1)
+    tol = UNIFORM_RTOL * np.finfo(float).eps * max(abs(T[0]), abs(T[-1]))
+    for lo in range(0, N, _CHUNK):  # in chunks: a 10**8-point grid needs no 800 MB copy
+        k = np.arange(lo, min(lo + _CHUNK, N), dtype=float)
+        if np.max(np.abs(T[lo : lo + k.size] - (T[0] + k * dt))) > tol:
+            return None
+    return float(dt)
 
 
 @functools.lru_cache(maxsize=64)
-def _compiled_loop(tab: ButcherTableau, substeps: bool):
-    namespace: dict = {}
-    exec(compile(_loop_source(tab, substeps), f"<qc_control loop: {tab.name}>", "exec"), namespace)
-    return namespace["run"]
+def _structure(tab: ButcherTableau):
+    """The tableau's non-zero entries, by stage: ``(stages, weights)``.
+
+    ``stages[i - 1] = (c_i, ((j, a_ij), ...))`` over ``a_ij != 0``, for each
+    stage ``i >= 1``; ``weights = ((b, (i, ...)), ...)`` groups the stages
+    of equal weight ``b_i != 0``.
+    """
+    a, b, c = tab.a.tolist(), tab.b.tolist(), tab.c.tolist()
+    stages = tuple(
+        (c[i], tuple((j, a[i][j]) for j in range(i) if a[i][j] != 0)) for i in range(1, tab.stages)
+    )
+    groups: dict[float, list[int]] = {}
+    for i, bi in enumerate(b):
+        if bi != 0:
+            groups.setdefault(bi, []).append(i)
+    return stages, tuple((bi, tuple(idx)) for bi, idx in groups.items())
 
 
-def uniform_step(T: np.ndarray, rtol: float = 1e-9, atol: float = 0.0) -> float | None:
-    """The step of an evenly spaced grid T, or None if a step departs from
-    the mean ``(T[-1] - T[0])/(N - 1)`` by more than ``atol + rtol·dt``."""
-    dt = (T[-1] - T[0]) / (T.size - 1)
-    return float(dt) if np.max(np.abs(np.diff(T) - dt)) <= atol + rtol * abs(dt) else None
+def _plan(tab: ButcherTableau, h: float):
+    """The step's non-zero coefficients times ``h``, as loop data.
+
+    ``(stages, weights)``: for each stage ``i >= 1`` the pair
+    ``(c_i h, ((j, a_ij h), ...))``, and the weights as
+    ``((b h, i0, (i, ...)), ...)``, the stages of equal ``b`` summed before
+    they are scaled, so RK4's step is ``x + h/6 (k1 + k4) + h/3 (k2 + k3)``.
+    """
+    stages, weights = _structure(tab)
+    return (
+        tuple((c * h, tuple((j, a * h) for j, a in terms)) for c, terms in stages),
+        tuple((bi * h, idx[0], idx[1:]) for bi, idx in weights),
+    )
+
+
+def _steps(f, ts, plans, x, buf):
+    """One step from each time ``ts[m]`` with ``plans[m]``; ``buf[m + 1]`` gets its end.
+
+    The plain stage loop of scipy's ``rk_step`` (integrate/_ivp/rk.py) over
+    the tableau as data: ``plans[m]`` holds the non-zero coefficients
+    already multiplied by the step (`_plan`), so zero entries cost nothing.
+    """
+    m = 0
+    for t, (stages, weights) in zip(ts, plans):
+        k = [f(t, x)]
+        for hc, terms in stages:
+            xi = x
+            for j, ha in terms:
+                xi = xi + ha * k[j]
+            k.append(f(t + hc, xi))
+        for hb, i0, rest in weights:
+            ks = k[i0]
+            for i in rest:
+                ks = ks + k[i]
+            x = x + hb * ks
+        m += 1
+        buf[m] = x
+    return x
+
+
+def _run(f, tab, tt, x, out, start, stop, substeps, dt, plans):
+    """Step from ``tt[start]`` to ``tt[stop]``, writing ``out[n + 1]``; return x.
+
+    On a uniform grid (``dt`` its step) every step has one plan; otherwise
+    each interval has its own, kept in ``plans`` by step size (a nearly
+    even grid has a few rounded variants). With substeps, the steps inside
+    the intervals go to a scratch buffer and every ``substeps``-th is kept.
+    """
+    if dt is not None:
+        h = dt / substeps
+        plan = plans.get(h)
+        if plan is None:
+            plan = plans[h] = _plan(tab, h)
+        hs = [h] * (stop - start)
+        step_plans = [plan] * ((stop - start) * substeps)
+    else:
+        hs = [(tt[n + 1] - tt[n]) / substeps for n in range(start, stop)]
+        if len(plans) > _PLANS:
+            plans.clear()
+        step_plans = []
+        for h in hs:
+            plan = plans.get(h)
+            if plan is None:
+                plan = plans[h] = _plan(tab, h)
+            step_plans += [plan] * substeps
+    if substeps == 1:
+        return _steps(f, tt[start:stop], step_plans, x, out[start:])
+    ts = [tt[n] + sub * h for n, h in zip(range(start, stop), hs) for sub in range(substeps)]
+    buf = np.empty((len(ts) + 1,) + x.shape, dtype=out.dtype)
+    x = _steps(f, ts, step_plans, x, buf)
+    out[start + 1 : stop + 1] = buf[substeps::substeps]
+    return x
 
 
 def check_substeps(substeps) -> int:
@@ -159,7 +277,9 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     """Solve ``x' = f(t, x)`` with a fixed-step explicit Runge–Kutta method.
 
     Each interval ``[t[i], t[i+1]]`` of the grid is split into ``substeps``
-    equal steps ``h``; one step is
+    equal steps ``h``; on a grid that `uniform_step` finds uniform, every
+    interval is taken as its step ``Δt`` (the grid's points differ from
+    ``t[0] + iΔt`` only by their rounding). One step is
 
     .. math::
 
@@ -174,7 +294,9 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     t : array_like, shape (N,)
         Output times, strictly increasing; need not be uniform.
     x0 : array_like, shape (n,) or (m, n)
-        Initial state, or ``m`` initial states stepped together.
+        Initial state, or ``m`` initial states stepped together. As in
+        scipy's `solve_ivp`, a complex ``x0`` makes the integration
+        complex; with a real ``x0``, ``f`` must return real values.
     method : str or ButcherTableau, default ``'rk4'``
         A name in `qc_control.METHODS` or any explicit tableau.
     substeps : int, default 1
@@ -185,7 +307,24 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     Solution
         If the state becomes non-finite, the run stops there: a
         `DivergenceWarning` is issued and the solution holds the samples
-        up to the last finite one, with ``status='diverged'``.
+        up to the last finite one, with ``status='diverged'``. Every
+        sample is checked; a non-finite state is never a success.
+
+    Raises
+    ------
+    ValueError
+        For a bad ``t``, ``x0`` or ``substeps``, naming it and its value.
+    TypeError
+        For an ``f`` that is not callable, or that returns complex values
+        on a real state.
+
+    Notes
+    -----
+    The loop is scipy's plain stage loop (``rk_step`` in
+    ``scipy/integrate/_ivp/rk.py``) over the tableau as data, with the
+    non-zero ``h a_ij``, ``h b_i`` and ``c_i h`` computed once per step
+    size and zero entries skipped; stages of equal weight are summed
+    before they are scaled.
 
     Examples
     --------
@@ -197,22 +336,31 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     tab = get_method(method)
     t = check_time_grid(t, "t")
     substeps = check_substeps(substeps)
-    x = np.array(x0, dtype=float)
-    if x.ndim not in (1, 2) or x.size == 0:
-        raise ValueError(f"x0 must have shape (n,) or (m, n), got {x.shape}")
-    if not np.all(np.isfinite(x)):
-        raise ValueError("x0 must be finite")
+    if not callable(f):
+        raise TypeError(f"f must be callable as f(t, x), got {type(f).__name__} {_show(f)}")
+    x = _initial_state(x0)
 
-    run = _compiled_loop(tab, substeps > 1)
-    out = np.empty((t.size,) + x.shape)
+    dt = uniform_step(t)  # a uniform grid is stepped with its one step, like the LTI engine
+    out = np.empty((t.size,) + x.shape, dtype=x.dtype)
     out[0] = x
     tt = t.tolist()
+    plans: dict = {}
     n_last, n_computed, status, message = t.size - 1, t.size - 1, "success", ""
-    with np.errstate(over="ignore", invalid="ignore"):
+    with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings():
+        # a complex f on a real state would lose its imaginary part in `out`
+        warnings.simplefilter("error", np.exceptions.ComplexWarning)
         for start in range(0, t.size - 1, _CHECK_EVERY):
             stop = min(start + _CHECK_EVERY, t.size - 1)
-            x = run(f, tt, x, out, start, stop, substeps)
+            try:
+                x = _run(f, tab, tt, x, out, start, stop, substeps, dt, plans)
+            except np.exceptions.ComplexWarning:
+                raise TypeError(
+                    "f returned complex values for a real x0; pass a complex x0 (e.g. "
+                    "x0 + 0j) to integrate in complex arithmetic, as scipy's solve_ivp does"
+                ) from None
             block = out[start + 1 : stop + 1]
+            if np.isfinite(block).all():
+                continue
             bad = ~np.isfinite(block.reshape(block.shape[0], -1)).all(axis=1)
             if bad.any():
                 n_last = start + int(np.argmax(bad))
@@ -234,3 +382,19 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
         status=status,
         message=message,
     )
+
+
+def _initial_state(x0) -> np.ndarray:
+    """``x0`` as a float (or, if complex, complex) array of shape (n,) or (m, n)."""
+    try:
+        x = np.array(x0)
+        x = x.astype(complex if np.iscomplexobj(x) else float)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"x0 must be an array of real or complex numbers, got {_show(x0)}"
+        ) from None
+    if x.ndim not in (1, 2) or x.size == 0:
+        raise ValueError(f"x0 must have shape (n,) or (m, n), got {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise ValueError(f"x0 must be finite, got {_show(x0)}")
+    return x
