@@ -430,7 +430,7 @@ def compare_methods(
         mine = conv[(conv["method"] == tab.name) & (conv["level"] <= 2)]
         order = _observed_order(mine["h"], mine["error"]) if mine["stable"].all() else math.nan
 
-        nm[tab.name] = numerical_modes(tab, h, sys)
+        nm[tab.name] = numerical_modes(tab, h, modes)
         row = {
             "order": tab.order,
             "stages": tab.stages,
