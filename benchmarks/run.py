@@ -5,7 +5,7 @@
     python benchmarks/run.py --loop     # only qc.integrate against hand-written loops
 
 Every speed is a ratio measured in this run on this machine (best of several
-repeats, or for the stepping loop the medians of alternating runs), because
+repeats, or for the stepping loop medians of alternating runs in CPU time), because
 the machines are shared and noisy; absolute times are
 printed for context only. Benchmarks are not tests: nothing here fails on a
 slow machine.
@@ -38,11 +38,13 @@ def best_of(fn, repeats: int) -> float:
     return best_time(fn, repeats, warmup=True)
 
 
-def paired_medians(fn_a, fn_b, repeats: int) -> tuple[float, float]:
-    """Median times of ``fn_a`` and ``fn_b``, timed alternately in one run.
+def paired_medians(fn_a, fn_b, repeats: int) -> tuple[float, float, float]:
+    """Median CPU times of ``fn_a`` and ``fn_b``, and the median of their ratios.
 
     After one untimed call of each, the two are timed in turns (a b, b a, a b,
-    ...), so that a change of load on a shared machine falls on both sides.
+    ...) in CPU time of this process (``time.process_time``), so that other
+    processes on a shared machine count on neither side; each pair's ratio
+    ``b / a`` compares two runs made within a fraction of a second.
     """
     fn_a()
     fn_b()
@@ -50,10 +52,11 @@ def paired_medians(fn_a, fn_b, repeats: int) -> tuple[float, float]:
     for r in range(repeats):
         for side in (0, 1) if r % 2 == 0 else (1, 0):
             fn = (fn_a, fn_b)[side]
-            start = time.perf_counter()
+            start = time.process_time()
             fn()
-            times[side].append(time.perf_counter() - start)
-    return statistics.median(times[0]), statistics.median(times[1])
+            times[side].append(time.process_time() - start)
+    ratios = [b / a for a, b in zip(*times)]
+    return statistics.median(times[0]), statistics.median(times[1]), statistics.median(ratios)
 
 
 # -- hand-written loops: what a student writes, the yardstick for the generic stepper
@@ -122,15 +125,16 @@ def loop_comparison(f, T, repeats: int):
     """``qc.integrate`` against the hand-written loops: header, rows, and a caption."""
     rows = []
     for m, hand in HAND.items():
-        t_hand, t_gen = paired_medians(
+        t_hand, t_gen, ratio = paired_medians(
             lambda: hand(f, T, X0), lambda: qc.integrate(f, T, X0, m), repeats
         )
-        rows.append([m, g(t_hand * 1e3), g(t_gen * 1e3), g(t_gen / t_hand)])
+        rows.append([m, g(t_hand * 1e3), g(t_gen * 1e3), g(ratio)])
     head = ["method", "hand loop [ms]", "qc.integrate [ms]", "ratio (target ≤ 1.2)"]
     text = (
         "Both call the same Python `f(t, x) = A @ x`. `qc.integrate` is a plain loop over "
         "the tableau as data (no generated code): the non-zero h·a_ij, h·b_i and c_i·h once "
-        f"per step size. Medians of {repeats} runs of each, timed in turns."
+        f"per step size. CPU times, medians of {repeats} runs of each timed in turns; the "
+        "ratio is the median of the ratios of the pairs."
     )
     return head, rows, text
 

@@ -28,9 +28,6 @@ _CHECK_EVERY = 128
 #: sit this far from ``T[0] + k·dt`` and the grid still counts as uniform.
 UNIFORM_RTOL = 4
 
-#: Step sizes whose coefficient plans `_run` keeps (a linspace grid has ~20).
-_PLANS = 64
-
 #: Grid points `uniform_step` checks per vectorised chunk (bounds its memory).
 _CHUNK = 1 << 20
 
@@ -175,93 +172,86 @@ def uniform_step(T, *, rtol=None, atol=None) -> float | None:
 
 @functools.lru_cache(maxsize=64)
 def _structure(tab: ButcherTableau):
-    """The tableau's non-zero entries, by stage: ``(stages, weights)``.
+    """The tableau's non-zero entries as loop data: ``(coefficients, stages, first, others)``.
 
-    ``stages[i - 1] = (c_i, ((j, a_ij), ...))`` over ``a_ij != 0``, for each
-    stage ``i >= 1``; ``weights = ((b, (i, ...)), ...)`` groups the stages
-    of equal weight ``b_i != 0``.
+    ``coefficients`` lists the non-zero ``c_i``, ``a_ij`` and ``b`` values
+    once; the rest refers to them by position ``p``. ``stages`` holds, for
+    each stage ``i >= 1``, ``(p of c_i, ((j, p of a_ij), ...))`` over
+    ``a_ij != 0`` (a zero ``c_i`` points at the appended 0.0). The weights
+    are groups ``(p of b, i0, (i, ...))`` of the stages with equal ``b``,
+    summed before they are scaled (RK4's step is
+    ``x + h/6 (k1 + k4) + h/3 (k2 + k3)``), the first group apart.
     """
     a, b, c = tab.a.tolist(), tab.b.tolist(), tab.c.tolist()
+    coefficients: list[float] = [0.0]
+
+    def at(value: float) -> int:
+        coefficients.append(value)
+        return len(coefficients) - 1
+
     stages = tuple(
-        (c[i], tuple((j, a[i][j]) for j in range(i) if a[i][j] != 0)) for i in range(1, tab.stages)
+        (at(c[i]) if c[i] else 0, tuple((j, at(a[i][j])) for j in range(i) if a[i][j] != 0))
+        for i in range(1, tab.stages)
     )
     groups: dict[float, list[int]] = {}
     for i, bi in enumerate(b):
         if bi != 0:
             groups.setdefault(bi, []).append(i)
-    return stages, tuple((bi, tuple(idx)) for bi, idx in groups.items())
+    weights = tuple((at(bi), idx[0], tuple(idx[1:])) for bi, idx in groups.items())
+    return np.array(coefficients), stages, weights[0], weights[1:]
 
 
-def _plan(tab: ButcherTableau, h: float):
-    """The step's non-zero coefficients times ``h``, as loop data.
-
-    ``(stages, weights)``: for each stage ``i >= 1`` the pair
-    ``(c_i h, ((j, a_ij h), ...))``, and the weights as
-    ``((b h, i0, (i, ...)), ...)``, the stages of equal ``b`` summed before
-    they are scaled, so RK4's step is ``x + h/6 (k1 + k4) + h/3 (k2 + k3)``.
-    """
-    stages, weights = _structure(tab)
-    return (
-        tuple((c * h, tuple((j, a * h) for j, a in terms)) for c, terms in stages),
-        tuple((bi * h, idx[0], idx[1:]) for bi, idx in weights),
-    )
-
-
-def _steps(f, ts, plans, x, buf):
-    """One step from each time ``ts[m]`` with ``plans[m]``; ``buf[m + 1]`` gets its end.
+def _steps(f, ts, rows, x, buf, structure):
+    """One step from each time ``ts[m]`` with coefficients ``rows[m]``; ``buf[m + 1]`` its end.
 
     The plain stage loop of scipy's ``rk_step`` (integrate/_ivp/rk.py) over
-    the tableau as data: ``plans[m]`` holds the non-zero coefficients
-    already multiplied by the step (`_plan`), so zero entries cost nothing.
+    the tableau as data: ``rows[m]`` holds the non-zero coefficients times
+    the step ``h`` (`_structure`), so zero entries cost nothing.
     """
+    _, stages, (pb, i0, rest), others = structure
     m = 0
-    for t, (stages, weights) in zip(ts, plans):
+    for t, v in zip(ts, rows):
         k = [f(t, x)]
-        for hc, terms in stages:
+        for pc, terms in stages:
             xi = x
-            for j, ha in terms:
-                xi = xi + ha * k[j]
-            k.append(f(t + hc, xi))
-        for hb, i0, rest in weights:
-            ks = k[i0]
-            for i in rest:
+            for j, pa in terms:
+                xi = xi + v[pa] * k[j]
+            k.append(f(t + v[pc], xi))
+        ks = k[i0]
+        for i in rest:
+            ks = ks + k[i]
+        x = x + v[pb] * ks
+        for pb_, i0_, rest_ in others:
+            ks = k[i0_]
+            for i in rest_:
                 ks = ks + k[i]
-            x = x + hb * ks
+            x = x + v[pb_] * ks
         m += 1
         buf[m] = x
     return x
 
 
-def _run(f, tab, tt, x, out, start, stop, substeps, dt, plans):
+def _run(f, tab, tt, x, out, start, stop, substeps, dt):
     """Step from ``tt[start]`` to ``tt[stop]``, writing ``out[n + 1]``; return x.
 
-    On a uniform grid (``dt`` its step) every step has one plan; otherwise
-    each interval has its own, kept in ``plans`` by step size (a nearly
-    even grid has a few rounded variants). With substeps, the steps inside
-    the intervals go to a scratch buffer and every ``substeps``-th is kept.
+    The coefficients times ``h`` are formed once for a uniform grid (``dt``
+    its step), else once per interval in one vectorised product. With
+    substeps, the steps inside the intervals go to a scratch buffer and
+    every ``substeps``-th is kept.
     """
+    structure = _structure(tab)
+    coefficients, n = structure[0], stop - start
     if dt is not None:
-        h = dt / substeps
-        plan = plans.get(h)
-        if plan is None:
-            plan = plans[h] = _plan(tab, h)
-        hs = [h] * (stop - start)
-        step_plans = [plan] * ((stop - start) * substeps)
+        rows = [(coefficients * (dt / substeps)).tolist()] * (n * substeps)
+        hs = [dt / substeps] * n
     else:
-        hs = [(tt[n + 1] - tt[n]) / substeps for n in range(start, stop)]
-        if len(plans) > _PLANS:
-            plans.clear()
-        step_plans = []
-        for h in hs:
-            plan = plans.get(h)
-            if plan is None:
-                plan = plans[h] = _plan(tab, h)
-            step_plans += [plan] * substeps
+        hs = [(tt[i + 1] - tt[i]) / substeps for i in range(start, stop)]
+        rows = (np.repeat(hs, substeps)[:, None] * coefficients).tolist()
     if substeps == 1:
-        return _steps(f, tt[start:stop], step_plans, x, out[start:])
-    ts = [tt[n] + sub * h for n, h in zip(range(start, stop), hs) for sub in range(substeps)]
+        return _steps(f, tt[start:stop], rows, x, out[start:], structure)
+    ts = [tt[i] + sub * h for i, h in zip(range(start, stop), hs) for sub in range(substeps)]
     buf = np.empty((len(ts) + 1,) + x.shape, dtype=out.dtype)
-    x = _steps(f, ts, step_plans, x, buf)
+    x = _steps(f, ts, rows, x, buf, structure)
     out[start + 1 : stop + 1] = buf[substeps::substeps]
     return x
 
@@ -344,7 +334,6 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     out = np.empty((t.size,) + x.shape, dtype=x.dtype)
     out[0] = x
     tt = t.tolist()
-    plans: dict = {}
     n_last, n_computed, status, message = t.size - 1, t.size - 1, "success", ""
     with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings():
         # a complex f on a real state would lose its imaginary part in `out`
@@ -352,7 +341,7 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
         for start in range(0, t.size - 1, _CHECK_EVERY):
             stop = min(start + _CHECK_EVERY, t.size - 1)
             try:
-                x = _run(f, tab, tt, x, out, start, stop, substeps, dt, plans)
+                x = _run(f, tab, tt, x, out, start, stop, substeps, dt)
             except np.exceptions.ComplexWarning:
                 raise TypeError(
                     "f returned complex values for a real x0; pass a complex x0 (e.g. "
