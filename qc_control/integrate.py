@@ -8,7 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .methods import ButcherTableau, _show, get_method
+from .messages import show
+from .methods import ButcherTableau, get_method
 
 __all__ = [
     "Solution",
@@ -95,7 +96,7 @@ def check_time_grid(t, name: str = "T") -> np.ndarray:
     try:
         t = np.asarray(t, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be an array of real times [s], got {_show(t)}") from None
+        raise ValueError(f"{name} must be an array of real times [s], got {show(t)}") from None
     if t.ndim != 1 or t.size < 2:
         raise ValueError(f"{name} must be a 1-D array of at least 2 times, got shape {t.shape}")
     if not np.all(np.isfinite(t)):
@@ -327,7 +328,7 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     t = check_time_grid(t, "t")
     substeps = check_substeps(substeps)
     if not callable(f):
-        raise TypeError(f"f must be callable as f(t, x), got {type(f).__name__} {_show(f)}")
+        raise TypeError(f"f must be callable as f(t, x), got {show(f)}")
     x = _initial_state(x0)
 
     dt = uniform_step(t)  # a uniform grid is stepped with its one step, like the LTI engine
@@ -380,10 +381,10 @@ def _initial_state(x0) -> np.ndarray:
         x = x.astype(complex if np.iscomplexobj(x) else float)
     except (TypeError, ValueError):
         raise ValueError(
-            f"x0 must be an array of real or complex numbers, got {_show(x0)}"
+            f"x0 must be an array of real or complex numbers, got {show(x0)}"
         ) from None
     if x.ndim not in (1, 2) or x.size == 0:
         raise ValueError(f"x0 must have shape (n,) or (m, n), got {x.shape}")
     if not np.all(np.isfinite(x)):
-        raise ValueError(f"x0 must be finite, got {_show(x0)}")
+        raise ValueError(f"x0 must be finite, got {show(x0)}")
     return x

@@ -14,26 +14,18 @@ four entries of `METHODS`.
 
 from __future__ import annotations
 
-import reprlib
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
+from .messages import show
 from .order_conditions import MAX_ORDER, check_order
 
 __all__ = ["ButcherTableau", "METHODS", "get_method", "EULER", "MIDPOINT", "HEUN", "RK4"]
 
 _EPS = np.finfo(float).eps
-
-
-_REPR = reprlib.Repr()
-_REPR.maxlist = _REPR.maxtuple = 6
-_REPR.maxstring = _REPR.maxother = 40
-
-
-def _show(value) -> str:
-    """A short repr of a user's value for an error message."""
-    return _REPR.repr(value)
 
 
 def _real_array(value, what: str, where: str) -> np.ndarray:
@@ -44,9 +36,9 @@ def _real_array(value, what: str, where: str) -> np.ndarray:
             raise TypeError
         arr = arr.astype(float)
     except (TypeError, ValueError):
-        raise ValueError(f"{where}: {what} must be real numbers, got {_show(value)}") from None
+        raise ValueError(f"{where}: {what} must be real numbers, got {show(value)}") from None
     if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{where}: {what} must be finite, got {_show(value)}")
+        raise ValueError(f"{where}: {what} must be finite, got {show(value)}")
     return arr
 
 
@@ -105,12 +97,23 @@ class ButcherTableau:
     name: str
     a: np.ndarray
     b: np.ndarray
-    c: np.ndarray | None = None
-    order: int | None = None
+    c: np.ndarray = None  # type: ignore[assignment]  # None: the row sums of a
+    order: int = None  # type: ignore[assignment]  # None: computed
+
+    if TYPE_CHECKING:  # what the generated __init__ accepts; each field ends an array/int
+
+        def __init__(
+            self,
+            name: str,
+            a: npt.ArrayLike,
+            b: npt.ArrayLike,
+            c: npt.ArrayLike | None = None,
+            order: int | None = None,
+        ) -> None: ...
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
-            raise ValueError(f"tableau name must be a non-empty string, got {_show(self.name)}")
+            raise ValueError(f"tableau name must be a non-empty string, got {show(self.name)}")
         where = f"tableau {self.name!r}"
         a = _real_array(self.a, "a", where)
         b = _real_array(self.b, "b", where)
@@ -135,7 +138,7 @@ class ButcherTableau:
         if claimed is not None and (
             isinstance(claimed, bool) or not isinstance(claimed, (int, np.integer)) or claimed < 1
         ):
-            raise ValueError(f"{where}: order must be a positive integer, got {_show(claimed)}")
+            raise ValueError(f"{where}: order must be a positive integer, got {show(claimed)}")
         top = min(s, MAX_ORDER)  # an explicit s-stage method has order <= s
         if claimed is not None:
             # up to order s + 1 when more is claimed, to name the first failing tree
@@ -194,15 +197,17 @@ class ButcherTableau:
 #: Forward Euler: x + h f(x) (seed, 4.2.1).
 EULER = ButcherTableau("euler", a=[[0.0]], b=[1.0], c=[0.0], order=1)
 #: Explicit midpoint: x + h f(x + h/2 f(x)) (seed, 4.2.2).
-MIDPOINT = ButcherTableau("midpoint", a=[[0, 0], [0.5, 0]], b=[0, 1], c=[0, 0.5], order=2)
+MIDPOINT = ButcherTableau(
+    "midpoint", a=[[0.0, 0.0], [0.5, 0.0]], b=[0.0, 1.0], c=[0.0, 0.5], order=2
+)
 #: Heun: x + h/2 (f(x) + f(x + h f(x))) (seed, 4.2.4).
 HEUN = ButcherTableau("heun", a=[[0, 0], [1, 0]], b=[0.5, 0.5], c=[0, 1], order=2)
 #: Classic RK4: x + h/6 (k1 + 2 k2 + 2 k3 + k4) (seed, 4.2.3).
 RK4 = ButcherTableau(
     "rk4",
-    a=[[0, 0, 0, 0], [0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 1, 0]],
+    a=[[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, 0.0, 0.0], [0.0, 0.5, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]],
     b=[1 / 6, 1 / 3, 1 / 3, 1 / 6],
-    c=[0, 0.5, 0.5, 1],
+    c=[0.0, 0.5, 0.5, 1.0],
     order=4,
 )
 
@@ -232,5 +237,5 @@ def get_method(method) -> ButcherTableau:
             ) from None
     raise TypeError(
         f"method must be a name in METHODS ({', '.join(METHODS)}) or a ButcherTableau, "
-        f"got {type(method).__name__} {_show(method)}"
+        f"got {show(method)}"
     )

@@ -32,7 +32,8 @@ import numpy as np
 import pandas as pd
 from numpy.polynomial import Polynomial
 
-from .methods import _show, get_method
+from .messages import show
+from .methods import get_method
 
 __all__ = [
     "stability_function",
@@ -141,21 +142,14 @@ def eigenvalues_of(system_or_eigenvalues) -> np.ndarray:
         "or a 1-D array of eigenvalues"
     )
     if isinstance(obj, (str, bytes, dict, control.InputOutputSystem)) or obj is None:
-        raise TypeError(f"expected {expected}, got {type(obj).__name__} {_short(obj)}")
+        raise TypeError(f"expected {expected}, got {show(obj)}")
     try:
         lam = np.atleast_1d(np.asarray(obj, dtype=complex))
     except (TypeError, ValueError):
-        raise TypeError(f"expected {expected}, got {type(obj).__name__} {_short(obj)}") from None
+        raise TypeError(f"expected {expected}, got {show(obj)}") from None
     if lam.ndim != 1 or not np.all(np.isfinite(lam)):
-        raise ValueError(f"eigenvalues must be a finite 1-D array, got {_show(obj)}")
+        raise ValueError(f"eigenvalues must be a finite 1-D array, got {show(obj)}")
     return lam
-
-
-def _short(obj) -> str:
-    """A value for a message: its repr if short and simple, else nothing."""
-    if isinstance(obj, (str, bytes, int, float, complex, list, tuple, dict)) or obj is None:
-        return _show(obj)
-    return ""
 
 
 def _batch_eigenvalues(system_or_eigenvalues) -> np.ndarray:
@@ -226,7 +220,7 @@ def step_is_stable(method, h: float, eigenvalues):
     (False, True)
     """
     if not (isinstance(h, (int, float, np.number)) and not isinstance(h, bool)) or not h >= 0:
-        raise ValueError(f"h must be a step >= 0 s, got {_show(h)}")
+        raise ValueError(f"h must be a step >= 0 s, got {show(h)}")
     coef = stability_coefficients(method)
     lam = _settle(_batch_eigenvalues(eigenvalues))
     radius = np.abs(np.polynomial.polynomial.polyval(h * lam, coef))
@@ -347,10 +341,10 @@ def _mode_rows(modes_or_system):
         if not rows:
             raise ValueError(f"{type(modes_or_system).__name__}.modes is empty")
         return rows
-    lam = eigenvalues_of(modes_or_system)
-    reps = np.unique(np.where(lam.imag < 0, lam.conj(), lam))  # each pair once
-    reps = sorted(reps, key=lambda x: (abs(x), x.imag))
-    return [(f"mode {i + 1}", complex(x), None) for i, x in enumerate(reps)]
+    eig = eigenvalues_of(modes_or_system)
+    reps = np.unique(np.where(eig.imag < 0, eig.conj(), eig))  # each pair once
+    ordered = sorted((complex(x) for x in reps), key=lambda x: (abs(x), x.imag))
+    return [(f"mode {i + 1}", x, None) for i, x in enumerate(ordered)]
 
 
 def _numerical_eigenvalue(coef: np.ndarray, h: float, lam: complex) -> tuple[complex, float]:
@@ -444,7 +438,7 @@ def numerical_modes(method, h: float, modes) -> pd.DataFrame:
         or not math.isfinite(h)
         or h <= 0
     ):
-        raise ValueError(f"h must be a finite step > 0 s, got {_show(h)}")
+        raise ValueError(f"h must be a finite step > 0 s, got {show(h)}")
     coef = stability_coefficients(method)
     rows = {}
     for name, lam, mode_zeta in _mode_rows(modes):

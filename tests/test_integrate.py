@@ -121,7 +121,7 @@ def test_bad_substeps(bad):
 
 
 def test_f_must_be_callable():
-    with pytest.raises(TypeError, match="f must be callable as f\\(t, x\\), got str 'A x'"):
+    with pytest.raises(TypeError, match="f must be callable as f\\(t, x\\), got 'A x'"):
         integrate("A x", [0, 1], [1.0])
 
 
