@@ -318,9 +318,3 @@ def run(argv: list[str]) -> int:
     except (UsageError, ScenarioError) as exc:
         print(f"{_PROG}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
-
-
-if __name__ == "__main__":  # pragma: no cover
-    from .console import main
-
-    sys.exit(main())

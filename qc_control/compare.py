@@ -479,7 +479,7 @@ def mode_errors(
     eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
     per_method, rows = {}, {}
     for tab in methods:
-        nm = numerical_modes(tab, h, sys)
+        nm = numerical_modes(tab, h, modes)
         per_method[tab.name] = nm
         h_max = max_stable_step(tab, eig)
         row = {

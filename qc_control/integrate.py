@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .messages import show
 from .methods import ButcherTableau, get_method
 
 __all__ = [
@@ -17,11 +18,19 @@ __all__ = [
     "check_time_grid",
     "check_substeps",
     "uniform_step",
+    "UNIFORM_RTOL",
 ]
 
 #: Intervals between checks for a non-finite state. Checking every step would
 #: cost about as much as a stage; a blow-up is still cut at its first bad sample.
-_CHECK_EVERY = 64
+_CHECK_EVERY = 128
+
+#: `uniform_step`'s tolerance, in units of ``eps·max|T|``: a grid point may
+#: sit this far from ``T[0] + k·dt`` and the grid still counts as uniform.
+UNIFORM_RTOL = 4
+
+#: Grid points `uniform_step` checks per vectorised chunk (bounds its memory).
+_CHUNK = 1 << 20
 
 
 class DivergenceWarning(RuntimeWarning):
@@ -30,7 +39,7 @@ class DivergenceWarning(RuntimeWarning):
 
 @dataclass(frozen=True, eq=False)
 class Solution:
-    """The result of `integrate`.
+    """The result of `integrate` (and of the LTI engine, `qc_control.lti.lti_solve`).
 
     Attributes
     ----------
@@ -38,6 +47,7 @@ class Solution:
         The output times: the grid given, cut at divergence.
     x : ndarray, shape (n, N), or (m, n, N) for a batch
         The state at each output time (time last, as in python-control).
+        Real, or complex when ``x0`` is complex.
     nfev : int
         Right-hand-side evaluations made: ``stages * steps`` (one call of
         ``f`` per stage, whatever the batch size).
@@ -47,6 +57,11 @@ class Solution:
     status : str
         ``'success'`` or ``'diverged'``.
     message : str
+
+    Notes
+    -----
+    A Solution whose ``x`` holds a nan or an inf is never a success: it
+    is built with ``status='diverged'`` whatever status it was given.
     """
 
     t: np.ndarray
@@ -57,20 +72,36 @@ class Solution:
     status: str
     message: str
 
+    def __post_init__(self):
+        if self.status not in ("success", "diverged"):
+            raise ValueError(f"status must be 'success' or 'diverged', got {self.status!r}")
+        if self.status == "success" and not np.all(np.isfinite(self.x)):
+            object.__setattr__(self, "status", "diverged")
+            note = "the state holds non-finite values"
+            object.__setattr__(self, "message", "; ".join(filter(None, [self.message, note])))
+
     @property
     def success(self) -> bool:
         return self.status == "success"
 
 
 def check_time_grid(t, name: str = "T") -> np.ndarray:
-    """``t`` as a float array: 1-D, at least 2 points, finite, increasing."""
-    t = np.asarray(t, dtype=float)
+    """``t`` as a float array: 1-D, at least 2 points, finite, increasing.
+
+    Raises
+    ------
+    ValueError
+        Naming ``name`` and the offending value.
+    """
+    try:
+        t = np.asarray(t, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be an array of real times [s], got {show(t)}") from None
     if t.ndim != 1 or t.size < 2:
         raise ValueError(f"{name} must be a 1-D array of at least 2 times, got shape {t.shape}")
     if not np.all(np.isfinite(t)):
-        raise ValueError(
-            f"{name} must be finite; first bad value at index {int(np.argmin(np.isfinite(t)))}"
-        )
+        i = int(np.argmin(np.isfinite(t)))
+        raise ValueError(f"{name} must be finite; {name}[{i}] = {float(t[i])!r}")
     steps = np.diff(t)
     if np.any(steps <= 0):
         i = int(np.argmax(steps <= 0))
@@ -81,71 +112,145 @@ def check_time_grid(t, name: str = "T") -> np.ndarray:
     return t
 
 
-def _loop_source(tab: ButcherTableau, substeps: bool) -> str:
-    """Python source of the stepping loop for one tableau, stages unrolled.
+def uniform_step(T) -> float | None:
+    r"""The step of an evenly spaced grid ``T``, or None.
 
-    The coefficients are data, but a loop over them per step costs as much
-    as a stage; writing them into the code once gives the loop a hand-written
-    one would have. Stages of equal weight share one multiplication.
+    ``T`` is uniform when every point lies on the line through its ends
+    to within the rounding of the points themselves:
+
+    .. math::
+
+        \max_k \big|T_k - (T_0 + k\,\Delta t)\big| \le 4\,\varepsilon \max_k |T_k|,
+        \qquad \Delta t = \frac{T_{N-1} - T_0}{N - 1}
+
+    (``ε`` the double-precision machine epsilon; the factor is
+    `UNIFORM_RTOL`). Every step then equals ``Δt`` to within twice that.
+    A grid built as ``np.linspace``, ``np.arange`` or ``T0 + k*dt`` sits
+    within about one unit in the last place (``≤ ε max|T|``) of that line,
+    at any length: ``np.linspace(0, 1e6, 10**8 + 1)`` is uniform. A grid
+    that was jittered, or summed step by step (``np.cumsum``, whose
+    rounding drifts by hundreds of ulps), is not.
+
+    The bound is on the points, not only on the steps, so that stepping
+    with ``Δt`` puts every sample within ``4 ε max|T|`` of its time in
+    ``T``. The LTI engine, which assumes ``Δt``, then reproduces the
+    generic stepper on ``T`` to about ``|λ|max · 4 ε max|T|`` relative
+    (about 2e-13 for the seed's car over 10 s), besides rounding.
+
+    Parameters
+    ----------
+    T : array_like, shape (N,)
+        Times, checked by `check_time_grid`.
+
+    Returns
+    -------
+    float or None
+        ``Δt``, or None when ``T`` is not uniform.
+
+    Examples
+    --------
+    >>> uniform_step(np.linspace(0, 1, 101))
+    0.01
+    >>> T = np.linspace(0, 1, 101)
+    >>> T[50] += 1e-9
+    >>> uniform_step(T) is None
+    True
     """
-    s = tab.stages
-    a, b, c = tab.a.tolist(), tab.b.tolist(), tab.c.tolist()
-    coef = []
-    lines = [
-        "def run(f, tt, x, out, start, stop, substeps):",
-        "    h_prev = None",
-        "    for n in range(start, stop):",
-        "        t = tt[n]",
-        "        h = (tt[n + 1] - t) / substeps" if substeps else "        h = tt[n + 1] - t",
-        "        if h != h_prev:",
-        "            h_prev = h",
-    ]
-    for i in range(s):
-        if c[i] not in (0.0, 1.0):
-            coef.append(f"            hc{i} = h * {c[i]!r}")
-        for j in range(i):
-            if a[i][j]:
-                coef.append(f"            ha{i}_{j} = h * {a[i][j]!r}")
-    weights: dict[float, list[int]] = {}
-    for i in range(s):
-        if b[i]:
-            weights.setdefault(b[i], []).append(i)
-    for g, w in enumerate(weights):
-        coef.append(f"            hb{g} = h * {w!r}")
-    lines += coef
-    body = []
-    if substeps:
-        body += [
-            "        t0 = t",
-            "        for sub in range(substeps):",
-            "            t = t0 + sub * h",
-        ]
-    pad = "            " if substeps else "        "
-    for i in range(s):
-        ti = "t" if c[i] == 0.0 else "t + h" if c[i] == 1.0 else f"t + hc{i}"
-        xi = "x" + "".join(f" + ha{i}_{j} * k{j}" for j in range(i) if a[i][j])
-        body.append(f"{pad}k{i} = f({ti}, {xi})")
-    terms = []
-    for g, idx in enumerate(weights.values()):
-        ks = " + ".join(f"k{i}" for i in idx)
-        terms.append(f"hb{g} * ({ks})" if len(idx) > 1 else f"hb{g} * {ks}")
-    body.append(f"{pad}x = x + " + " + ".join(terms))
-    lines += body + ["        out[n + 1] = x", "    return x", ""]
-    return "\n".join(lines)
+    T = check_time_grid(T, "T")
+    N = T.size
+    dt = (T[-1] - T[0]) / (N - 1)
+    tol = UNIFORM_RTOL * np.finfo(float).eps * max(abs(T[0]), abs(T[-1]))
+    for lo in range(0, N, _CHUNK):  # in chunks: a 10**8-point grid needs no 800 MB copy
+        k = np.arange(lo, min(lo + _CHUNK, N), dtype=float)
+        if np.max(np.abs(T[lo : lo + k.size] - (T[0] + k * dt))) > tol:
+            return None
+    return float(dt)
 
 
 @functools.lru_cache(maxsize=64)
-def _compiled_loop(tab: ButcherTableau, substeps: bool):
-    namespace: dict = {}
-    exec(compile(_loop_source(tab, substeps), f"<qc_control loop: {tab.name}>", "exec"), namespace)
-    return namespace["run"]
+def _structure(tab: ButcherTableau):
+    """The tableau's non-zero entries as loop data: ``(coefficients, stages, first, others)``.
+
+    ``coefficients`` lists the non-zero ``c_i``, ``a_ij`` and ``b`` values
+    once; the rest refers to them by position ``p``. ``stages`` holds, for
+    each stage ``i >= 1``, ``(p of c_i, ((j, p of a_ij), ...))`` over
+    ``a_ij != 0`` (a zero ``c_i`` points at the appended 0.0). The weights
+    are groups ``(p of b, i0, (i, ...))`` of the stages with equal ``b``,
+    summed before they are scaled (RK4's step is
+    ``x + h/6 (k1 + k4) + h/3 (k2 + k3)``), the first group apart.
+    """
+    a, b, c = tab.a.tolist(), tab.b.tolist(), tab.c.tolist()
+    coefficients: list[float] = [0.0]
+
+    def at(value: float) -> int:
+        coefficients.append(value)
+        return len(coefficients) - 1
+
+    stages = tuple(
+        (at(c[i]) if c[i] else 0, tuple((j, at(a[i][j])) for j in range(i) if a[i][j] != 0))
+        for i in range(1, tab.stages)
+    )
+    groups: dict[float, list[int]] = {}
+    for i, bi in enumerate(b):
+        if bi != 0:
+            groups.setdefault(bi, []).append(i)
+    weights = tuple((at(bi), idx[0], tuple(idx[1:])) for bi, idx in groups.items())
+    return np.array(coefficients), stages, weights[0], weights[1:]
 
 
-def uniform_step(T: np.ndarray, rtol: float = 1e-9, atol: float = 0.0) -> float | None:
-    """The step of an evenly spaced grid T, or None if a step departs from
-    the mean ``(T[-1] - T[0])/(N - 1)`` by more than ``atol + rtol·dt``."""
-    dt = (T[-1] - T[0]) / (T.size - 1)
-    return float(dt) if np.max(np.abs(np.diff(T) - dt)) <= atol + rtol * abs(dt) else None
+def _steps(f, ts, rows, x, buf, structure):
+    """One step from each time ``ts[m]`` with coefficients ``rows[m]``; ``buf[m + 1]`` its end.
+
+    The plain stage loop of scipy's ``rk_step`` (integrate/_ivp/rk.py) over
+    the tableau as data: ``rows[m]`` holds the non-zero coefficients times
+    the step ``h`` (`_structure`), so zero entries cost nothing.
+    """
+    _, stages, (pb, i0, rest), others = structure
+    m = 0
+    for t, v in zip(ts, rows):
+        k = [f(t, x)]
+        for pc, terms in stages:
+            xi = x
+            for j, pa in terms:
+                xi = xi + v[pa] * k[j]
+            k.append(f(t + v[pc], xi))
+        ks = k[i0]
+        for i in rest:
+            ks = ks + k[i]
+        x = x + v[pb] * ks
+        for pb_, i0_, rest_ in others:
+            ks = k[i0_]
+            for i in rest_:
+                ks = ks + k[i]
+            x = x + v[pb_] * ks
+        m += 1
+        buf[m] = x
+    return x
+
+
+def _run(f, tab, tt, x, out, start, stop, substeps, dt):
+    """Step from ``tt[start]`` to ``tt[stop]``, writing ``out[n + 1]``; return x.
+
+    The coefficients times ``h`` are formed once for a uniform grid (``dt``
+    its step), else once per interval in one vectorised product. With
+    substeps, the steps inside the intervals go to a scratch buffer and
+    every ``substeps``-th is kept.
+    """
+    structure = _structure(tab)
+    coefficients, n = structure[0], stop - start
+    if dt is not None:
+        rows = [(coefficients * (dt / substeps)).tolist()] * (n * substeps)
+        hs = [dt / substeps] * n
+    else:
+        hs = [(tt[i + 1] - tt[i]) / substeps for i in range(start, stop)]
+        rows = (np.repeat(hs, substeps)[:, None] * coefficients).tolist()
+    if substeps == 1:
+        return _steps(f, tt[start:stop], rows, x, out[start:], structure)
+    ts = [tt[i] + sub * h for i, h in zip(range(start, stop), hs) for sub in range(substeps)]
+    buf = np.empty((len(ts) + 1,) + x.shape, dtype=out.dtype)
+    x = _steps(f, ts, rows, x, buf, structure)
+    out[start + 1 : stop + 1] = buf[substeps::substeps]
+    return x
 
 
 def check_substeps(substeps) -> int:
@@ -159,7 +264,9 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     """Solve ``x' = f(t, x)`` with a fixed-step explicit Runge–Kutta method.
 
     Each interval ``[t[i], t[i+1]]`` of the grid is split into ``substeps``
-    equal steps ``h``; one step is
+    equal steps ``h``; on a grid that `uniform_step` finds uniform, every
+    interval is taken as its step ``Δt`` (the grid's points differ from
+    ``t[0] + iΔt`` only by their rounding). One step is
 
     .. math::
 
@@ -174,7 +281,9 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     t : array_like, shape (N,)
         Output times, strictly increasing; need not be uniform.
     x0 : array_like, shape (n,) or (m, n)
-        Initial state, or ``m`` initial states stepped together.
+        Initial state, or ``m`` initial states stepped together. As in
+        scipy's `solve_ivp`, a complex ``x0`` makes the integration
+        complex; with a real ``x0``, ``f`` must return real values.
     method : str or ButcherTableau, default ``'rk4'``
         A name in `qc_control.METHODS` or any explicit tableau.
     substeps : int, default 1
@@ -185,7 +294,24 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     Solution
         If the state becomes non-finite, the run stops there: a
         `DivergenceWarning` is issued and the solution holds the samples
-        up to the last finite one, with ``status='diverged'``.
+        up to the last finite one, with ``status='diverged'``. Every
+        sample is checked; a non-finite state is never a success.
+
+    Raises
+    ------
+    ValueError
+        For a bad ``t``, ``x0`` or ``substeps``, naming it and its value.
+    TypeError
+        For an ``f`` that is not callable, or that returns complex values
+        on a real state.
+
+    Notes
+    -----
+    The loop is scipy's plain stage loop (``rk_step`` in
+    ``scipy/integrate/_ivp/rk.py``) over the tableau as data, with the
+    non-zero ``h a_ij``, ``h b_i`` and ``c_i h`` computed once per step
+    size and zero entries skipped; stages of equal weight are summed
+    before they are scaled.
 
     Examples
     --------
@@ -197,22 +323,30 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     tab = get_method(method)
     t = check_time_grid(t, "t")
     substeps = check_substeps(substeps)
-    x = np.array(x0, dtype=float)
-    if x.ndim not in (1, 2) or x.size == 0:
-        raise ValueError(f"x0 must have shape (n,) or (m, n), got {x.shape}")
-    if not np.all(np.isfinite(x)):
-        raise ValueError("x0 must be finite")
+    if not callable(f):
+        raise TypeError(f"f must be callable as f(t, x), got {show(f)}")
+    x = _initial_state(x0)
 
-    run = _compiled_loop(tab, substeps > 1)
-    out = np.empty((t.size,) + x.shape)
+    dt = uniform_step(t)  # a uniform grid is stepped with its one step, like the LTI engine
+    out = np.empty((t.size,) + x.shape, dtype=x.dtype)
     out[0] = x
     tt = t.tolist()
     n_last, n_computed, status, message = t.size - 1, t.size - 1, "success", ""
-    with np.errstate(over="ignore", invalid="ignore"):
+    with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings():
+        # a complex f on a real state would lose its imaginary part in `out`
+        warnings.simplefilter("error", np.exceptions.ComplexWarning)
         for start in range(0, t.size - 1, _CHECK_EVERY):
             stop = min(start + _CHECK_EVERY, t.size - 1)
-            x = run(f, tt, x, out, start, stop, substeps)
+            try:
+                x = _run(f, tab, tt, x, out, start, stop, substeps, dt)
+            except np.exceptions.ComplexWarning:
+                raise TypeError(
+                    "f returned complex values for a real x0; pass a complex x0 (e.g. "
+                    "x0 + 0j) to integrate in complex arithmetic, as scipy's solve_ivp does"
+                ) from None
             block = out[start + 1 : stop + 1]
+            if np.isfinite(block).all():
+                continue
             bad = ~np.isfinite(block.reshape(block.shape[0], -1)).all(axis=1)
             if bad.any():
                 n_last = start + int(np.argmax(bad))
@@ -234,3 +368,19 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
         status=status,
         message=message,
     )
+
+
+def _initial_state(x0) -> np.ndarray:
+    """``x0`` as a float (or, if complex, complex) array of shape (n,) or (m, n)."""
+    try:
+        x = np.array(x0)
+        x = x.astype(complex if np.iscomplexobj(x) else float)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"x0 must be an array of real or complex numbers, got {show(x0)}"
+        ) from None
+    if x.ndim not in (1, 2) or x.size == 0:
+        raise ValueError(f"x0 must have shape (n,) or (m, n), got {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise ValueError(f"x0 must be finite, got {show(x0)}")
+    return x

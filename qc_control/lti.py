@@ -22,13 +22,15 @@ over steps or blocks, only over the log2 rounds of the scans.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
-from .methods import ButcherTableau
+from .integrate import DivergenceWarning, Solution, check_substeps, check_time_grid, uniform_step
+from .methods import ButcherTableau, get_method
 from .stability import stability_coefficients
 
-__all__ = ["step_matrices", "affine_scan", "lti_trajectory"]
+__all__ = ["step_matrices", "affine_scan", "lti_trajectory", "lti_solve"]
 
 
 def step_matrices(
@@ -221,13 +223,73 @@ def lti_trajectory(
     """The method's states on a uniform grid T, shape ``(n, len(T))``.
 
     ``U`` is ``(ninputs, len(T))`` or None. The result equals
-    `qc_control.integrate` on ``f = A x + B u(t)`` up to rounding.
+    `qc_control.integrate` on ``f = A x + B u(t)`` up to rounding, on any
+    grid that `qc_control.integrate.uniform_step` accepts (the step is
+    taken as the mean ``(T[-1] - T[0]) / (len(T) - 1)``).
+
+    Past the method's stability limit the states overflow to inf or nan
+    without a RuntimeWarning; `lti_solve` cuts them off and warns.
     """
     H = (T[-1] - T[0]) / (T.size - 1)
-    phi, g_lo, g_hi = step_matrices(method, A, B, H, substeps)
-    W = None
-    if U is not None and U.size and np.any(U):
-        W = U[:, :-1].T @ g_lo.T + U[:, 1:].T @ g_hi.T
-    # Without input there is no block-Toeplitz product, so longer blocks
-    # (fewer scan rounds) win; with input, 16 keeps that product small.
-    return affine_scan(phi, x0, W, T.size, block=16 if W is not None else 32).T
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        phi, g_lo, g_hi = step_matrices(method, A, B, H, substeps)
+        W = None
+        if U is not None and U.size and np.any(U):
+            W = U[:, :-1].T @ g_lo.T + U[:, 1:].T @ g_hi.T
+        # Without input there is no block-Toeplitz product, so longer blocks
+        # (fewer scan rounds) win; with input, 16 keeps that product small.
+        return affine_scan(phi, x0, W, T.size, block=16 if W is not None else 32).T
+
+
+def lti_solve(method, A, B, T, U, x0, substeps: int = 1) -> Solution:
+    """The LTI engine as a `qc_control.integrate.Solution`, cut like `integrate`'s.
+
+    `lti_trajectory` on the grid ``T``, which must be uniform by
+    `qc_control.integrate.uniform_step`. If a state is non-finite (a step
+    past the stability limit overflows), the solution ends at the last
+    finite sample, a `DivergenceWarning` is issued and ``status`` is
+    ``'diverged'``: the same contract as the generic stepper's, and no
+    numpy RuntimeWarning.
+
+    Parameters
+    ----------
+    method : str or ButcherTableau
+    A : array_like, shape (n, n)
+    B : array_like, shape (n, m)
+    T : array_like, shape (N,)
+        Uniform time grid [s].
+    U : ndarray, shape (m, N), or None
+        Input samples, linear between them.
+    x0 : array_like, shape (n,)
+    substeps : int, default 1
+
+    Returns
+    -------
+    Solution
+        ``x`` of shape ``(n, N')``, ``N' <= N``; ``steps`` are those of the
+        whole grid (the engine computes every interval at once) and
+        ``nfev = stages * steps``, as the generic stepper would count them.
+
+    Raises
+    ------
+    ValueError
+        When ``T`` is not uniform, or a bad ``T`` or ``substeps``.
+    """
+    tab = get_method(method)
+    T = check_time_grid(T, "T")
+    substeps = check_substeps(substeps)
+    if uniform_step(T) is None:
+        raise ValueError("the LTI engine needs a uniformly spaced T (see uniform_step)")
+    x = lti_trajectory(tab, A, B, T, U, np.asarray(x0, dtype=float), substeps)
+    finite = np.isfinite(x).all(axis=0)
+    n_keep, status, message = T.size, "success", ""
+    if not finite.all():
+        n_keep = int(np.argmin(finite))
+        status = "diverged"
+        message = (
+            f"{tab.name}: the state became non-finite after t = {T[n_keep - 1]:.6g}; "
+            f"stopped after {n_keep - 1} of {T.size - 1} intervals"
+        )
+        warnings.warn(message, DivergenceWarning, stacklevel=2)
+    steps = (T.size - 1) * substeps  # the engine computes every interval at once
+    return Solution(T[:n_keep], x[:, :n_keep], tab.stages * steps, steps, tab, status, message)

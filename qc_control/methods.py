@@ -15,24 +15,31 @@ four entries of `METHODS`.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
+
+from .messages import show
+from .order_conditions import MAX_ORDER, check_order
 
 __all__ = ["ButcherTableau", "METHODS", "get_method", "EULER", "MIDPOINT", "HEUN", "RK4"]
 
-_TOL = 1e-13
+_EPS = np.finfo(float).eps
 
 
-def _order_conditions(a, b, c):
-    """Residuals of the order conditions for orders 1..4 (HNW I, Table II.2.1)."""
-    one = np.ones_like(b)
-    ac = a @ c
-    return {
-        1: [b @ one - 1],
-        2: [b @ c - 1 / 2],
-        3: [b @ c**2 - 1 / 3, b @ ac - 1 / 6],
-        4: [b @ c**3 - 1 / 4, b @ (c * ac) - 1 / 8, b @ (a @ c**2) - 1 / 12, b @ (a @ ac) - 1 / 24],
-    }
+def _real_array(value, what: str, where: str) -> np.ndarray:
+    """``value`` as a float array, or a ValueError naming ``what`` and the value."""
+    try:
+        arr = np.array(value)
+        if arr.dtype.kind not in "biuf":  # not bool, int or float: strings, None, complex
+            raise TypeError
+        arr = arr.astype(float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}: {what} must be real numbers, got {show(value)}") from None
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{where}: {what} must be finite, got {show(value)}")
+    return arr
 
 
 @dataclass(frozen=True, eq=False)
@@ -47,25 +54,40 @@ class ButcherTableau:
         Stage coefficients, strictly lower triangular (explicit method).
     b : array_like, shape (s,)
         Weights, summing to 1.
-    c : array_like, shape (s,)
-        Nodes; row ``i`` of ``a`` sums to ``c[i]``.
-    order : int
-        Classical order p. Checked against the order conditions up to 4.
+    c : array_like, shape (s,), optional
+        Nodes; row ``i`` of ``a`` must sum to ``c[i]``. Default: those sums.
+    order : int, optional
+        Classical order p. Computed from the tableau when left out; when
+        given, it must be the computed order.
 
     Raises
     ------
     ValueError
-        When the tableau is not explicit, not consistent, or does not
-        satisfy the conditions of the order it claims.
+        When an entry is not a finite real number, the tableau is not
+        explicit or not consistent, or the stated order is not its order.
+
+    Notes
+    -----
+    The order is the largest ``p`` for which ``Φ(t) = 1/γ(t)`` holds on
+    every rooted tree with at most ``p`` vertices (Butcher, *Numerical
+    Methods for ODEs*, 3rd ed., §31-§32; HNW I, §II.2, Table 2.2), checked
+    up to ``min(s, MAX_ORDER)`` (an explicit ``s``-stage method has order at
+    most ``s``) by `qc_control.order_conditions.check_order`.
+
+    A tableau equals another with the same name, coefficients and order,
+    and equals the string of its name, so ``resp.method == "heun"`` reads
+    as meant. The hash is that of the name, consistent with both.
 
     Examples
     --------
     Ralston's second-order method:
 
     >>> ralston = ButcherTableau("ralston", a=[[0, 0], [2/3, 0]], b=[1/4, 3/4],
-    ...                          c=[0, 2/3], order=2)
-    >>> ralston.stages
-    2
+    ...                          c=[0, 2/3])
+    >>> ralston.stages, ralston.order
+    (2, 2)
+    >>> ralston == "ralston"
+    True
     >>> ButcherTableau("bad", a=[[0, 0], [1, 0]], b=[0.5, 0.5], c=[0, 0.5], order=2)
     Traceback (most recent call last):
     ...
@@ -75,53 +97,98 @@ class ButcherTableau:
     name: str
     a: np.ndarray
     b: np.ndarray
-    c: np.ndarray
-    order: int
+    c: np.ndarray = None  # type: ignore[assignment]  # None: the row sums of a
+    order: int = None  # type: ignore[assignment]  # None: computed
+
+    if TYPE_CHECKING:  # what the generated __init__ accepts; each field ends an array/int
+
+        def __init__(
+            self,
+            name: str,
+            a: npt.ArrayLike,
+            b: npt.ArrayLike,
+            c: npt.ArrayLike | None = None,
+            order: int | None = None,
+        ) -> None: ...
 
     def __post_init__(self):
-        a = np.array(self.a, dtype=float)
-        b = np.array(self.b, dtype=float)
-        c = np.array(self.c, dtype=float)
-        s = b.shape[0] if b.ndim == 1 else -1
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"tableau name must be a non-empty string, got {show(self.name)}")
         where = f"tableau {self.name!r}"
+        a = _real_array(self.a, "a", where)
+        b = _real_array(self.b, "b", where)
+        s = b.shape[0] if b.ndim == 1 else -1
+        c = a.sum(axis=-1) if self.c is None and a.shape == (s, s) else self.c
+        c = _real_array(c, "c", where)
         if s < 1 or a.shape != (s, s) or c.shape != (s,):
             raise ValueError(
                 f"{where}: need a (s, s), b (s,), c (s,); got a {a.shape}, b {b.shape}, c {c.shape}"
             )
-        if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(np.isfinite(c))):
-            raise ValueError(f"{where}: coefficients must be finite")
         if np.any(np.triu(a) != 0):
             raise ValueError(f"{where}: a must be strictly lower triangular (explicit method)")
         for i in range(s):
-            if abs(a[i].sum() - c[i]) > _TOL:
+            # rounding of the row sum: a few eps times the sum of magnitudes
+            if abs(a[i].sum() - c[i]) > 64 * s * _EPS * max(1.0, np.abs(a[i]).sum()):
                 raise ValueError(
                     f"{where}: row {i} of a sums to {a[i].sum():.15g}, but c[{i}] = {c[i]:.15g}"
                 )
-        if abs(b.sum() - 1) > _TOL:
+        if abs(b.sum() - 1) > 64 * s * _EPS * max(1.0, np.abs(b).sum()):
             raise ValueError(f"{where}: b sums to {b.sum():.15g}, not 1")
-        if (
-            isinstance(self.order, bool)
-            or not isinstance(self.order, (int, np.integer))
-            or self.order < 1
+        claimed = self.order
+        if claimed is not None and (
+            isinstance(claimed, bool) or not isinstance(claimed, (int, np.integer)) or claimed < 1
         ):
-            raise ValueError(f"{where}: order must be a positive integer, got {self.order!r}")
-        residuals = _order_conditions(a, b, c)
-        for p in range(1, min(int(self.order), 4) + 1):
-            if max(abs(r) for r in residuals[p]) > _TOL:
+            raise ValueError(f"{where}: order must be a positive integer, got {show(claimed)}")
+        top = min(s, MAX_ORDER)  # an explicit s-stage method has order <= s
+        if claimed is not None:
+            # up to order s + 1 when more is claimed, to name the first failing tree
+            top = min(max(top, min(claimed, s + 1)), MAX_ORDER)
+        found = check_order(a, b, top)
+        if claimed is not None and claimed > found.order:
+            if found.failing_tree is None:
                 raise ValueError(
-                    f"{where}: claims order {self.order} but fails the order-{p} conditions"
+                    f"{where}: claims order {claimed}; it meets every condition up to order "
+                    f"{found.order}, and orders are verified only up to {MAX_ORDER}"
                 )
+            bound = (
+                f"; an explicit method with {s} stages has order at most {s}" if claimed > s else ""
+            )
+            raise ValueError(
+                f"{where}: claims order {claimed} but fails the order-{found.order + 1} "
+                f"conditions ({found.failing}); its order is {found.order}{bound}"
+            )
+        if claimed is not None and claimed < found.order:
+            raise ValueError(
+                f"{where}: claims order {claimed}, but it meets every condition of order "
+                f"{found.order}; give order={found.order} or leave order out"
+            )
         for arr in (a, b, c):
             arr.flags.writeable = False
         object.__setattr__(self, "a", a)
         object.__setattr__(self, "b", b)
         object.__setattr__(self, "c", c)
-        object.__setattr__(self, "order", int(self.order))
+        object.__setattr__(self, "order", found.order)
 
     @property
     def stages(self) -> int:
         """Number of stages s: right-hand-side evaluations per step."""
         return self.b.shape[0]
+
+    def __eq__(self, other) -> bool:
+        if isinstance(other, str):
+            return other == self.name
+        if isinstance(other, ButcherTableau):
+            return (
+                other.name == self.name
+                and other.order == self.order
+                and np.array_equal(other.a, self.a)
+                and np.array_equal(other.b, self.b)
+                and np.array_equal(other.c, self.c)
+            )
+        return NotImplemented
+
+    def __hash__(self) -> int:
+        return hash(self.name)
 
     def __repr__(self) -> str:
         return f"ButcherTableau({self.name!r}, order={self.order}, stages={self.stages})"
@@ -130,15 +197,17 @@ class ButcherTableau:
 #: Forward Euler: x + h f(x) (seed, 4.2.1).
 EULER = ButcherTableau("euler", a=[[0.0]], b=[1.0], c=[0.0], order=1)
 #: Explicit midpoint: x + h f(x + h/2 f(x)) (seed, 4.2.2).
-MIDPOINT = ButcherTableau("midpoint", a=[[0, 0], [0.5, 0]], b=[0, 1], c=[0, 0.5], order=2)
+MIDPOINT = ButcherTableau(
+    "midpoint", a=[[0.0, 0.0], [0.5, 0.0]], b=[0.0, 1.0], c=[0.0, 0.5], order=2
+)
 #: Heun: x + h/2 (f(x) + f(x + h f(x))) (seed, 4.2.4).
 HEUN = ButcherTableau("heun", a=[[0, 0], [1, 0]], b=[0.5, 0.5], c=[0, 1], order=2)
 #: Classic RK4: x + h/6 (k1 + 2 k2 + 2 k3 + k4) (seed, 4.2.3).
 RK4 = ButcherTableau(
     "rk4",
-    a=[[0, 0, 0, 0], [0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 1, 0]],
+    a=[[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, 0.0, 0.0], [0.0, 0.5, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]],
     b=[1 / 6, 1 / 3, 1 / 3, 1 / 6],
-    c=[0, 0.5, 0.5, 1],
+    c=[0.0, 0.5, 0.5, 1.0],
     order=4,
 )
 
@@ -166,4 +235,7 @@ def get_method(method) -> ButcherTableau:
                 f"unknown method {method!r}; known methods are "
                 f"{', '.join(METHODS)} (or pass a ButcherTableau)"
             ) from None
-    raise TypeError(f"method must be a name or a ButcherTableau, got {type(method).__name__}")
+    raise TypeError(
+        f"method must be a name in METHODS ({', '.join(METHODS)}) or a ButcherTableau, "
+        f"got {show(method)}"
+    )

@@ -55,7 +55,7 @@ def test_step_limits_and_modes_from_eigenvalues(seed_cmp):
     assert seed_cmp.table.loc["euler", "limited by"] == "body bounce"
     wn, zeta, _ = control.damp(seed_cmp.system, doprint=False)
     assert seed_cmp.modes.body.zeta == pytest.approx(min(zeta), rel=1e-12)
-    nm = qc.numerical_modes("euler", 0.01, seed_cmp.system)
+    nm = qc.numerical_modes("euler", 0.01, seed_cmp.modes)
     assert (
         seed_cmp.table.loc["euler", "wheel hop freq err [%]"]
         == nm.loc["wheel hop", "freq error [%]"]

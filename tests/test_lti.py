@@ -1,11 +1,13 @@
 """The LTI engine equals the generic stepper, for every method, with and without input."""
 
+import warnings
+
 import numpy as np
 import pytest
 
 import qc_control as qc
 from qc_control import METHODS
-from qc_control.lti import affine_scan, step_matrices
+from qc_control.lti import affine_scan, lti_solve, step_matrices
 
 X0 = [0.1, -0.3, 0.05, 0.01]
 RALSTON = qc.ButcherTableau(
@@ -94,3 +96,48 @@ def test_batched_scan_equals_each_design():
         np.testing.assert_allclose(
             batch[i], affine_scan(phis[i], x0[i], W[i], 100), rtol=1e-13, atol=1e-14
         )
+
+
+# -- past the stability limit (issue 14 item 21)
+
+
+@pytest.mark.parametrize("U", [None, "step"])
+def test_lti_solve_past_the_limit_warns_and_cuts_like_the_generic(U):
+    """Euler at 3x its limit overflows: the LTI engine must cut at its first non-finite
+    sample with one DivergenceWarning and no numpy RuntimeWarning, as integrate does."""
+    sys = qc.quarter_car(road=True)
+    A, B = np.asarray(sys.A), np.asarray(sys.B)
+    h = 3 * qc.max_stable_step("euler", sys)
+    T = np.arange(20001) * h
+    u = None if U is None else np.where(T >= h, 0.05, 0.0)[None]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sol = lti_solve("euler", A, B, T, u, X0)
+    assert [w.category for w in caught] == [qc.DivergenceWarning]
+    assert sol.status == "diverged" and not sol.success and sol.method == "euler"
+    assert np.all(np.isfinite(sol.x)) and 10 < sol.t.size < T.size
+    assert "non-finite" in sol.message
+    # the generic stepper on the same problem diverges too, at nearly the same sample:
+    # the engine's powers Φ^k exceed the state by the eigenvectors' conditioning, so
+    # they may overflow a few steps sooner (measured: 8 of ~1900); allow 1% of the run
+    f = (
+        (lambda t, x: A @ x)
+        if u is None
+        else (lambda t, x: A @ x + B[:, 0] * np.interp(t, T, u[0]))
+    )
+    with pytest.warns(qc.DivergenceWarning):
+        generic = qc.integrate(f, T, X0, "euler")
+    assert abs(generic.t.size - sol.t.size) <= 0.01 * generic.t.size
+    n = min(generic.t.size, sol.t.size) - 5  # before overflow they agree to 1e-12 relative
+    assert rel(sol.x[:, :n], generic.x[:, :n]) < 1e-12
+
+
+def test_lti_solve_within_the_limit_is_integrate():
+    sys = qc.quarter_car(road=True)
+    A, B = np.asarray(sys.A), np.asarray(sys.B)
+    T = np.linspace(0, 5, 5001)
+    U = np.where(T >= 0.5, 0.05, 0.0)[None]
+    sol = lti_solve("rk4", A, B, T, U, X0, substeps=2)
+    assert sol.success and sol.x.shape == (4, T.size) and sol.nfev == 4 * 2 * 5000
+    with pytest.raises(ValueError, match="needs a uniformly spaced T"):
+        lti_solve("rk4", A, B, np.r_[0.0, 0.1, 0.3], None, X0)
