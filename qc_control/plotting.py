@@ -193,9 +193,7 @@ def plot_outputs(
     else:
         top, bottom = fig.subplots(), None
     if ref is not None:
-        top.plot(
-            reference.time, ref, color="0.6", lw=4, alpha=0.6, label=reference_label
-        )
+        top.plot(reference.time, ref, color="0.6", lw=4, alpha=0.6, label=reference_label)
     twins = _twins(curves, coincide_tol)
     for i, (name, resp) in enumerate(named.items()):
         style = _OVERLAYS[len(twins[name]) % len(_OVERLAYS)]
@@ -212,7 +210,9 @@ def plot_outputs(
             # exact zeros have no place on a log axis: left out, not clipped
             gap = np.where(gap > 0, gap, np.nan)
             bottom.semilogy(resp.time[:n], gap, color=color, lw=1, ls=style)
-    top.set(ylabel=ylabel, title=title or f"{output} of {len(named)} responses")
+    if title is None:
+        title = output if ref is None else f"{output} against the {reference_label}"
+    top.set(ylabel=ylabel, title=title)
     top.grid(alpha=0.3)
     last = top
     if bottom is not None:

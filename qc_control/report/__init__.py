@@ -252,9 +252,7 @@ def _numbered(blocks: list) -> list:
 def build_blocks(cmp, command: str | None = None) -> list:
     """The report as blocks, in the order: problem card, figures, findings, footer."""
     table = cmp.table
-    figs = {
-        spec.name: Image(spec.name, spec.caption, spec.label) for spec in figure_specs(cmp)
-    }
+    figs = {spec.name: Image(spec.name, spec.caption, spec.label) for spec in figure_specs(cmp)}
     blocks = [Paragraph(_scenario_text(cmp)), Heading("Problem card")]
     if cmp.params is not None:
         frame = pd.DataFrame(cmp.params.table(), columns=["symbol", "quantity", "value", "unit"])

@@ -149,9 +149,7 @@ def overlay_figure(cmp) -> Figure:
     fig = Figure(figsize=(8, 3.6), layout="constrained")
     ax = fig.subplots()
     ref = cmp.reference
-    ax.plot(
-        ref.time, output_signal(ref, "xs") * _MM, color="k", lw=4, alpha=0.25, label="exact"
-    )
+    ax.plot(ref.time, output_signal(ref, "xs") * _MM, color="k", lw=4, alpha=0.25, label="exact")
     for name, resp in cmp.responses.items():
         ax.plot(
             resp.time,
@@ -217,7 +215,7 @@ def convergence_figure(cmp) -> Figure:
     colors, rank = _colors(cmp.responses), _rank(cmp)
     fig = Figure(figsize=(7.5, 4.6), layout="constrained")
     ax = fig.subplots()
-    for i, tab in enumerate(cmp.methods):
+    for tab in cmp.methods:
         rows = conv[conv["method"] == tab.name].sort_values("h", ascending=False)
         ok = np.isfinite(rows["error"]) & (rows["error"] > 0)
         ax.loglog(
@@ -250,8 +248,10 @@ def convergence_figure(cmp) -> Figure:
 def work_precision_figure(cmp) -> Figure:
     """Max |xs error| against RHS evaluations and against wall time.
 
-    The points of each method are joined in order of work (RHS
-    evaluations), the order in which the refinements cost more.
+    Left, each method's refinements are joined in order of work (RHS
+    evaluations). Right, the measured wall times are drawn as points
+    only: a timing is one measurement on a shared machine, and a line
+    through noisy times would run back and forth.
     """
     conv = cmp.convergence
     colors, rank = _colors(cmp.responses), _rank(cmp)
@@ -268,7 +268,8 @@ def work_precision_figure(cmp) -> Figure:
             **_style(cmp, tab.name, rank),
         )
         left.loglog(rows["nfev"], rows["error"], **style)
-        right.loglog(rows["time"] * 1e3, rows["error"], **style)
+        # measured times are noisy: points only, so no line ever runs back in time
+        right.loglog(rows["time"] * 1e3, rows["error"], **{**style, "ls": "none"})
     left.set(
         xlabel="right-hand-side evaluations",
         ylabel="max |xs error| [m]",
@@ -318,7 +319,8 @@ def stability_figure(cmp) -> Figure:
     hl = cmp.h * np.array([m.eigenvalue for m in cmp.modes.modes])
     reach = float(np.max(np.abs(hl))) if hl.size else 0.1
     lim = max(3.2, 1.1 * reach)
-    _regions(full, cmp, np.linspace(-lim - 0.3, 1.0, 500), np.linspace(-lim, lim, 500), colors, rank)
+    x, y = np.linspace(-lim - 0.3, 1.0, 500), np.linspace(-lim, lim, 500)
+    _regions(full, cmp, x, y, colors, rank)
     _modes(full, cmp)
     # the zoom: a square around the origin that holds every hλ with a margin
     half = 1.3 * max(reach, 1e-6)
@@ -350,12 +352,18 @@ def stability_figure(cmp) -> Figure:
         for tab in cmp.methods
     ]
     handles += [
-        Line2D([], [], ls="none", marker=_MARKERS[i % len(_MARKERS)], color="k", mfc="none",
-               label=f"hλ, {mode.name}")
+        Line2D(
+            [],
+            [],
+            ls="none",
+            marker=_MARKERS[i % len(_MARKERS)],
+            color="k",
+            mfc="none",
+            label=f"hλ, {mode.name}",
+        )
         for i, mode in enumerate(cmp.modes.modes)
     ]
-    same = [g for g in coincidence_groups(cmp)]
-    note = "; ".join(" = ".join(g) + " (same R(z))" for g in same)
+    note = "; ".join(" = ".join(g) + " (same R(z))" for g in coincidence_groups(cmp))
     _legend(fig, note, handles=handles)
     return fig
 

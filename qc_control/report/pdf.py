@@ -214,8 +214,9 @@ class _Writer:
             width, height = width * most / height, most
         self.pages.room(height + cap_h + 0.25)
         y0 = self.pages.y - 0.08 - height
+        x0 = _LEFT + (_WIDTH - width) / 2
         ax = self.pages.fig.add_axes(
-            ((_LEFT + (_WIDTH - width) / 2) / _PAGE_W, y0 / _PAGE_H, width / _PAGE_W, height / _PAGE_H)
+            (x0 / _PAGE_W, y0 / _PAGE_H, width / _PAGE_W, height / _PAGE_H)
         )
         # 'none': vector backends embed the PNG itself, at its own resolution
         ax.imshow(pixels, interpolation="none", aspect="auto")
