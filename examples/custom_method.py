@@ -19,7 +19,7 @@ import numpy as np
 import qc_control as qc
 from qc_control.report import write_report
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(__file__).stem}_output")
+out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
 out.mkdir(parents=True, exist_ok=True)
 print(f"writing into {out.resolve()}")
 

@@ -21,7 +21,7 @@ from matplotlib.figure import Figure
 
 import qc_control as qc
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(__file__).stem}_output")
+out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
 out.mkdir(parents=True, exist_ok=True)
 print(f"writing into {out.resolve()}")
 T = np.linspace(0.0, 10.0, 10001)  # h = 1 ms

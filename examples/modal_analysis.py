@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 
 import qc_control as qc
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(__file__).stem}_output")
+out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
 out.mkdir(parents=True, exist_ok=True)
 print(f"writing into {out.resolve()}")
 print(qc.modal_analysis())  # the seed's Table 1

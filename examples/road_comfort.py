@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 import qc_control as qc
 from qc_control import road
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(__file__).stem}_output")
+out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
 out.mkdir(parents=True, exist_ok=True)
 print(f"writing into {out.resolve()}")
 params = qc.QuarterCarParams()

@@ -20,7 +20,7 @@ import qc_control as qc
 from qc_control.report import SEED_FIGURES
 from qc_control.report.figures import method_figure
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(__file__).stem}_output")
+out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
 out.mkdir(parents=True, exist_ok=True)
 print(f"writing into {out.resolve()}")
 

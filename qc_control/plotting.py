@@ -211,7 +211,7 @@ def plot_outputs(
             gap = np.where(gap > 0, gap, np.nan)
             bottom.semilogy(resp.time[:n], gap, color=color, lw=1, ls=style)
     if title is None:
-        title = output if ref is None else f"{output} against the {reference_label}"
+        title = output if ref is None else f"{output} against {reference_label}"
     top.set(ylabel=ylabel, title=title)
     top.grid(alpha=0.3)
     last = top
