@@ -41,6 +41,7 @@ __all__ = [
     "write_report",
     "build_blocks",
     "figure_specs",
+    "FigureSpec",
     "ReportError",
     "MARKER",
     "FORMATS",

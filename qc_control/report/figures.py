@@ -21,6 +21,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
+from matplotlib.ticker import NullFormatter
 
 from ..plotting import output_signal, output_unit
 from ..stability import stability_function
@@ -235,6 +236,10 @@ def convergence_figure(cmp) -> Figure:
                 tab.order,
                 colors[tab.name],
             )
+    # ticks at the steps themselves: log-axis minor labels crowd a 1.5-decade range
+    hs = np.sort(conv["h"].unique())[::-1]
+    ax.set_xticks(hs, [f"{h:.3g}" for h in hs], fontsize="small")
+    ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set(
         xlabel="step h [s]",
         ylabel="max |xs error| [m]",
@@ -281,6 +286,7 @@ def work_precision_figure(cmp) -> Figure:
     )
     for ax in (left, right):
         ax.grid(alpha=0.3, which="both")
+        ax.xaxis.set_minor_formatter(NullFormatter())  # minor labels would crowd
     handles, labels = left.get_legend_handles_labels()
     _legend(fig, coincidence_note(cmp), handles=handles, labels=labels)
     return fig

@@ -34,7 +34,6 @@ _PT = 1 / 72  # inch per point
 _BODY, _SMALL, _CODE = 9.5, 8.5, 7.5  # font sizes [pt]
 _TABLE_SIZES = (8.0, 7.5, 7.0, 6.5, 6.0)  # tried in turn until a table fits
 _CELL_PAD = 3.0  # [pt] either side of a cell's text
-_KEEP_WITH_HEADING = 2.8  # [in] below a heading, or it starts the next page
 
 
 @dataclass(frozen=True)
@@ -181,11 +180,31 @@ class _Writer:
             self.pages.y -= step
         self.pages.y -= after * _PT
 
-    def heading(self, text: str, level: int):
+    def heading(self, text: str, level: int, following=None):
         size = {1: 17.0, 2: 13.0}.get(level, 11.0)
-        # a heading keeps company with what follows it: a figure or a table's start
-        self.pages.room(14 * _PT + 1.35 * size * _PT + _KEEP_WITH_HEADING)
+        # a heading keeps company with the start of what follows it
+        self.pages.room((14 + 1.35 * size + 5) * _PT + self.start_height(following))
         self.lines(text, _Font(size, weight="bold"), before=14, after=5, color="0.05")
+
+    def start_height(self, block) -> float:
+        """Height [in] of the part of ``block`` that must not be parted from a heading."""
+        if isinstance(block, Image):
+            return sum(self._image_size(block)[1:])
+        if isinstance(block, Table):
+            return 1.3  # caption, header and the first rows
+        return 3 * 1.35 * _BODY * _PT  # three lines of text
+
+    def _image_size(self, block: Image) -> tuple[float, float, float]:
+        """(width, height, caption height) [in] of a figure as it will be drawn."""
+        with PILImage.open(self.image_dir / block.path) as png:
+            w_px, h_px = png.size
+        cap = self.m.wrap(caption_text(block), _Font(_SMALL, style="italic"), _WIDTH / _PT)
+        cap_h = len(cap) * 1.35 * _SMALL * _PT
+        width, height = _WIDTH, _WIDTH * h_px / w_px
+        most = _PAGE_H - _TOP - _BOTTOM - cap_h - 0.3
+        if height > most:
+            width, height = width * most / height, most
+        return width, height + 0.25, cap_h
 
     def code(self, text: str):
         font = _Font(_CODE, family="monospace")
@@ -203,16 +222,11 @@ class _Writer:
     def image(self, block: Image):
         with PILImage.open(self.image_dir / block.path) as png:
             pixels = np.asarray(png.convert("RGB"))  # 8-bit: embedded as it is
-        h_px, w_px = pixels.shape[:2]
         cap_font = _Font(_SMALL, style="italic")
         caption = self.m.wrap(caption_text(block), cap_font, _WIDTH / _PT)
-        cap_h = len(caption) * 1.35 * _SMALL * _PT
-        width = _WIDTH
-        height = width * h_px / w_px
-        most = _PAGE_H - _TOP - _BOTTOM - cap_h - 0.3
-        if height > most:
-            width, height = width * most / height, most
-        self.pages.room(height + cap_h + 0.25)
+        width, padded, cap_h = self._image_size(block)
+        height = padded - 0.25
+        self.pages.room(padded + cap_h)
         y0 = self.pages.y - 0.08 - height
         x0 = _LEFT + (_WIDTH - width) / 2
         ax = self.pages.fig.add_axes(
@@ -337,9 +351,9 @@ def to_pdf(title: str, blocks, image_dir, path) -> Path:
         writer = _Writer(pages, Path(image_dir))
         pages.new_page()
         writer.lines(title, _Font(17.0, weight="bold"), after=10, color="0.05")
-        for b in blocks:
+        for i, b in enumerate(blocks):
             if isinstance(b, Heading):
-                writer.heading(b.text, b.level)
+                writer.heading(b.text, b.level, blocks[i + 1] if i + 1 < len(blocks) else None)
             elif isinstance(b, Paragraph):
                 writer.lines(b.text, _Font(_BODY), after=6)
             elif isinstance(b, Table):
