@@ -1,29 +1,71 @@
-# Two commands do everything on a machine that has only python3:
-#   make report   set up .venv, install qc_control, write the comparison report
-#   make test     set up .venv with the test extra, run the whole suite
+# Every target needs only python3 on the machine; each sets up .venv itself.
+#   make report      install qc_control (no test or docs extras), write the comparison report
+#   make test        install qc_control[test,docs], run the whole suite (the docs build too)
+#   make docs        install qc_control[docs], build the docs site with warnings as errors
+#   make notebook    install qc_control[notebook], open the course notebook in JupyterLab
+#   make examples    run every example into examples_output/
+#   make check-html  install Chromium (apt-get) and check report.html in it
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
-STAMP  := $(VENV)/.installed
+# One stamp per kind of install: `make report` never pulls in the test or docs
+# extras. A stamp is older than pyproject.toml whenever the dependencies
+# change, so that install is refreshed then and only then.
+STAMP_BASE     := $(VENV)/.installed-base
+STAMP_TEST     := $(VENV)/.installed-test
+STAMP_DOCS     := $(VENV)/.installed-docs
+STAMP_NOTEBOOK := $(VENV)/.installed-notebook
+# root needs no sudo (containers, CI); anyone else does
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: report test bench clean
+.PHONY: report test docs notebook examples check-html bench clean
 
-# The stamp is older than pyproject.toml whenever the dependencies change,
-# so the venv is refreshed then and only then.
-$(STAMP): pyproject.toml
-	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test]'
-	touch $(STAMP)
 
-report: $(STAMP)
+$(STAMP_BASE): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e .
+	touch $@
+
+$(STAMP_TEST): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[test,docs]'
+	touch $@
+
+$(STAMP_DOCS): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[docs]'
+	touch $@
+
+$(STAMP_NOTEBOOK): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[notebook]'
+	touch $@
+
+report: $(STAMP_BASE)
 	$(BIN)/qc-control report --out report
 
-test: $(STAMP)
+test: $(STAMP_TEST)
 	$(BIN)/python -m pytest -q
 
-bench: $(STAMP)
+docs: $(STAMP_DOCS)
+	$(BIN)/sphinx-build -W --keep-going -q -b html docs docs/_build/html
+	@echo "open docs/_build/html/index.html"
+
+notebook: $(STAMP_NOTEBOOK)
+	$(BIN)/jupyter lab examples/course.ipynb
+
+examples: $(STAMP_BASE)
+	for script in examples/*.py; do \
+	    name=$$(basename $$script .py); \
+	    MPLBACKEND=Agg $(BIN)/python $$script examples_output/$$name || exit 1; \
+	done
+
+check-html: $(STAMP_TEST)
+	test -x /usr/bin/chromium || { $(SUDO) apt-get update && $(SUDO) apt-get install -y chromium; }
+	$(BIN)/python -m pytest -q -rs tests/test_html_browser.py
+
+bench: $(STAMP_BASE)
 	$(BIN)/python benchmarks/run.py
 
 clean:
-	rm -rf $(VENV) report build *.egg-info
+	rm -rf $(VENV) report examples_output docs/_build docs/auto_examples docs/generated \
+	    docs/notebooks build *.egg-info

@@ -1,7 +1,14 @@
-"""Add your own Butcher tableau to the comparison: Ralston and the 3/8 rule.
+"""
+Your own Butcher tableau in the comparison
+==========================================
 
-Run:  python examples/custom_method.py [OUT_DIR]
-Writes a full report for six methods into OUT_DIR/custom_report/.
+Adds Ralston's second-order method and Kutta's 3/8 rule to the seed's four
+methods and writes the full comparison report for all six: Markdown, a
+self-contained HTML page, a PDF, the CSV tables and the figures.
+
+Run: ``python examples/custom_method.py [OUT_DIR]`` (default
+``./custom_method_output``). Writes the report into
+``OUT_DIR/custom_report/``.
 """
 
 import sys
@@ -10,8 +17,11 @@ from pathlib import Path
 import numpy as np
 
 import qc_control as qc
+from qc_control.report import write_report
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
+out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
+out.mkdir(parents=True, exist_ok=True)
+print(f"writing into {out.resolve()}")
 
 # Ralston's second-order method: the 2-stage method of least error bound.
 ralston = qc.ButcherTableau(
@@ -33,5 +43,5 @@ cmp = qc.compare_methods(
     repeats=3,
 )
 print(cmp.summary().to_string(float_format=lambda v: f"{v:.4g}"))
-path = qc.write_report(cmp, out / "custom_report", command="python examples/custom_method.py")
-print(f"\nwrote {path}")
+path = write_report(cmp, out / "custom_report", command="python examples/custom_method.py")
+print(f"\nwrote {path / 'report.html'}, {path / 'report.pdf'} and the rest in {path}")

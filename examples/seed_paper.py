@@ -1,9 +1,14 @@
-"""Reproduce the seed paper's Figures 3-6 and its ranking, with numbers.
+"""
+The seed paper's Figures 3-6 and its ranking
+============================================
 
-Run:  python examples/seed_paper.py [OUT_DIR]
-Writes seed_figure_3_euler.png ... seed_figure_6_heun.png (the seed's
-order: Euler, Midpoint, RK4, Heun) and prints the ranking by accuracy,
-which the seed states as "RK4, then Heun and Midpoint, then Euler".
+Reproduces the seed paper's Figures 3-6, one per method in its order
+(Euler, Midpoint, RK4, Heun), and its ranking by accuracy, which it states
+as "RK4, then Heun and Midpoint, then Euler", with the numbers behind it.
+
+Run: ``python examples/seed_paper.py [OUT_DIR]`` (default
+``./seed_paper_output``). Writes ``seed_figure_3_euler.png`` ...
+``seed_figure_6_heun.png``.
 """
 
 import sys
@@ -12,17 +17,23 @@ from pathlib import Path
 import numpy as np
 
 import qc_control as qc
+from qc_control.report import SEED_FIGURES
 from qc_control.report.figures import method_figure
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
+out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
+out.mkdir(parents=True, exist_ok=True)
+print(f"writing into {out.resolve()}")
+
 T = np.linspace(0.0, 10.0, 1001)  # h = 0.01 s, as in the default scenario
 cmp = qc.compare_methods(qc.QuarterCarParams(), T, [0.0, 0.0, 0.05, 0.0], repeats=3)
 
-for number, method in zip((3, 4, 5, 6), ("euler", "midpoint", "rk4", "heun")):
+for method, number in SEED_FIGURES.items():  # Euler 3, Midpoint 4, RK4 5, Heun 6
     path = out / f"seed_figure_{number}_{method}.png"
     method_figure(cmp, method).savefig(path, dpi=110)
     print(f"Figure {number}: {path}")
 
+# %%
+# The ranking, from the errors against python-control's exact response.
 ranking = cmp.table.sort_values("max |xs err| [m]")
 print("\nRanking by max |xs error| against python-control's exact response:")
 for place, (name, row) in enumerate(ranking.iterrows(), 1):

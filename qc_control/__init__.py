@@ -90,6 +90,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         quarter_car_model,
         read_config,
     )
+    from .plotting import plot_outputs
     from .report import write_report
     from .response import (
         FixedStepResponse,
@@ -136,6 +137,7 @@ _LAZY: dict[str, str] = {
     "Metric": "metrics",
     "RideSignals": "metrics",
     "write_report": "report",
+    "plot_outputs": "plotting",
     "Scenario": "scenario",
     "ScenarioError": "scenario",
     "Corner": "vehicle",
@@ -192,6 +194,7 @@ __all__ = [
     "Metric",
     "RideSignals",
     "write_report",
+    "plot_outputs",
     "Scenario",
     "ScenarioError",
     "load_config",

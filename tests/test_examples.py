@@ -1,27 +1,204 @@
-"""Every script in examples/ runs and writes what it says it writes."""
+"""Every script in examples/ runs and writes what it says, with the numbers it should.
 
+Each example runs in a fresh process, as a student runs it, into an output
+folder whose parents do not exist yet. Every test checks something specific
+in what the example produced: file names and image sizes, and printed
+numbers against an independent computation in the test (numpy's matrix
+power for Euler's trajectory, eigenvalues of a matrix assembled here, the
+ISO 8608 class scaling).
+"""
+
+import csv
+import re
+import struct
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+import scipy.linalg
 
-EXAMPLES = sorted((Path(__file__).parent.parent / "examples").glob("*.py"))
+ROOT = Path(__file__).parent.parent
+EXAMPLES = {p.stem: p for p in sorted((ROOT / "examples").glob("*.py"))}
+ENV = {"MPLBACKEND": "Agg", "PATH": ""}
+PNG = b"\x89PNG\r\n\x1a\n"
+
+pytestmark = pytest.mark.slow
 
 
-def test_there_are_examples():
-    assert EXAMPLES
-
-
-@pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.name)
-def test_example_runs(script, tmp_path):
+def run(name, *args, cwd=None):
     out = subprocess.run(
-        [sys.executable, str(script), str(tmp_path)],
+        [sys.executable, str(EXAMPLES[name]), *map(str, args)],
         capture_output=True,
         text=True,
         timeout=600,
-        env={"MPLBACKEND": "Agg", "PATH": ""},
+        env=ENV,
+        cwd=cwd,
     )
     assert out.returncode == 0, out.stderr
-    pngs = list(tmp_path.rglob("*.png"))
-    assert pngs and all(p.stat().st_size > 5000 for p in pngs)
+    return out.stdout
+
+
+def png_size(path: Path) -> tuple[int, int]:
+    """(width, height) in pixels from the PNG header."""
+    data = path.read_bytes()
+    assert data[:8] == PNG, path
+    return struct.unpack(">II", data[16:24])
+
+
+def seed_A():
+    """The seed's A, assembled here from M, C, K (Table 1; cs = 2ζ√(ks·ms), ζ = 0.25)."""
+    return quarter_car_A(301.2, 100.0, 30000.0, 29530.0, 0.25)
+
+
+def quarter_car_A(ms, mu, ks, ku, zeta):
+    cs = 2 * zeta * np.sqrt(ks * ms)
+    M = np.diag([ms, mu])
+    C = np.array([[cs, -cs], [-cs, cs]])
+    K = np.array([[ks, -ks], [-ks, ks + ku]])
+    Minv = np.linalg.inv(M)
+    # states [vs, vu, xs, xu]
+    return np.block([[-Minv @ C, -Minv @ K], [np.eye(2), np.zeros((2, 2))]])
+
+
+def test_there_are_the_documented_examples():
+    assert set(EXAMPLES) >= {
+        "four_methods",
+        "seed_paper",
+        "custom_method",
+        "modal_analysis",
+        "design_sweep",
+        "road_comfort",
+    }
+
+
+@pytest.mark.parametrize("name", ["modal_analysis", "four_methods"])
+def test_without_an_argument_it_writes_beside_the_caller_and_says_where(name, tmp_path):
+    stdout = run(name, cwd=tmp_path)
+    folder = tmp_path / f"{name}_output"
+    assert [p.name for p in tmp_path.iterdir()] == [folder.name]  # nothing else in the cwd
+    assert list(folder.glob("*.png"))
+    assert f"writing into {folder.resolve()}" in stdout
+
+
+def test_four_methods(tmp_path):
+    out = tmp_path / "not" / "yet" / "there"
+    stdout = run("four_methods", out)
+    rows = re.findall(r"(\w+)\s+max \|xs error\| = (\S+) m with (\d+) RHS evaluations", stdout)
+    errors = {m: float(e) for m, e, _ in rows}
+    nfev = {m: int(n) for m, _, n in rows}
+    assert list(errors) == ["euler", "midpoint", "heun", "rk4"]
+    assert nfev == {"euler": 1000, "midpoint": 2000, "heun": 2000, "rk4": 4000}  # stages·steps
+    assert errors["rk4"] < errors["midpoint"] == errors["heun"] < errors["euler"]
+    # Euler independently: x_n = (I + hA)^n x0 against expm(A t) x0, 1000 steps of 0.01 s
+    A, x0, h = seed_A(), np.array([0.0, 0.0, 0.05, 0.0]), 0.01
+    step, exact_step = np.eye(4) + h * A, scipy.linalg.expm(h * A)
+    xe, xx, worst = x0.copy(), x0.copy(), 0.0
+    for _ in range(1000):
+        xe, xx = step @ xe, exact_step @ xx
+        worst = max(worst, abs(xe[2] - xx[2]))
+    # printed to 4 significant digits: 5e-4 relative, and expm's recurrence adds < 1e-12 m
+    assert errors["euler"] == pytest.approx(worst, rel=5e-4)
+    for name, size in (("four_methods.png", (960, 624)), ("four_methods_body_acc.png", (960, 624))):
+        assert png_size(out / name) == size  # 8 × 5.2 in at 120 dpi
+        assert (out / name).stat().st_size > 20_000
+
+
+def test_seed_paper(tmp_path):
+    out = tmp_path / "a" / "b"
+    stdout = run("seed_paper", out)
+    names = sorted(p.name for p in out.glob("*.png"))
+    assert names == [
+        "seed_figure_3_euler.png",
+        "seed_figure_4_midpoint.png",
+        "seed_figure_5_rk4.png",
+        "seed_figure_6_heun.png",
+    ]
+    ranking = re.findall(r"\d\. (\w+)\s+(\S+) m .*observed order (\S+)\)", stdout)
+    assert [m for m, _, _ in ranking][0] == "rk4" and ranking[-1][0] == "euler"
+    orders = {m: float(p) for m, _, p in ranking}
+    # the observed slope over h, h/2, h/4 is within 0.2 of the order at h = 0.01 s
+    for method, p in {"euler": 1, "midpoint": 2, "heun": 2, "rk4": 4}.items():
+        assert abs(orders[method] - p) < 0.2, (method, orders[method])
+
+
+def test_custom_method_writes_a_full_report(tmp_path):
+    out = tmp_path / "x" / "y"
+    run("custom_method", out)
+    report = out / "custom_report"
+    with open(report / "methods.csv", newline="", encoding="utf-8") as fh:
+        rows = {r["method"]: r for r in csv.DictReader(fh)}
+    assert list(rows) == ["euler", "midpoint", "heun", "ralston", "rk4", "3/8-rule"]
+    assert [int(r["order"]) for r in rows.values()] == [1, 2, 2, 2, 4, 4]
+    assert abs(float(rows["ralston"]["observed order"]) - 2) < 0.1
+    assert abs(float(rows["3/8-rule"]["observed order"]) - 4) < 0.2
+    md = (report / "report.md").read_text(encoding="utf-8")
+    # the seed's four keep Figures 3-6; added methods follow them
+    for label in ("Figure 3: euler", "Figure 6: heun", "Figure 7: ralston", "Figure 8: 3/8-rule"):
+        assert label in md
+    html = (report / "report.html").read_text(encoding="utf-8")
+    assert html.count('src="data:image/png;base64,') == len(list(report.glob("*.png")))
+    assert (report / "report.pdf").read_bytes()[:5] == b"%PDF-"
+
+
+def test_modal_analysis(tmp_path):
+    out = tmp_path / "deep" / "er"
+    stdout = run("modal_analysis", out)
+    # the body mode of the seed's car, independently: the slower pair of A's eigenvalues
+    lam = np.linalg.eigvals(seed_A())
+    body = min(lam[lam.imag > 0], key=abs)
+    assert f"{abs(body) / (2 * np.pi):.4g}" in stdout.split("body bounce")[1].split("\n")[0]
+    zeta = float(re.search(r"At ku/ks = 1000 the body's ζ is (\S+) ", stdout).group(1))
+    lam = np.linalg.eigvals(quarter_car_A(301.2, 100.0, 30000.0, 1000 * 30000.0, 0.25))
+    body = min(lam[lam.imag > 0], key=abs)
+    assert zeta == pytest.approx(-body.real / abs(body), abs=5e-5)  # printed to 4 decimals
+    assert png_size(out / "modal_tire_stiffness.png") == (770, 495)  # 7 × 4.5 in at 110 dpi
+
+
+def test_road_comfort(tmp_path):
+    out = tmp_path / "r" / "c"
+    stdout = run("road_comfort", out)
+    with open(out / "road_comfort.csv", newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    head, body = rows[0], rows[1:]
+    assert len(body) == 12  # classes A-D at 10, 20, 30 m/s
+    comfort = {(r[0], float(r[1])): float(r[2]) for r in body}
+    assert head[2].startswith("comfort")
+    # ISO 8608: each class has 4x the PSD of the one before, so 2x the RMS response
+    for v in (10.0, 20.0, 30.0):
+        for lo, hi in ("AB", "BC", "CD"):
+            assert comfort[(hi, v)] / comfort[(lo, v)] == pytest.approx(2.0, rel=1e-9)
+    sim = re.search(r"Wk RMS (\S+) m/s², tire load (\S+) \(spectral: (\S+), (\S+)\)", stdout)
+    wk_sim, tire_sim, wk_psd, tire_psd = map(float, sim.groups())
+    # a 90 s record of a random road: its RMS is within a few % of the spectral value
+    assert wk_sim == pytest.approx(wk_psd, rel=0.05)
+    assert tire_sim == pytest.approx(tire_psd, rel=0.05)
+    assert png_size(out / "road_comfort.png")[0] == 1100  # 10 in at 110 dpi
+
+
+def test_design_sweep(tmp_path):
+    out = tmp_path / "s" / "w"
+    stdout = run("design_sweep", out)
+    with open(out / "design_sweep.csv", newline="", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 1000  # 40 stiffnesses x 25 damping ratios
+    acc = [c for c in rows[0] if c.startswith("rms_body_acc")][0]
+    best = min(rows, key=lambda r: float(r[acc]))
+    printed = re.search(r"ks = (\d+) N/m, zeta = (\S+), RMS body acceleration (\S+) m/s²", stdout)
+    assert int(printed.group(1)) == round(float(best["ks"]))
+    assert float(printed.group(3)) == pytest.approx(float(best[acc]), abs=5e-4)
+    # the softest spring is the most comfortable on a road step
+    assert float(best["ks"]) == pytest.approx(15e3)
+    assert png_size(out / "design_sweep.png") == (880, 495)  # 8 × 4.5 in at 110 dpi
+
+
+def test_no_example_or_library_figure_calls_show():
+    files = list(EXAMPLES.values()) + [
+        *(ROOT / "qc_control" / "report").glob("*.py"),
+        ROOT / "qc_control" / "plotting.py",
+    ]
+    for path in files:
+        text = path.read_text(encoding="utf-8")
+        assert ".show(" not in text, path
+        assert "import matplotlib.pyplot" not in text, path

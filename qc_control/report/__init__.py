@@ -1,17 +1,24 @@
-"""The comparison report: Markdown, HTML, CSV and PNG from a MethodComparison.
+"""The comparison report: Markdown, HTML, PDF, CSV and PNG from a MethodComparison.
 
 Presentation only: every number comes from the `MethodComparison`.
+``report.html`` embeds its figures (it can be mailed or uploaded alone) and
+``report.pdf`` is drawn with matplotlib (no browser needed); figures and
+tables are numbered, the seed's four methods as its Figures 3-6. When the
+comparison carries its `Scenario`, ``scenario.toml`` is written beside the
+report and the "Reproduce" section gives the exact command.
 The report is built in a temporary directory beside the target and moved
 into place, so a failure never leaves a half-written report.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import datetime as _dt
 import platform
 import re
 import shutil
 import tempfile
+from importlib.metadata import version
 from pathlib import Path
 
 import numpy as np
@@ -23,18 +30,33 @@ from .figures import (
     error_figure,
     method_figure,
     overlay_figure,
-    road_figure,
+    reference_figure,
     stability_figure,
+    transmissibility_figure,
     work_precision_figure,
 )
 from .findings import findings
+from .pdf import to_pdf
 
-__all__ = ["write_report", "build_blocks", "ReportError", "MARKER", "FORMATS"]
+__all__ = [
+    "write_report",
+    "build_blocks",
+    "figure_specs",
+    "FigureSpec",
+    "ReportError",
+    "MARKER",
+    "FORMATS",
+    "SEED_FIGURES",
+]
 
 #: A file that marks a directory as a qc-control report (safe to replace).
 MARKER = ".qc-control-report"
-FORMATS = ("md", "html", "csv")
+FORMATS = ("md", "html", "pdf", "csv")
 TITLE = "Quarter car: fixed-step methods against the exact response"
+#: The seed paper's figure numbers of its four methods (and their order there).
+SEED_FIGURES = {"euler": 3, "midpoint": 4, "rk4": 5, "heun": 6}
+#: Resolution of the PNG figures (the HTML and the PDF embed them).
+DPI = 150
 
 
 class ReportError(ValueError):
@@ -42,19 +64,18 @@ class ReportError(ValueError):
 
 
 def _versions() -> dict[str, str]:
-    import control
-    import matplotlib
-    import scipy
-
-    from .. import __version__
-
+    """The installed versions behind the numbers, from the distributions' metadata."""
+    names = {
+        "qc_control": "qc-control",
+        "python-control": "control",
+        "numpy": "numpy",
+        "scipy": "scipy",
+        "matplotlib": "matplotlib",
+        "pandas": "pandas",
+    }
+    found = {label: version(dist) for label, dist in names.items()}
     return {
-        "qc_control": __version__,
-        "python-control": control.__version__,
-        "numpy": np.__version__,
-        "scipy": scipy.__version__,
-        "matplotlib": matplotlib.__version__,
-        "pandas": pd.__version__,
+        **found,
         "python": platform.python_version(),
         "machine": f"{platform.system()} {platform.machine()}",
     }
@@ -71,52 +92,112 @@ def _slug(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "-", name).strip("-.") or "method"
 
 
-def _figures(cmp) -> list[tuple[str, str, object]]:
-    """(file name, caption, figure factory) for every figure, in report order."""
-    figs = [
+@dataclasses.dataclass(frozen=True)
+class FigureSpec:
+    """One figure of the report: its file, number, caption and how to draw it."""
+
+    name: str
+    label: str  # "Figure 3"
+    caption: str
+    make: object  # () -> matplotlib Figure
+
+    @property
+    def number(self) -> int:
+        return int(self.label.split()[-1])
+
+
+def _method_order(cmp) -> list[str]:
+    """The seed's four in its order (Euler, Midpoint, RK4, Heun), then the others."""
+    names = [tab.name for tab in cmp.methods]
+    seed = [m for m in SEED_FIGURES if m in names]
+    return seed + [m for m in names if m not in SEED_FIGURES]
+
+
+def figure_specs(cmp) -> list[FigureSpec]:
+    """Every figure, in report order, numbered.
+
+    Figure 1 is the exact response, Figure 2 all methods over it. When the
+    comparison runs any of the seed's four methods, they keep the seed's
+    numbers (Euler 3, Midpoint 4, RK4 5, Heun 6) and the other figures
+    count on from 7; otherwise figures are numbered in order.
+    """
+    drafts = [
         (
-            f"method_{_slug(tab.name)}.png",
-            f"{tab.name}: displacement of the suspension (sprung mass, red solid) and of "
-            f"the wheel (blue dashed), h = {cmp.h:g} s",
-            lambda name=tab.name: method_figure(cmp, name),
-        )
-        for tab in cmp.methods
-    ]
-    figs += [
+            "reference.png",
+            "The exact response the methods are measured against: python-control's "
+            "matrix exponential"
+            + (f", under {cmp.input_description}" if getattr(cmp, "input_description", "") else ""),
+            lambda: reference_figure(cmp),
+            None,
+        ),
         (
             "overlay.png",
             "All methods' body displacement over the exact response",
             lambda: overlay_figure(cmp),
+            None,
         ),
-        ("error.png", "Body-displacement error against time (log axis)", lambda: error_figure(cmp)),
+    ]
+    for name in _method_order(cmp):
+        drafts.append(
+            (
+                f"method_{_slug(name)}.png",
+                f"{name}: displacement of the suspension (sprung mass, red solid) and of "
+                f"the wheel (blue dashed) against the exact xs (dark grey) and xu (light "
+                f"grey, dashed), h = {cmp.h:g} s",
+                lambda name=name: method_figure(cmp, name),
+                SEED_FIGURES.get(name),
+            )
+        )
+    drafts += [
+        (
+            "error.png",
+            "Body-displacement error against time (log axis)",
+            lambda: error_figure(cmp),
+            None,
+        ),
         (
             "convergence.png",
             "Max |xs error| against h, with slope guides of each order",
             lambda: convergence_figure(cmp),
+            None,
         ),
         (
             "work_precision.png",
-            "Max |xs error| against RHS evaluations and against wall time",
+            "Max |xs error| against RHS evaluations (machine-independent) and against "
+            "wall time (measured on this machine)",
             lambda: work_precision_figure(cmp),
+            None,
         ),
         (
             "stability.png",
-            "Stability regions |R(z)| ≤ 1 with hλ of each mode",
+            "Stability regions |R(z)| ≤ 1 with hλ of each mode, and a zoom on hλ",
             lambda: stability_figure(cmp),
+            None,
         ),
     ]
-    if cmp.ride is not None:
-        figs += [
-            ("road.png", "The road input and the body's exact response", lambda: road_figure(cmp)),
+    if cmp.ride is not None and getattr(cmp, "transmissibility", None) is not None:
+        drafts.append(
             (
                 "transmissibility.png",
-                "Transmissibility from the road height zr (magnitude "
-                "and phase); the circle is the invariant point √(ku/mu), where |body_acc/zr| = "
-                "ku/ms for every damper",
-                lambda: cmp.transmissibility.figure(),
-            ),
-        ]
-    return figs
+                "Transmissibility from the road height zr (magnitude and phase); the "
+                "circle is the invariant point √(ku/mu), where |body_acc/zr| = ku/ms for "
+                "every damper",
+                lambda: transmissibility_figure(cmp),
+                None,
+            )
+        )
+    seed_present = any(d[3] is not None for d in drafts)
+    specs, count = [], 0
+    for name, caption, make, fixed in drafts:
+        if fixed is None:
+            count += 1
+            if seed_present and 3 <= count <= 6:
+                count = 7
+            number = count
+        else:
+            number = fixed
+        specs.append(FigureSpec(name, f"Figure {number}", caption, make))
+    return specs
 
 
 def _scenario_text(cmp) -> str:
@@ -135,10 +216,44 @@ def _scenario_text(cmp) -> str:
     )
 
 
+def _reproduce(cmp, command: str | None) -> list:
+    scenario = getattr(cmp, "scenario", None)
+    if scenario is not None:
+        return [
+            Paragraph(
+                "The exact command that redoes this run; scenario.toml, beside this "
+                "report, holds its whole scenario (vehicle, initial state, road, time "
+                "span, step and methods):"
+            ),
+            Code(scenario.command()),
+        ]
+    if command:
+        return [Code(command)]
+    return [
+        Paragraph(
+            "This report was written from Python without a Scenario, so no command can "
+            "redo it: rerun the code that called compare_methods. (A comparison built "
+            "from a qc_control Scenario, as the qc-control command builds it, gives the "
+            "exact command here and its scenario.toml beside the report.)"
+        )
+    ]
+
+
+def _numbered(blocks: list) -> list:
+    """Tables numbered in the order they appear."""
+    out, count = [], 0
+    for b in blocks:
+        if isinstance(b, Table):
+            count += 1
+            b = dataclasses.replace(b, label=f"Table {count}")
+        out.append(b)
+    return out
+
+
 def build_blocks(cmp, command: str | None = None) -> list:
     """The report as blocks, in the order: problem card, figures, findings, footer."""
     table = cmp.table
-    figs = {name: (name, caption) for name, caption, _ in _figures(cmp)}
+    figs = {spec.name: Image(spec.name, spec.caption, spec.label) for spec in figure_specs(cmp)}
     blocks = [Paragraph(_scenario_text(cmp)), Heading("Problem card")]
     if cmp.params is not None:
         frame = pd.DataFrame(cmp.params.table(), columns=["symbol", "quantity", "value", "unit"])
@@ -162,19 +277,33 @@ def build_blocks(cmp, command: str | None = None) -> list:
             f"It took {fmt(cmp.reference_time * 1e3)} ms."
         )
     )
+    blocks.append(figs["reference.png"])
 
+    blocks += [Heading("All methods against the reference"), figs["overlay.png"]]
     blocks.append(Heading("Per-method responses"))
-    blocks += [Image(*figs[f"method_{_slug(tab.name)}.png"]) for tab in cmp.methods]
-    blocks += [Heading("All methods against the reference"), Image(*figs["overlay.png"])]
+    names = [tab.name for tab in cmp.methods]
+    seed = [m for m in SEED_FIGURES if m in names]
+    if seed:
+        blocks.append(
+            Paragraph(
+                "Figures 3–6 keep the seed paper's numbers: Euler, Midpoint, RK4, Heun"
+                + (
+                    "."
+                    if len(seed) == len(SEED_FIGURES)
+                    else "; the numbers of the seed's methods not run here are left out."
+                )
+            )
+        )
+    blocks += [figs[f"method_{_slug(name)}.png"] for name in _method_order(cmp)]
 
     accuracy = [c for c in table.columns if "err" in c and "freq" not in c and "zeta" not in c]
     blocks += [
         Heading("Accuracy"),
-        Image(*figs["error.png"]),
+        figs["error.png"],
         Table(table[accuracy], "Errors against the reference over the whole run"),
     ]
 
-    blocks += [Heading("Convergence"), Image(*figs["convergence.png"])]
+    blocks += [Heading("Convergence"), figs["convergence.png"]]
     conv = cmp.convergence.pivot(index="h", columns="method", values="error")
     conv = conv.sort_index(ascending=False)[[t.name for t in cmp.methods]]
     conv.index.name = "h [s]"
@@ -186,7 +315,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
         )
     )
 
-    blocks += [Heading("Work and precision"), Image(*figs["work_precision.png"])]
+    blocks += [Heading("Work and precision"), figs["work_precision.png"]]
     cost_cols = [
         "stages",
         "steps",
@@ -198,9 +327,9 @@ def build_blocks(cmp, command: str | None = None) -> list:
     blocks.append(
         Table(
             table[cost_cols],
-            f"Cost at h = {fmt(cmp.h)} s (best of several runs): wall time "
-            "of the step-by-step loop, as the seed runs it, and of qc_control's "
-            "LTI engine, which computes the same trajectory; control's exact "
+            f"Cost at h = {fmt(cmp.h)} s (best of several runs; wall times depend on the "
+            "machine): wall time of the step-by-step loop, as the seed runs it, and of "
+            "qc_control's LTI engine, which computes the same trajectory; control's exact "
             f"response took {fmt(cmp.reference_time * 1e3)} ms",
         )
     )
@@ -219,7 +348,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
         )
     )
 
-    blocks += [Heading("Stability and numerical modes"), Image(*figs["stability.png"])]
+    blocks += [Heading("Stability and numerical modes"), figs["stability.png"]]
     stab_cols = ["h_max [s]", "limited by", "stable"] + [
         c for c in table.columns if "freq err" in c or "zeta err" in c
     ]
@@ -232,18 +361,18 @@ def build_blocks(cmp, command: str | None = None) -> list:
     )
 
     if cmp.ride is not None:
+        blocks.append(Heading("Road and ride"))
+        if "transmissibility.png" in figs:
+            blocks.append(figs["transmissibility.png"])
         blocks += [
-            Heading("Road and ride"),
-            Image(*figs["road.png"]),
-            Image(*figs["transmissibility.png"]),
             Table(
                 cmp.ride,
                 "Ride metrics of each method and of the exact reference "
                 "(ISO 2631-1 Wk weighting; tire load over the static "
                 "wheel load (ms + mu)·g)",
             ),
+            Table(cmp.ride_error, "Each method's ride metrics against the reference [%]"),
         ]
-        blocks.append(Table(cmp.ride_error, "Each method's ride metrics against the reference [%]"))
     blocks.append(Heading("Findings"))
     blocks += [Paragraph(text) for text in findings(cmp)]
 
@@ -256,14 +385,8 @@ def build_blocks(cmp, command: str | None = None) -> list:
             + f". Written {_dt.datetime.now().isoformat(timespec='seconds')}."
         )
     )
-    blocks.append(
-        Code(
-            command
-            or "python -c 'import qc_control as qc; "
-            'qc.write_report(qc.compare_methods(None), "report")\''
-        )
-    )
-    return blocks
+    blocks += _reproduce(cmp, command)
+    return _numbered(blocks)
 
 
 def _csv_tables(cmp) -> dict[str, pd.DataFrame]:
@@ -305,10 +428,14 @@ def write_report(
     out_dir : path
         Created if missing. An existing directory is replaced only if it is
         empty or an earlier qc-control report (it holds `MARKER`).
-    formats : iterable of {'md', 'html', 'csv'}
-        PNG figures are always written; Markdown and HTML link to them.
+    formats : iterable of {'md', 'html', 'pdf', 'csv'}
+        PNG figures are always written; Markdown links to them, while
+        ``report.html`` embeds them (self-contained) and ``report.pdf``
+        (A4, drawn with matplotlib) holds them.
     command : str, optional
-        The command that reproduces the report, printed in its footer.
+        The command that reproduces the report, printed in its footer when
+        ``cmp`` carries no ``scenario`` (whose ``command()`` wins, and whose
+        ``to_toml()`` is written to ``scenario.toml`` beside the report).
     overwrite : bool, default True
         Replace an earlier report in ``out_dir``.
 
@@ -336,16 +463,21 @@ def write_report(
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
     try:
-        for name, _, make in _figures(cmp):
-            make().savefig(tmp / name, dpi=110)
+        for spec in figure_specs(cmp):
+            spec.make().savefig(tmp / spec.name, dpi=DPI)
         blocks = build_blocks(cmp, command)
         if "md" in formats:
             (tmp / "report.md").write_text(to_markdown(TITLE, blocks), encoding="utf-8")
         if "html" in formats:
-            (tmp / "report.html").write_text(to_html(TITLE, blocks), encoding="utf-8")
+            (tmp / "report.html").write_text(to_html(TITLE, blocks, tmp), encoding="utf-8")
+        if "pdf" in formats:
+            to_pdf(TITLE, blocks, tmp, tmp / "report.pdf")
         if "csv" in formats:
             for name, frame in _csv_tables(cmp).items():
                 frame.to_csv(tmp / name)
+        scenario = getattr(cmp, "scenario", None)
+        if scenario is not None:
+            (tmp / "scenario.toml").write_text(scenario.to_toml(), encoding="utf-8")
         (tmp / MARKER).write_text(f"qc-control report\n{command or ''}\n", encoding="utf-8")
         if out.exists():
             old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))

@@ -1,19 +1,32 @@
 """A report as a list of blocks, rendered to Markdown or HTML.
 
-One list of blocks feeds both writers, so the two formats can never say
-different things.
+One list of blocks feeds every writer (Markdown, HTML and the PDF in
+`qc_control.report.pdf`), so the formats can never say different things.
 """
 
 from __future__ import annotations
 
+import base64
 import html
 import math
 from dataclasses import dataclass
 from numbers import Integral, Real
+from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["Heading", "Paragraph", "Table", "Image", "Code", "fmt", "to_markdown", "to_html"]
+__all__ = [
+    "Heading",
+    "Paragraph",
+    "Table",
+    "Image",
+    "Code",
+    "fmt",
+    "table_cells",
+    "caption_text",
+    "to_markdown",
+    "to_html",
+]
 
 
 @dataclass(frozen=True)
@@ -31,12 +44,14 @@ class Paragraph:
 class Table:
     frame: pd.DataFrame
     caption: str = ""
+    label: str = ""  # "Table 2"
 
 
 @dataclass(frozen=True)
 class Image:
     path: str  # relative to the report
     caption: str
+    label: str = ""  # "Figure 3"
 
 
 @dataclass(frozen=True)
@@ -44,27 +59,70 @@ class Code:
     text: str
 
 
+#: Integer-valued floats up to this size print in full (30000, not 3e+04).
+_WHOLE_LIMIT = 1e15
+
+
 def fmt(value) -> str:
-    """A number to 4 significant digits; integers and text unchanged."""
+    """A value as report text: numbers readable at a glance, text unchanged.
+
+    - integers, and floats with an integer value below 1e15, in full:
+      ``30000.0 -> '30000'``, ``29530.0 -> '29530'``;
+    - other reals to 4 significant digits, without an exponent from 1e-3 up
+      to 1e4 (``0.01982``, ``1503``), rounded to whole numbers from 1e4 up
+      to 1e15 (``12346``), with an exponent beyond (``1.917e-07``);
+    - complex values as ``a ± bj``, and a complex value with a zero
+      imaginary part as the real number it is;
+    - NaN as an en dash, infinities as ``∞``; booleans as yes/no.
+    """
     if isinstance(value, bool):
         return "yes" if value else "no"
     if isinstance(value, Integral):
-        return f"{value:d}"
+        return f"{int(value):d}"
     if isinstance(value, complex):
-        return f"{value.real:.4g} {'+' if value.imag >= 0 else '−'} {abs(value.imag):.4g}j"
+        if value.imag == 0:
+            return fmt(value.real)
+        return f"{fmt(value.real)} {'+' if value.imag >= 0 else '−'} {fmt(abs(value.imag))}j"
     if isinstance(value, Real):
+        value = float(value)
         if math.isnan(value):
             return "–"
         if math.isinf(value):
             return "∞" if value > 0 else "−∞"
-        return f"{value:.4g}"
+        if value == 0:
+            return "0"
+        size = abs(value)
+        if size < _WHOLE_LIMIT and value == round(value):
+            return f"{value:.0f}"
+        text = f"{value:.4g}"
+        if 1e-3 <= size < _WHOLE_LIMIT and "e" in text:  # 12345.6 or 9999.95
+            return f"{value:.0f}"
+        return text
     return str(value)
 
 
-def _cells(frame: pd.DataFrame) -> tuple[list[str], list[list[str]]]:
-    head = [frame.index.name or ""] + [str(c) for c in frame.columns]
-    body = [[fmt(idx)] + [fmt(v) for v in row] for idx, row in zip(frame.index, frame.values)]
-    return head, body
+def _is_number(value) -> bool:
+    return isinstance(value, (Real, complex)) and not isinstance(value, bool)
+
+
+def table_cells(frame: pd.DataFrame) -> tuple[list[str], list[list[str]], list[bool]]:
+    """(header, body rows, numeric flag per column) of a table, index first.
+
+    Each column is formatted from its own values (``Series.tolist`` keeps
+    each column's dtype), never from ``frame.values``, which upcasts a table
+    with one complex column to complex throughout. A column is numeric, and
+    right-aligned, when every value in it is a number.
+    """
+    columns = [frame.index.tolist()] + [frame.iloc[:, j].tolist() for j in range(frame.shape[1])]
+    numeric = [bool(col) and all(_is_number(v) for v in col) for col in columns]
+    head = [str(frame.index.name or "")] + [str(c) for c in frame.columns]
+    body = [[fmt(col[i]) for col in columns] for i in range(len(frame))]
+    return head, body, numeric
+
+
+def caption_text(block) -> str:
+    """'Figure 3: caption', or the caption alone when the block has no label."""
+    return f"{block.label}: {block.caption}" if block.label else block.caption
 
 
 def to_markdown(title: str, blocks) -> str:
@@ -75,63 +133,111 @@ def to_markdown(title: str, blocks) -> str:
         elif isinstance(b, Paragraph):
             out += [b.text, ""]
         elif isinstance(b, Table):
-            head, body = _cells(b.frame)
-            if b.caption:
-                out += [f"*{b.caption}*", ""]
+            head, body, numeric = table_cells(b.frame)
+            if b.caption or b.label:
+                out += [f"*{caption_text(b)}*", ""]
             out.append("| " + " | ".join(c.replace("|", "\\|") for c in head) + " |")
-            out.append("|" + "|".join("---" for _ in head) + "|")
+            out.append("|" + "|".join("---:" if n else ":---" for n in numeric) + "|")
             out += ["| " + " | ".join(c.replace("|", "\\|") for c in row) + " |" for row in body]
             out.append("")
         elif isinstance(b, Image):
-            out += [f"![{b.caption}]({b.path})", "", f"*{b.caption}*", ""]
+            out += [f"![{caption_text(b)}]({b.path})", "", f"*{caption_text(b)}*", ""]
         elif isinstance(b, Code):
             out += ["```", b.text, "```", ""]
     return "\n".join(out)
 
 
+# Tables scroll inside their own box on a narrow screen; the page never does.
 _CSS = """
 body { font-family: system-ui, sans-serif; max-width: 60em; margin: 2em auto; padding: 0 1em;
-       line-height: 1.45; color: #222; }
-table { border-collapse: collapse; margin: 0.5em 0 1.5em; font-size: 0.9em; }
-th, td { border: 1px solid #ccc; padding: 0.2em 0.6em; text-align: right; }
-th:first-child, td:first-child { text-align: left; }
-th { background: #f3f3f3; }
-figure { margin: 1em 0 2em; } figure img { max-width: 100%; }
-figcaption, caption { font-style: italic; color: #555; }
-pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; }
+       line-height: 1.45; color: #222; overflow-wrap: anywhere; }
+.table { overflow-x: auto; margin: 0.5em 0 1.5em; }
+table { border-collapse: collapse; font-size: 0.85em; }
+th, td { border: 1px solid #ccc; padding: 0.2em 0.5em; vertical-align: top; }
+th { background: #f3f3f3; overflow-wrap: normal; }
+td { white-space: nowrap; }
+.num { text-align: right; font-variant-numeric: tabular-nums; }
+.text { text-align: left; }
+figure { margin: 1em 0 2em; } figure img { max-width: 100%; height: auto; }
+figcaption, caption { font-style: italic; color: #555; text-align: left; }
+caption { caption-side: top; padding-bottom: 0.3em; }
+pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; white-space: pre-wrap; }
+@media print { .table { overflow: visible; } }
 """
 
 
-def to_html(title: str, blocks) -> str:
+def _data_uri(path: Path) -> str:
+    kind = {".png": "image/png", ".svg": "image/svg+xml", ".jpg": "image/jpeg"}.get(
+        path.suffix.lower(), "application/octet-stream"
+    )
+    return f"data:{kind};base64," + base64.b64encode(path.read_bytes()).decode("ascii")
+
+
+def _anchor(label: str) -> str:
+    return label.lower().replace(" ", "-")
+
+
+def to_html(title: str, blocks, image_dir=None) -> str:
+    """The report as one HTML page.
+
+    Parameters
+    ----------
+    title : str
+    blocks : list
+    image_dir : path, optional
+        Where the images' files are. When given, every image is embedded as
+        a data URI, so the page is self-contained (it can be mailed or
+        uploaded alone); otherwise images are relative links.
+    """
     esc = html.escape
     out = [
         "<!DOCTYPE html>",
         '<html lang="en">',
         "<head>",
         '<meta charset="utf-8">',
+        '<meta name="viewport" content="width=device-width, initial-scale=1">',
         f"<title>{esc(title)}</title>",
         f"<style>{_CSS}</style>",
         "</head>",
         "<body>",
         f"<h1>{esc(title)}</h1>",
     ]
+
+    def caption(b) -> str:
+        if not b.label:
+            return esc(b.caption)
+        return f"<b>{esc(b.label)}:</b> {esc(b.caption)}"
+
     for b in blocks:
         if isinstance(b, Heading):
             out.append(f"<h{b.level}>{esc(b.text)}</h{b.level}>")
         elif isinstance(b, Paragraph):
             out.append(f"<p>{esc(b.text)}</p>")
         elif isinstance(b, Table):
-            head, body = _cells(b.frame)
-            out.append("<table>")
-            if b.caption:
-                out.append(f"<caption>{esc(b.caption)}</caption>")
-            out.append("<tr>" + "".join(f"<th>{esc(c)}</th>" for c in head) + "</tr>")
-            out += ["<tr>" + "".join(f"<td>{esc(c)}</td>" for c in row) + "</tr>" for row in body]
-            out.append("</table>")
-        elif isinstance(b, Image):
+            head, body, numeric = table_cells(b.frame)
+            cls = ["num" if n else "text" for n in numeric]
+            ident = f' id="{_anchor(b.label)}"' if b.label else ""
+            out.append(f'<div class="table"{ident}><table>')
+            if b.caption or b.label:
+                out.append(f"<caption>{caption(b)}</caption>")
             out.append(
-                f'<figure><img src="{esc(b.path)}" alt="{esc(b.caption)}">'
-                f"<figcaption>{esc(b.caption)}</figcaption></figure>"
+                "<tr>"
+                + "".join(f'<th class="{k}">{esc(c)}</th>' for k, c in zip(cls, head))
+                + "</tr>"
+            )
+            out += [
+                "<tr>"
+                + "".join(f'<td class="{k}">{esc(c)}</td>' for k, c in zip(cls, row))
+                + "</tr>"
+                for row in body
+            ]
+            out.append("</table></div>")
+        elif isinstance(b, Image):
+            src = _data_uri(Path(image_dir) / b.path) if image_dir is not None else b.path
+            ident = f' id="{_anchor(b.label)}"' if b.label else ""
+            out.append(
+                f'<figure{ident}><img src="{esc(src)}" alt="{esc(caption_text(b))}">'
+                f"<figcaption>{caption(b)}</figcaption></figure>"
             )
         elif isinstance(b, Code):
             out.append(f"<pre><code>{esc(b.text)}</code></pre>")

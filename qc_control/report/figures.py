@@ -3,226 +3,412 @@
 They draw numbers already in the `MethodComparison`; none is recomputed
 here except the stability-region contours, which are drawings of R(z).
 They use `matplotlib.figure.Figure` directly (no pyplot state, no show()).
+
+Conventions, so that a projected figure reads at a glance:
+
+- legends sit outside the axes (``fig.legend(loc="outside ...")``), so they
+  never cover data;
+- methods with the same trajectory (``cmp.coincident``, e.g. Midpoint and
+  Heun on a linear system) are drawn dashed over each other, and the figure
+  says that they coincide;
+- outputs are looked up by label (`qc_control.plotting.output_signal`),
+  never by position.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Rectangle
+from matplotlib.ticker import NullFormatter
 
+from ..plotting import output_signal, output_unit
 from ..stability import stability_function
+from .findings import coincidence_groups
 
 __all__ = [
+    "reference_figure",
     "method_figure",
     "overlay_figure",
     "error_figure",
     "convergence_figure",
     "work_precision_figure",
     "stability_figure",
-    "road_figure",
+    "transmissibility_figure",
+    "coincidence_note",
 ]
 
 _MM = 1e3
+_CYCLE = (
+    "tab:blue",
+    "tab:orange",
+    "tab:green",
+    "tab:red",
+    "tab:purple",
+    "tab:brown",
+    "tab:pink",
+    "tab:olive",
+)
+#: Line styles of the 1st, 2nd, ... member of a group of coinciding methods.
+_OVERLAY_STYLES = ("-", (0, (5, 4)), (0, (1, 2.5)), (0, (8, 3, 1, 3)))
+_MARKERS = ("o", "s", "^", "v", "D")
+#: Exact responses: two greys and two styles, under the methods' colours.
+_EXACT = {
+    "xs": {"color": "0.55", "lw": 4.0, "ls": "-", "alpha": 0.7},
+    "xu": {"color": "0.8", "lw": 4.0, "ls": (0, (2, 1)), "alpha": 0.9},
+}
 
 
 def _colors(methods):
-    cycle = [
-        "tab:blue",
-        "tab:orange",
-        "tab:green",
-        "tab:red",
-        "tab:purple",
-        "tab:brown",
-        "tab:pink",
-        "tab:olive",
-    ]
-    return {m: cycle[i % len(cycle)] for i, m in enumerate(methods)}
+    return {m: _CYCLE[i % len(_CYCLE)] for i, m in enumerate(methods)}
+
+
+def _rank(cmp) -> dict[str, int]:
+    """Each method's place in its group of coinciding methods (0: drawn solid)."""
+    rank = {name: 0 for name in cmp.responses}
+    for group in coincidence_groups(cmp):
+        for i, name in enumerate(group):
+            rank[name] = i
+    return rank
+
+
+def coincidence_note(cmp) -> str:
+    """'midpoint = heun (≤ 1e-12 m apart)' for every group of coinciding methods."""
+    return "; ".join(
+        " = ".join(group) + " (same trajectory, ≤ 1e-12 m apart)"
+        for group in coincidence_groups(cmp)
+    )
+
+
+def _style(cmp, name, rank=None) -> dict:
+    rank = _rank(cmp) if rank is None else rank
+    return {
+        "ls": _OVERLAY_STYLES[rank[name] % len(_OVERLAY_STYLES)],
+        "zorder": 2 + rank[name],
+    }
+
+
+def _legend(fig, note: str = "", **kw):
+    """A figure legend outside the axes, on the right, with ``note`` as its title."""
+    kw.setdefault("loc", "outside right upper")
+    kw.setdefault("fontsize", "small")
+    if note:
+        kw.update(title=note.replace("; ", "\n").replace(" (", "\n("), title_fontsize="small")
+    return fig.legend(**kw)
+
+
+def reference_figure(cmp) -> Figure:
+    """The exact response the methods are measured against (and the road, if any)."""
+    ref = cmp.reference
+    fig = Figure(figsize=(8, 3.4), layout="constrained")
+    ax = fig.subplots()
+    if cmp.U is not None and "zr" in cmp.system.input_labels:
+        zr = np.asarray(cmp.U)[list(cmp.system.input_labels).index("zr")]
+        ax.plot(cmp.T, zr * _MM, color="tab:brown", lw=0.9, label="road zr")
+    ax.plot(ref.time, output_signal(ref, "xs") * _MM, "r-", lw=1.3, label="body xs (exact)")
+    ax.plot(ref.time, output_signal(ref, "xu") * _MM, "b--", lw=1.1, label="wheel xu (exact)")
+    ax.set(
+        xlabel="time [s]",
+        ylabel="displacement [mm]",
+        title=cmp.input_description or "Free response: the exact solution",
+    )
+    ax.grid(alpha=0.3)
+    _legend(fig)
+    return fig
 
 
 def method_figure(cmp, method: str) -> Figure:
     """One method's displacements against time, as in the seed's Figures 3-6.
 
     Sprung mass ``xs`` in red (solid), wheel ``xu`` in blue (dashed); the
-    exact response is drawn faintly underneath.
+    exact ``xs`` (dark grey, solid) and ``xu`` (light grey, dashed) are
+    drawn wide underneath.
     """
     resp, ref = cmp.responses[method], cmp.reference
-    fig = Figure(figsize=(7.5, 3.6), layout="constrained")
+    fig = Figure(figsize=(8, 3.4), layout="constrained")
     ax = fig.subplots()
-    ax.plot(ref.time, ref.outputs[0] * _MM, color="0.8", lw=3, label="exact xs, xu")
-    ax.plot(ref.time, ref.outputs[1] * _MM, color="0.8", lw=3)
-    ax.plot(resp.time, resp.outputs[0] * _MM, "r-", lw=1.2, label="suspension (sprung mass) xs")
-    ax.plot(resp.time, resp.outputs[1] * _MM, "b--", lw=1.2, label="wheel xu")
-    ax.set(xlabel="time [s]", ylabel="displacement [mm]", title=f"{method}, h = {cmp.h:g} s")
+    for name in ("xs", "xu"):
+        ax.plot(ref.time, output_signal(ref, name) * _MM, label=f"exact {name}", **_EXACT[name])
+    xs, xu = output_signal(resp, "xs"), output_signal(resp, "xu")
+    ax.plot(resp.time, xs * _MM, "r-", lw=1.2, label="suspension (sprung mass) xs")
+    ax.plot(resp.time, xu * _MM, "b--", lw=1.2, label="wheel xu")
+    title = f"{method}, h = {cmp.h:g} s"
+    same = [g for g in coincidence_groups(cmp) if method in g]
+    if same:
+        others = " and ".join(m for m in same[0] if m != method)
+        title += f"\nthe same trajectory as {others} (≤ 1e-12 m apart)"
+    ax.set(xlabel="time [s]", ylabel="displacement [mm]", title=title)
     ax.grid(alpha=0.3)
-    ax.legend(loc="upper right", fontsize="small")
+    _legend(fig, loc="outside lower center", ncols=4)
     return fig
 
 
 def overlay_figure(cmp) -> Figure:
     """Every method's body displacement over the exact response."""
-    colors = _colors(cmp.responses)
-    fig = Figure(figsize=(7.5, 3.8), layout="constrained")
+    colors, rank = _colors(cmp.responses), _rank(cmp)
+    fig = Figure(figsize=(8, 3.6), layout="constrained")
     ax = fig.subplots()
-    ax.plot(
-        cmp.reference.time,
-        cmp.reference.outputs[0] * _MM,
-        color="k",
-        lw=3,
-        alpha=0.25,
-        label="exact (python-control)",
-    )
+    ref = cmp.reference
+    ax.plot(ref.time, output_signal(ref, "xs") * _MM, color="k", lw=4, alpha=0.25, label="exact")
     for name, resp in cmp.responses.items():
-        ax.plot(resp.time, resp.outputs[0] * _MM, color=colors[name], lw=1, label=name)
+        ax.plot(
+            resp.time,
+            output_signal(resp, "xs") * _MM,
+            color=colors[name],
+            lw=1.2,
+            label=name,
+            **_style(cmp, name, rank),
+        )
     ax.set(
         xlabel="time [s]",
         ylabel="body displacement xs [mm]",
         title=f"All methods against the exact response, h = {cmp.h:g} s",
     )
     ax.grid(alpha=0.3)
-    ax.legend(fontsize="small", ncol=2)
+    _legend(fig, coincidence_note(cmp))
     return fig
 
 
 def error_figure(cmp) -> Figure:
     """|xs error| against time on a log axis."""
-    colors = _colors(cmp.responses)
-    fig = Figure(figsize=(7.5, 3.8), layout="constrained")
+    colors, rank = _colors(cmp.responses), _rank(cmp)
+    fig = Figure(figsize=(8, 3.6), layout="constrained")
     ax = fig.subplots()
+    exact = output_signal(cmp.reference, "xs")
     for name, resp in cmp.responses.items():
         n = resp.time.size
-        err = np.abs(resp.outputs[0] - cmp.reference.outputs[0, :n])
-        ax.semilogy(resp.time[1:], np.maximum(err[1:], 1e-17), color=colors[name], lw=1, label=name)
+        err = np.abs(output_signal(resp, "xs") - exact[:n])
+        err = np.where(err > 0, err, np.nan)  # exact zeros (t = 0) have no log
+        ax.semilogy(resp.time, err, color=colors[name], lw=1, label=name, **_style(cmp, name, rank))
     ax.set(
         xlabel="time [s]",
         ylabel="|xs − xs exact| [m]",
         title=f"Error against time, h = {cmp.h:g} s",
     )
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize="small", ncol=2)
+    _legend(fig, coincidence_note(cmp))
     return fig
 
 
-def _slope_guide(ax, x, y, p, color):
-    """A dashed line of slope p through the coarsest point, labelled h^p."""
-    x = np.asarray(x)
-    ax.loglog(x, y * (x / x[0]) ** p, ":", color=color, lw=1)
+def _slope_guide(ax, x, y0, p, color):
+    """A dotted line of slope p, starting a little above the coarsest point,
+    labelled ``h^p`` beside its middle, off the line (not struck through)."""
+    x = np.asarray(x, dtype=float)
+    y = y0 * (x / x[0]) ** p
+    ax.loglog(x, y, ":", color=color, lw=1.2)
+    mid = np.sqrt(x[0] * x[-1])
     ax.annotate(
-        f"h^{p}",
-        (x[-1], y * (x[-1] / x[0]) ** p),
+        f"$h^{{{p}}}$",
+        (mid, y0 * (mid / x[0]) ** p),
         color=color,
-        fontsize="small",
-        xytext=(4, 0),
+        fontsize="medium",
+        xytext=(-6, 6),
         textcoords="offset points",
+        ha="right",
+        va="bottom",
     )
 
 
 def convergence_figure(cmp) -> Figure:
     """Max |xs error| against h, log-log, with guides of slope p."""
     conv = cmp.convergence
-    colors = _colors(cmp.responses)
-    fig = Figure(figsize=(6.5, 4.5), layout="constrained")
+    colors, rank = _colors(cmp.responses), _rank(cmp)
+    fig = Figure(figsize=(7.5, 4.6), layout="constrained")
     ax = fig.subplots()
     for tab in cmp.methods:
-        rows = conv[conv["method"] == tab.name]
-        ok = np.isfinite(rows["error"])
-        ax.loglog(rows["h"][ok], rows["error"][ok], "o-", color=colors[tab.name], label=tab.name)
-        if ok.any():
+        rows = conv[conv["method"] == tab.name].sort_values("h", ascending=False)
+        ok = np.isfinite(rows["error"]) & (rows["error"] > 0)
+        ax.loglog(
+            rows["h"][ok],
+            rows["error"][ok],
+            marker=_MARKERS[rank[tab.name] % len(_MARKERS)],
+            mfc="none" if rank[tab.name] else colors[tab.name],
+            color=colors[tab.name],
+            label=tab.name,
+            **_style(cmp, tab.name, rank),
+        )
+        if ok.any() and rank[tab.name] == 0:  # one guide per group of coinciding methods
             _slope_guide(
                 ax,
                 rows["h"][ok].to_numpy(),
-                rows["error"][ok].iloc[0] * 1.6,
+                rows["error"][ok].iloc[0] * 3,
                 tab.order,
                 colors[tab.name],
             )
+    # ticks at the steps themselves: log-axis minor labels crowd a 1.5-decade range
+    hs = np.sort(conv["h"].unique())[::-1]
+    ax.set_xticks(hs, [f"{h:.3g}" for h in hs], fontsize="small")
+    ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set(
         xlabel="step h [s]",
         ylabel="max |xs error| [m]",
         title="Convergence (dotted: slope of the method's order)",
     )
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize="small")
+    _legend(fig, coincidence_note(cmp))
     return fig
 
 
 def work_precision_figure(cmp) -> Figure:
-    """Max |xs error| against RHS evaluations and against wall time."""
+    """Max |xs error| against RHS evaluations and against wall time.
+
+    Left, each method's refinements are joined in order of work (RHS
+    evaluations). Right, the measured wall times are drawn as points
+    only: a timing is one measurement on a shared machine, and a line
+    through noisy times would run back and forth.
+    """
     conv = cmp.convergence
-    colors = _colors(cmp.responses)
+    colors, rank = _colors(cmp.responses), _rank(cmp)
     fig = Figure(figsize=(10, 4.2), layout="constrained")
     left, right = fig.subplots(1, 2, sharey=True)
     for tab in cmp.methods:
         rows = conv[(conv["method"] == tab.name) & np.isfinite(conv["error"])]
-        left.loglog(rows["nfev"], rows["error"], "o-", color=colors[tab.name], label=tab.name)
-        right.loglog(
-            rows["time"] * 1e3, rows["error"], "o-", color=colors[tab.name], label=tab.name
+        rows = rows.sort_values("nfev", kind="stable")
+        style = dict(
+            color=colors[tab.name],
+            marker=_MARKERS[rank[tab.name] % len(_MARKERS)],
+            mfc="none" if rank[tab.name] else colors[tab.name],
+            label=tab.name,
+            **_style(cmp, tab.name, rank),
         )
+        left.loglog(rows["nfev"], rows["error"], **style)
+        # measured times are noisy: points only, so no line ever runs back in time
+        right.loglog(rows["time"] * 1e3, rows["error"], **{**style, "ls": "none"})
     left.set(
         xlabel="right-hand-side evaluations",
         ylabel="max |xs error| [m]",
-        title="Error against work",
+        title="Against work",
     )
-    right.set(xlabel="wall time, step by step [ms]", title="Error against time")
+    right.set(
+        xlabel="wall time, step by step [ms]",
+        title="Against wall time (this machine)",
+    )
     for ax in (left, right):
         ax.grid(alpha=0.3, which="both")
-    left.legend(fontsize="small")
+        ax.xaxis.set_minor_formatter(NullFormatter())  # minor labels would crowd
+    handles, labels = left.get_legend_handles_labels()
+    _legend(fig, coincidence_note(cmp), handles=handles, labels=labels)
     return fig
 
 
-def stability_figure(cmp) -> Figure:
-    """Stability regions |R(z)| <= 1 with hλ of each mode marked."""
-    colors = _colors(cmp.responses)
-    fig = Figure(figsize=(6.5, 5.5), layout="constrained")
-    ax = fig.subplots()
-    x = np.linspace(-3.5, 1.0, 400)
-    y = np.linspace(-3.2, 3.2, 400)
+def _regions(ax, cmp, x, y, colors, rank):
     Z = x[None, :] + 1j * y[:, None]
-    handles = []
-    styles = ["solid", "dashed", "dotted", "dashdot"]
-    for i, tab in enumerate(cmp.methods):
-        R = stability_function(tab)
-        # distinct styles: methods with the same R(z) (midpoint, heun) stay visible
-        cs = ax.contour(
+    for tab in cmp.methods:
+        ax.contour(
             x,
             y,
-            np.abs(R(Z)),
+            np.abs(stability_function(tab)(Z)),
             levels=[1.0],
             colors=[colors[tab.name]],
             linewidths=1.5,
-            linestyles=styles[i % len(styles)],
+            linestyles=[_OVERLAY_STYLES[rank[tab.name] % len(_OVERLAY_STYLES)]],
         )
-        handles.append((cs.legend_elements()[0][0], f"{tab.name}: |R(z)| = 1"))
-    markers = {"body bounce": "o", "wheel hop": "s"}
-    for mode in cmp.modes.modes:
-        for lam in (mode.eigenvalue, mode.eigenvalue.conjugate()):
-            (pt,) = ax.plot(
-                (cmp.h * lam).real,
-                (cmp.h * lam).imag,
-                markers[mode.name],
-                color="k",
-                ms=6,
-                mfc="none",
-            )
-        handles.append((pt, f"h·λ, {mode.name}"))
-    ax.axhline(0, color="0.6", lw=0.6)
-    ax.axvline(0, color="0.6", lw=0.6)
-    ax.set(
-        xlabel="Re(hλ)",
-        ylabel="Im(hλ)",
-        aspect="equal",
-        title=f"Stability regions; modes at h = {cmp.h:g} s",
+
+
+def _modes(ax, cmp, size=6):
+    for i, mode in enumerate(cmp.modes.modes):
+        z = cmp.h * np.array([mode.eigenvalue, np.conj(mode.eigenvalue)])
+        ax.plot(z.real, z.imag, _MARKERS[i % len(_MARKERS)], color="k", ms=size, mfc="none")
+
+
+def stability_figure(cmp) -> Figure:
+    """Stability regions |R(z)| <= 1 with hλ of each mode, and a zoom on hλ.
+
+    Left: the regions in full. Right: the square around the origin that
+    holds every hλ (outlined on the left), with the regions redrawn there,
+    so that modes near the boundary can be told inside from outside.
+    """
+    colors, rank = _colors(cmp.responses), _rank(cmp)
+    fig = Figure(figsize=(10.5, 4.8), layout="constrained")
+    full, zoom = fig.subplots(1, 2)
+    hl = cmp.h * np.array([m.eigenvalue for m in cmp.modes.modes])
+    reach = float(np.max(np.abs(hl))) if hl.size else 0.1
+    lim = max(3.2, 1.1 * reach)
+    x, y = np.linspace(-lim - 0.3, 1.0, 500), np.linspace(-lim, lim, 500)
+    _regions(full, cmp, x, y, colors, rank)
+    _modes(full, cmp)
+    # the zoom: a square around the origin that holds every hλ with a margin
+    half = 1.3 * max(reach, 1e-6)
+    cx = min(0.0, float(np.min(hl.real))) / 2 if hl.size else 0.0
+    xs = np.linspace(cx - half, cx + half, 500)
+    ys = np.linspace(-half, half, 500)
+    _regions(zoom, cmp, xs, ys, colors, rank)
+    _modes(zoom, cmp, size=8)
+    full.add_patch(Rectangle((cx - half, -half), 2 * half, 2 * half, fill=False, ec="0.3", lw=0.8))
+    for ax in (full, zoom):
+        ax.axhline(0, color="0.6", lw=0.6)
+        ax.axvline(0, color="0.6", lw=0.6)
+        ax.set(xlabel="Re(hλ)", ylabel="Im(hλ)", aspect="equal")
+    full.set_title("Stability regions |R(z)| ≤ 1")
+    zoom.set(
+        xlim=(cx - half, cx + half),
+        ylim=(-half, half),
+        title=f"Zoom: each mode's hλ at h = {cmp.h:g} s",
     )
-    ax.legend([h for h, _ in handles], [t for _, t in handles], fontsize="small", loc="upper left")
+    handles = [
+        Line2D(
+            [],
+            [],
+            color=colors[tab.name],
+            ls=_OVERLAY_STYLES[rank[tab.name] % len(_OVERLAY_STYLES)],
+            lw=1.5,
+            label=f"{tab.name}: |R(z)| = 1",
+        )
+        for tab in cmp.methods
+    ]
+    handles += [
+        Line2D(
+            [],
+            [],
+            ls="none",
+            marker=_MARKERS[i % len(_MARKERS)],
+            color="k",
+            mfc="none",
+            label=f"hλ, {mode.name}",
+        )
+        for i, mode in enumerate(cmp.modes.modes)
+    ]
+    note = "; ".join(" = ".join(g) + " (same R(z))" for g in coincidence_groups(cmp))
+    _legend(fig, note, handles=handles)
     return fig
 
 
-def road_figure(cmp) -> Figure:
-    """The road input zr against time, and the body's exact response to it."""
-    ref = cmp.reference
-    fig = Figure(figsize=(7.5, 3.6), layout="constrained")
-    ax = fig.subplots()
-    ax.plot(cmp.T, cmp.U[0] * _MM, color="0.3", lw=1, label="road zr")
-    ax.plot(ref.time, ref.outputs[0] * _MM, "r-", lw=1, label="body xs (exact)")
-    ax.set(xlabel="time [s]", ylabel="height [mm]", title=cmp.input_description or "Road input")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize="small")
+def transmissibility_figure(cmp) -> Figure:
+    """Magnitude and phase from the road height zr to each ride signal.
+
+    Drawn from ``cmp.transmissibility`` (frequencies and complex gains);
+    the circle marks the invariant point √(ku/mu), where
+    |body_acc/zr| = ku/ms for every damper.
+    """
+    tr = cmp.transmissibility
+    fig = Figure(figsize=(10, 6.5), layout="constrained")
+    axes = fig.subplots(2, 2, sharex=True).ravel()
+    for ax, (name, h) in zip(axes, tr.response.items()):
+        unit = output_unit(name)
+        gain = f"({unit})/m" if "/" in unit else f"{unit}/m"
+        ax.loglog(tr.freqs_hz, np.abs(h), color="tab:blue", lw=1.6)
+        ax.set(title=f"{name} / zr", ylabel=f"|H| [{gain}]")
+        ax.grid(alpha=0.3, which="both")
+        twin = ax.twinx()
+        twin.semilogx(tr.freqs_hz, np.degrees(np.unwrap(np.angle(h))), color="tab:orange", lw=0.9)
+        twin.set_ylabel("phase [deg]", color="tab:orange")
+        if name == "body_acc":
+            ax.plot([tr.invariant_hz], [tr.invariant_gain], "ko", mfc="none", ms=8)
+    for ax in axes[2:]:
+        ax.set_xlabel("frequency [Hz]")
+    handles = [
+        Line2D([], [], color="tab:blue", lw=1.6, label="|H| (left axis)"),
+        Line2D([], [], color="tab:orange", lw=0.9, label="phase (right axis)"),
+        Line2D(
+            [],
+            [],
+            ls="none",
+            marker="o",
+            color="k",
+            mfc="none",
+            label=f"invariant point\n{tr.invariant_hz:.3g} Hz, |H| = ku/ms",
+        ),
+    ]
+    _legend(fig, handles=handles, loc="outside lower center", ncols=3)
     return fig

@@ -6,7 +6,7 @@ import math
 
 from .document import fmt
 
-__all__ = ["findings"]
+__all__ = ["findings", "coincidence_groups"]
 
 _KIND = {
     "interpolated": "interpolated",
@@ -68,10 +68,17 @@ def _groups(pairs) -> list[list[str]]:
     return groups
 
 
+def coincidence_groups(cmp) -> list[list[str]]:
+    """Groups of methods with the same trajectory (``cmp.coincident``), each in
+    the comparison's method order."""
+    order = {name: i for i, name in enumerate(cmp.responses)}
+    return [sorted(g, key=order.get) for g in _groups(cmp.coincident)]
+
+
 def _coincidence(cmp) -> list[str]:
     out = []
     orders = cmp.table["order"]
-    for group in _groups(cmp.coincident):
+    for group in coincidence_groups(cmp):
         gap = max(v for k, v in cmp.coincident.items() if set(k) <= set(group))
         names = ", ".join(group[:-1]) + " and " + group[-1]
         p = int(orders[group[0]])
@@ -89,7 +96,7 @@ def _coincidence(cmp) -> list[str]:
         )
     names = set(cmp.table.index)
     if {"midpoint", "heun"} <= names and not any(
-        {"midpoint", "heun"} <= set(g) for g in _groups(cmp.coincident)
+        {"midpoint", "heun"} <= set(g) for g in coincidence_groups(cmp)
     ):
         out.append("midpoint and heun differ here by more than 1e-12 m.")
     return out
@@ -133,14 +140,30 @@ def _orders(cmp) -> list[str]:
     return out
 
 
+def _column(frame, *names) -> str:
+    """The first of ``names`` that ``frame`` has.
+
+    The ride metrics are being renamed to one spelling (CONTRACTS item 6,
+    e.g. ``rms_body_acc_wk [m/s²]``); the report reads the old and the new.
+    """
+    for name in names:
+        if name in frame.columns:
+            return name
+    raise KeyError(f"none of the columns {list(names)} in {list(frame.columns)}")
+
+
 def _ride(cmp) -> list[str]:
     if cmp.ride is None:
         return []
-    key = "rms_body_acc_wk [m/s²]"
-    ref = float(cmp.ride.loc["reference", key])
-    off = cmp.ride_error["rms_body_acc_wk [% off]"]
+    ride = cmp.ride
+    key = _column(ride, "rms_body_acc_wk [m/s²]", "rms body_acc Wk [m/s²]")
+    ref = float(ride.loc["reference", key])
+    off = cmp.ride_error[
+        _column(cmp.ride_error, "rms_body_acc_wk [% off]", "rms body_acc Wk [% off]")
+    ]
     parts = [f"{m} {v:+.2g}%" for m, v in off.items()]
-    lift = bool(cmp.ride.loc["reference", "lift_off"])
+    lift = bool(ride.loc["reference", _column(ride, "lift_off", "lift-off")])
+    tire = _column(ride, "rms_tire_load / static [-]", "rms tire load / static [-]")
     return [
         f"On this road the exact Wk-weighted body acceleration is {fmt(ref)} m/s² RMS "
         f"(ISO 2631-1); at h = {fmt(cmp.h)} s the methods give it "
@@ -150,8 +173,7 @@ def _ride(cmp) -> list[str]:
             "The dynamic tire load exceeds the static wheel load: the wheel would "
             "lift off, which this linear model does not represent."
             if lift
-            else f"The RMS dynamic tire load is "
-            f"{fmt(float(cmp.ride.loc['reference', 'rms_tire_load / static [-]']))} "
+            else f"The RMS dynamic tire load is {fmt(float(ride.loc['reference', tire]))} "
             "of the static wheel load, and the wheel never lifts off."
         )
     ]
