@@ -204,7 +204,7 @@ def plot_outputs(
             )
         color = f"C{i % 10}"
         top.plot(resp.time, curves[name], color=color, lw=1.3, ls=style, label=label)
-        if bottom is not None:
+        if bottom is not None and ref is not None:
             n = min(curves[name].size, ref.size)
             gap = np.abs(curves[name][:n] - ref[:n])
             # exact zeros have no place on a log axis: left out, not clipped

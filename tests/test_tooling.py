@@ -45,8 +45,6 @@ ENTRY_POINT = ("qc_control/console.py", "qc_control.cli")
 #: The presentation layer, where matplotlib may be imported at module level.
 PRESENTATION = ("qc_control.report", "qc_control.plotting")
 
-ARCHITECTURE_MERGE = "fixed by the architecture merge"
-
 
 def _run(args: list[str], timeout: float = 300) -> subprocess.CompletedProcess:
     return subprocess.run(
@@ -68,7 +66,6 @@ def test_ruff_format_is_clean():
 
 
 @pytest.mark.slow  # measured 0.9-3 s with a warm .mypy_cache, 8-21 s cold
-@pytest.mark.xfail(strict=True, reason=ARCHITECTURE_MERGE)
 def test_mypy_is_clean():
     run = _run([sys.executable, "-m", "mypy", "qc_control"])
     assert run.returncode == 0, run.stdout + run.stderr
@@ -79,7 +76,6 @@ def _lint_imports() -> subprocess.CompletedProcess:
     return _run([sys.executable, "-c", code, "--no-cache"])
 
 
-@pytest.mark.xfail(strict=True, reason=ARCHITECTURE_MERGE)
 def test_import_contracts_hold():
     """The contracts in pyproject.toml's [tool.importlinter]: the layers, the
     numerics that import nothing vehicle-specific, no cycles, and no module
@@ -267,7 +263,6 @@ def test_no_private_names_imported_across_modules():
     _assert_none(private_name_imports(), "private names imported from another module")
 
 
-@pytest.mark.xfail(strict=True, reason=ARCHITECTURE_MERGE)
 def test_imports_inside_functions_only_for_heavy_optional_packages():
     _assert_none(
         function_level_imports(),

@@ -14,12 +14,15 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
+import functools
 import platform
 import re
 import shutil
 import tempfile
+from collections.abc import Callable
 from importlib.metadata import version
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -37,6 +40,9 @@ from .figures import (
 )
 from .findings import findings
 from .pdf import to_pdf
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = [
     "write_report",
@@ -99,7 +105,7 @@ class FigureSpec:
     name: str
     label: str  # "Figure 3"
     caption: str
-    make: object  # () -> matplotlib Figure
+    make: Callable[[], Figure]
 
     @property
     def number(self) -> int:
@@ -121,7 +127,7 @@ def figure_specs(cmp) -> list[FigureSpec]:
     numbers (Euler 3, Midpoint 4, RK4 5, Heun 6) and the other figures
     count on from 7; otherwise figures are numbered in order.
     """
-    drafts = [
+    drafts: list[tuple[str, str, Callable[[], Any], int | None]] = [
         (
             "reference.png",
             "The exact response the methods are measured against: python-control's "
@@ -144,7 +150,7 @@ def figure_specs(cmp) -> list[FigureSpec]:
                 f"{name}: displacement of the suspension (sprung mass, red solid) and of "
                 f"the wheel (blue dashed) against the exact xs (dark grey) and xu (light "
                 f"grey, dashed), h = {cmp.h:g} s",
-                lambda name=name: method_figure(cmp, name),
+                functools.partial(method_figure, cmp, name),
                 SEED_FIGURES.get(name),
             )
         )

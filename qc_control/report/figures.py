@@ -17,6 +17,8 @@ Conventions, so that a projected figure reads at a glance:
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
@@ -54,7 +56,7 @@ _CYCLE = (
 _OVERLAY_STYLES = ("-", (0, (5, 4)), (0, (1, 2.5)), (0, (8, 3, 1, 3)))
 _MARKERS = ("o", "s", "^", "v", "D")
 #: Exact responses: two greys and two styles, under the methods' colours.
-_EXACT = {
+_EXACT: dict[str, dict[str, Any]] = {
     "xs": {"color": "0.55", "lw": 4.0, "ls": "-", "alpha": 0.7},
     "xu": {"color": "0.8", "lw": 4.0, "ls": (0, (2, 1)), "alpha": 0.9},
 }

@@ -72,7 +72,7 @@ def coincidence_groups(cmp) -> list[list[str]]:
     """Groups of methods with the same trajectory (``cmp.coincident``), each in
     the comparison's method order."""
     order = {name: i for i, name in enumerate(cmp.responses)}
-    return [sorted(g, key=order.get) for g in _groups(cmp.coincident)]
+    return [sorted(g, key=order.__getitem__) for g in _groups(cmp.coincident)]
 
 
 def _coincidence(cmp) -> list[str]:
@@ -94,8 +94,8 @@ def _coincidence(cmp) -> list[str]:
             )
             + ". They can differ on nonlinear systems or inputs that curve within a step."
         )
-    names = set(cmp.table.index)
-    if {"midpoint", "heun"} <= names and not any(
+    present = set(cmp.table.index)
+    if {"midpoint", "heun"} <= present and not any(
         {"midpoint", "heun"} <= set(g) for g in coincidence_groups(cmp)
     ):
         out.append("midpoint and heun differ here by more than 1e-12 m.")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import RendererAgg
@@ -45,9 +46,8 @@ class _Font:
 
     @property
     def prop(self) -> FontProperties:
-        return FontProperties(
-            family=self.family, size=self.size, weight=self.weight, style=self.style
-        )
+        style: Any = self.style  # 'normal' or 'italic': FontProperties wants the literal
+        return FontProperties(family=self.family, size=self.size, weight=self.weight, style=style)
 
 
 class _Measure:
@@ -229,6 +229,7 @@ class _Writer:
         self.pages.room(padded + cap_h)
         y0 = self.pages.y - 0.08 - height
         x0 = _LEFT + (_WIDTH - width) / 2
+        assert self.pages.fig is not None  # room() has opened a page
         ax = self.pages.fig.add_axes(
             (x0 / _PAGE_W, y0 / _PAGE_H, width / _PAGE_W, height / _PAGE_H)
         )
