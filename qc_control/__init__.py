@@ -80,7 +80,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from .integrate import DivergenceWarning, Solution
     from .methods import METHODS, ButcherTableau, get_method
     from .metrics import Metric, RideSignals
-    from .modal import ModalAnalysis, Mode, modal_analysis
+    from .modal import ModalAnalysis, Mode, modal_analysis, numerical_modes
     from .model import (
         OUTPUTS,
         STATES,
@@ -108,7 +108,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         wk_weighted,
     )
     from .scenario import Scenario, ScenarioError
-    from .stability import max_stable_step, numerical_modes, stability_function
+    from .stability import max_stable_step, stability_function
     from .sweeps import DEFAULT_METRICS, METRICS, SweepChunk, SweepResult, design_grid, sweep
     from .vehicle import Corner, SignalRoles, VehicleModel
 
@@ -155,7 +155,7 @@ _LAZY: dict[str, str] = {
     "wk_filter": "ride",
     "wk_weighted": "ride",
     "max_stable_step": "stability",
-    "numerical_modes": "stability",
+    "numerical_modes": "modal",
     "stability_function": "stability",
     "DEFAULT_METRICS": "sweeps",
     "METRICS": "sweeps",

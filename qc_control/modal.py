@@ -9,9 +9,10 @@ import control
 import numpy as np
 import pandas as pd
 
+from . import stability
 from .model import QuarterCarParams, quarter_car
 
-__all__ = ["Mode", "ModalAnalysis", "modal_analysis", "quarter_car_matrices"]
+__all__ = ["Mode", "ModalAnalysis", "modal_analysis", "quarter_car_matrices", "numerical_modes"]
 
 BODY, WHEEL = "body bounce", "wheel hop"
 
@@ -283,3 +284,26 @@ def _damping_note(body: Mode, MinvK: np.ndarray) -> str:
         f"moves {body.shape_ratio:.2f} times as far as the body and the damper strokes "
         f"{stroke:.2f} of the body's motion."
     )
+
+
+def numerical_modes(method, h: float, vehicle=None) -> pd.DataFrame:
+    """`qc_control.stability.numerical_modes` with the vehicle's modes named.
+
+    A quarter car (parameters, a dict, ``None`` for the seed's, or a system
+    in quarter-car form) gets rows ``body bounce`` and ``wheel hop`` from
+    `modal_analysis`; any other system or list of eigenvalues gets the
+    general rows (``mode 1``, ``mode 2``, ... by increasing ``|λ|``).
+
+    Examples
+    --------
+    >>> nm = numerical_modes("euler", 0.01)
+    >>> list(nm.index), bool(nm.loc["body bounce", "zeta error"] < 0)
+    (['body bounce', 'wheel hop'], True)
+    """
+    if vehicle is None or isinstance(vehicle, (QuarterCarParams, dict)):
+        return stability.numerical_modes(method, h, modal_analysis(vehicle))
+    try:
+        named = modal_analysis(vehicle)
+    except (TypeError, ValueError):  # not a quarter car: general rows
+        return stability.numerical_modes(method, h, vehicle)
+    return stability.numerical_modes(method, h, named)

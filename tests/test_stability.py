@@ -10,11 +10,12 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control import METHODS, max_stable_step, numerical_modes, stability_function
+from qc_control import METHODS, max_stable_step, stability_function
 from qc_control.stability import (
     MARGINAL_RTOL,
     amplification,
     eigenvalues_of,
+    numerical_modes,
     step_is_stable,
 )
 
