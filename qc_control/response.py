@@ -714,11 +714,13 @@ def forced_response(
 
     Parameters
     ----------
-    sysdata : StateSpace, TransferFunction or list of them
+    sysdata : StateSpace, TransferFunction, NonlinearIOSystem or list of them
         A list gives a `control.TimeResponseList`, one response per system.
         Discrete-time and ``dt=None`` systems are simulated by their own
         difference equation, as python-control does (no method applied;
-        see the result's ``note``). Nonlinear systems are refused for now.
+        see the result's ``note``). A nonlinear system goes to
+        `input_output_response`, as python-control's does (``engine`` does
+        not apply to it).
     timepts (or T) : array_like
         Sample times [s], strictly increasing. Each interval is one step
         (or ``substeps`` steps); unlike python-control, a non-uniform grid
