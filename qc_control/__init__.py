@@ -97,6 +97,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         forced_response,
         impulse_response,
         initial_response,
+        input_output_response,
         step_response,
     )
     from .ride import (
@@ -148,6 +149,7 @@ _LAZY: dict[str, str] = {
     "initial_response": "response",
     "step_response": "response",
     "impulse_response": "response",
+    "input_output_response": "response",
     "Transmissibility": "ride",
     "ride_metrics": "ride",
     "ride_metrics_spectral": "ride",
@@ -214,6 +216,7 @@ __all__ = [
     "forced_response",
     "step_response",
     "impulse_response",
+    "input_output_response",
     "FixedStepResponse",
     "stability_function",
     "max_stable_step",

@@ -360,15 +360,15 @@ def test_list_of_systems_gives_a_time_response_list():
     assert isinstance(qc.forced_response(systems, T, 0.0, X0), control.TimeResponseList)
 
 
-def test_nonlinear_systems_are_refused_until_the_engine_lands():
+def test_nonlinear_systems_go_to_input_output_response_as_in_control():
+    # the responses themselves: tests/test_nonlinear_response.py
     nl = control.nlsys(lambda t, x, u, params: -x + u, None, inputs=1, states=1, name="nl")
-    for call in (
-        lambda: qc.initial_response(nl, [0, 1], 1.0),
-        lambda: qc.forced_response(nl, [0, 1], 0.0),
-        lambda: qc.step_response(nl, [0, 1]),
+    for r in (
+        qc.initial_response(nl, [0, 1], 1.0),
+        qc.forced_response(nl, [0, 1], 0.0),
+        qc.step_response(nl, [0, 1]),
     ):
-        with pytest.raises(NotImplementedError, match="nonlinear engine is not there yet"):
-            call()
+        assert isinstance(r, qc.FixedStepResponse) and r.method.name == "rk4"
     with pytest.raises(ValueError, match="must be LTI"):  # control's own refusal
         qc.impulse_response(nl, [0, 1])
 

@@ -22,8 +22,14 @@ python-control's other response functions in ``control.timeresp``
 (``step_response``, ``impulse_response``, ``initial_response`` are built on
 ``forced_response``; they keep control's own); ``all`` routes those too.
 ``QC_PEER_REPORT`` names the JSON file that receives the callers, each
-test's outcome, the tests in which qc_control refused a nonlinear system,
-and each test's largest relative difference from python-control.
+test's outcome, the tests in which a nonlinear system went through
+qc_control's nonlinear engine, and each test's largest relative difference
+from python-control: from its exact answer for linear systems, from its
+answer with solve_ivp at `TIGHT_IVP` for nonlinear ones.
+
+Nonlinear systems: the step is chosen by the same rule, with ``|λ|max``
+from the system's Jacobian at the call's initial state and first input
+(python-control's ``linearize``).
 
 Random systems: python-control's tests draw them with ``ct.rss`` from
 numpy's global generator. The plugin seeds it per test (from the node id),
@@ -73,6 +79,8 @@ FUNCS = (
 _ORIGINAL = {name: getattr(ct_timeresp, name) for name in FUNCS}
 _SIGNATURE = {name: inspect.signature(f) for name, f in _ORIGINAL.items()}
 _ALIASES = {"timepts": "T", "timepts_num": "T_num"}
+#: the module (``control.nlsys`` is also the name of its factory function)
+_NLSYS = sys.modules["control.nlsys"]
 
 COMPARE = os.environ.get("QC_PEER_COMPARE", "1") == "1"
 
@@ -80,17 +88,35 @@ _current: str | None = None
 _comparing = False
 called: set[str] = set()
 outcomes: dict[str, str] = {}
-refused: set[str] = set()  # tests in which qc_control refused a nonlinear system
-errors: dict[str, float] = {}  # largest relative difference from control, per test
+nonlinear: set[str] = set()  # tests in which a nonlinear system went to qc's nonlinear engine
+errors: dict[str, float] = {}  # largest relative difference from control, per test (LTI calls)
+errors_nonlinear: dict[str, float] = {}  # the same for nonlinear calls, from a tight solve_ivp
+_in_nonlinear = False  # set by the nonlinear engine's hook during a routed call
+
+#: The reference for a nonlinear call: python-control's own response with
+#: solve_ivp at these settings instead of its default (RK45, rtol 1e-3).
+TIGHT_IVP = {"method": "DOP853", "rtol": 1e-12, "atol": 1e-12}
 
 
-def _record_refusal(original):
-    def refuse(sys, *args, **kwargs):
+def _record_nonlinear(original):
+    def engine(sys, *args, **kwargs):
+        global _in_nonlinear
+        _in_nonlinear = True
         if _current is not None:
-            refused.add(_current)
+            nonlinear.add(_current)
         return original(sys, *args, **kwargs)
 
-    return refuse
+    return engine
+
+
+def _tight(original_iorsp):
+    """control.input_output_response with solve_ivp at `TIGHT_IVP`."""
+
+    def iorsp(*args, **kwargs):
+        kwargs["solve_ivp_kwargs"] = {**(kwargs.get("solve_ivp_kwargs") or {}), **TIGHT_IVP}
+        return original_iorsp(*args, **kwargs)
+
+    return iorsp
 
 
 def _relative_difference(ours, theirs) -> float:
@@ -113,10 +139,18 @@ def _relative_difference(ours, theirs) -> float:
     return worst
 
 
-def _compare(original, ours_result, args, kwargs) -> None:
-    """Run control's own function on the same call and keep the difference."""
+def _compare(original, ours_result, args, kwargs, is_nonlinear: bool) -> None:
+    """Run control's own function on the same call and keep the difference.
+
+    On a nonlinear system control's answer is solve_ivp's at its default
+    tolerances (RK45, rtol 1e-3), not an exact one: the call is then run
+    with solve_ivp at `TIGHT_IVP`, and the difference kept apart.
+    """
     global _comparing
     _comparing = True
+    saved = _NLSYS.input_output_response
+    if is_nonlinear:
+        _NLSYS.input_output_response = _tight(saved)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -125,9 +159,11 @@ def _compare(original, ours_result, args, kwargs) -> None:
         return
     finally:
         _comparing = False
+        _NLSYS.input_output_response = saved
     err = _relative_difference(ours_result, theirs)
+    table = errors_nonlinear if is_nonlinear else errors
     if _current is not None:
-        errors[_current] = max(errors.get(_current, 0.0), err)
+        table[_current] = max(table.get(_current, 0.0), err)
 
 
 def _argument(name: str, args, kwargs, key: str):
@@ -148,6 +184,28 @@ def _h_lambda(t_lambda: float) -> float:
     if not (math.isfinite(t_lambda) and t_lambda > 0):
         return H_LAMBDA
     return min(H_LAMBDA, (120 * TARGET / t_lambda) ** 0.25)
+
+
+def _jacobian(system, name: str, args, kwargs) -> np.ndarray:
+    """A nonlinear system's Jacobian at the call's initial state and first input.
+
+    python-control's own `linearize` (forward differences); an empty array
+    when it cannot be had (then the grid's own step is used).
+    """
+    try:
+        X0 = _argument(name, args, kwargs, "initial_state")
+        x0, _ = _NLSYS._process_vector_argument(0.0 if X0 is None else X0, "X0", system.nstates)
+        U = _argument(name, args, kwargs, "inputs")
+        u = np.asarray(0.0 if U is None else U, dtype=float)
+        # the first sample: U is (ninputs, N), (N,) for one input, or a number
+        u0 = u[:, 0] if u.ndim == 2 else (u[:1] if u.ndim == 1 else np.full(system.ninputs, u))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            params = _argument(name, args, kwargs, "params")
+            lin = system.linearize(x0, u0 if system.ninputs else None, params=params)
+        return np.asarray(lin.A, dtype=float)
+    except Exception:
+        return np.zeros((0, 0))
 
 
 def _fine_substeps(name: str, args, kwargs) -> int:
@@ -174,9 +232,14 @@ def _fine_substeps(name: str, args, kwargs) -> int:
         return 1
     need = 1
     for system in systems:
-        if not isinstance(system, control.LTI) or not control.isctime(system, strict=True):
+        if not isinstance(system, control.InputOutputSystem) or not control.isctime(
+            system, strict=True
+        ):
             continue
-        A = np.asarray(control.ss(system).A, dtype=float)
+        if isinstance(system, control.LTI):
+            A = np.asarray(control.ss(system).A, dtype=float)
+        else:
+            A = _jacobian(system, name, args, kwargs)
         if A.size and np.all(np.isfinite(A)) and math.isfinite(H) and H > 0:
             lam = float(np.max(np.abs(np.linalg.eigvals(A))))
             need = max(need, math.ceil(H * lam / _h_lambda(span * lam)))
@@ -197,10 +260,12 @@ def _routed(name: str):
             called.add(_current)
         if MODE == "record":
             return original(*args, **kwargs)
+        global _in_nonlinear
         substeps = _fine_substeps(name, args, kwargs)
+        _in_nonlinear = False
         result = ours(*args, method="rk4", substeps=substeps, **kwargs)
         if COMPARE:
-            _compare(original, result, args, kwargs)
+            _compare(original, result, args, kwargs, _in_nonlinear)
         return result
 
     call.__name__ = call.__qualname__ = name
@@ -212,7 +277,7 @@ def _routed(name: str):
 def pytest_configure(config):
     # control's rss draws from numpy's legacy global generator: seed that one
     np.random.seed(0)  # noqa: NPY002  (systems drawn while collecting)
-    qc_response._nonlinear_response = _record_refusal(qc_response._nonlinear_response)
+    qc_response._nonlinear_response = _record_nonlinear(qc_response._nonlinear_response)
     for name in _ORIGINAL:
         routed = _routed(name)
         setattr(control, name, routed)
@@ -255,8 +320,9 @@ def pytest_sessionfinish(session, exitstatus):
                     "h_lambda": H_LAMBDA,
                     "called": sorted(called),
                     "outcomes": outcomes,
-                    "refused_nonlinear": sorted(refused),
+                    "nonlinear": sorted(nonlinear),
                     "relative_difference": errors,
+                    "relative_difference_nonlinear": errors_nonlinear,
                 },
                 f,
                 indent=0,
