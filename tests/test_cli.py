@@ -28,6 +28,7 @@ def run(*args):
     )
 
 
+@pytest.mark.slow
 def test_modes_prints_table():
     out = run("modes")
     assert out.returncode == 0, out.stderr
@@ -43,6 +44,7 @@ def test_modes_options_and_config(tmp_path, capsys):
     assert "8.66" in text
 
 
+@pytest.mark.slow
 def test_version(capsys):
     assert main(["--version"]) == 0
     assert capsys.readouterr().out.startswith(f"qc-control {qc_control.__version__} (")
@@ -119,6 +121,7 @@ def test_bad_input_one_line_exit_2(files, monkeypatch, args, words, capsys):
     assert "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_bad_input_via_real_process(files):
     out = run("report", "--road", "iso8608", "--seed", "-1")
     assert out.returncode == 2 and out.stdout == ""

@@ -26,6 +26,7 @@ def taylor_map(A, h, p):
     return total
 
 
+@pytest.mark.slow
 def test_errors_against_an_independent_trajectory(seed_cmp):
     """For s = p methods the trajectory is x_{k+1} = T_p(hA) x_k (no stepper involved)."""
     sys = seed_cmp.system
@@ -48,6 +49,7 @@ def test_errors_against_an_independent_trajectory(seed_cmp):
         assert row["RHS evals"] == p * 400 and row["steps"] == 400
 
 
+@pytest.mark.slow
 def test_step_limits_and_modes_from_eigenvalues(seed_cmp):
     lam = np.linalg.eigvals(np.asarray(seed_cmp.system.A))
     euler = min(-2 * l.real / abs(l) ** 2 for l in lam)  # |1 + h lambda| = 1
@@ -62,18 +64,21 @@ def test_step_limits_and_modes_from_eigenvalues(seed_cmp):
     )
 
 
+@pytest.mark.slow
 def test_observed_orders_in_the_asymptotic_range():
     cmp = qc.compare_methods(None, np.linspace(0, 2, 1001), X0, repeats=1)  # h = 2 ms
     for name, p in ORDERS.items():
         assert cmp.table.loc[name, "observed order"] == pytest.approx(p, abs=0.15)
 
 
+@pytest.mark.slow
 def test_reference_accuracy_is_stated_and_tiny(seed_cmp):
     # python-control's expm recurrence against the modal closed form: rounding only
     assert seed_cmp.reference_error < 1e-14
     assert "closed form" in seed_cmp.reference_description
 
 
+@pytest.mark.slow
 def test_cost_to_reach_brackets_the_measurements(seed_cmp):
     conv = seed_cmp.convergence
     for name in ORDERS:
@@ -88,11 +93,13 @@ def test_cost_to_reach_brackets_the_measurements(seed_cmp):
                 assert kind == "extrapolated" and n > 0
 
 
+@pytest.mark.slow
 def test_midpoint_heun_recorded_as_coincident(seed_cmp):
     assert ("midpoint", "heun") in seed_cmp.coincident
     assert seed_cmp.coincident[("midpoint", "heun")] < 1e-12
 
 
+@pytest.mark.slow
 def test_forced_comparison_uses_forced_reference():
     T = np.linspace(0, 2, 201)
     U = np.where(T >= 0.5, 0.05, 0.0)
@@ -131,6 +138,7 @@ def test_non_uniform_grid_rejected():
         qc.compare_methods(None, [0, 0.1, 0.3], X0)
 
 
+@pytest.mark.slow
 def test_steps_compose_and_timing_is_optional():
     """compare_methods is its steps: each run alone gives the same numbers, and
     without timing every number but the times is unchanged."""

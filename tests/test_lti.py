@@ -20,6 +20,7 @@ def rel(a, b):
     return np.max(np.abs(a - b)) / np.max(np.abs(b))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ALL, ids=lambda m: getattr(m, "name", m))
 @pytest.mark.parametrize("substeps", [1, 3])
 def test_lti_equals_generic(method, substeps):

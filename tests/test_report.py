@@ -40,6 +40,7 @@ def report(cmp, tmp_path_factory):
     return write_report(cmp, tmp_path_factory.mktemp("r") / "report", command="qc-control report")
 
 
+@pytest.mark.slow
 def test_files_and_figure_count(report, cmp):
     pngs = sorted(report.glob("*.png"))
     assert len(pngs) == len(cmp.methods) + 6  # per-method + reference + 5 comparison figures
@@ -84,6 +85,7 @@ def test_method_figure_is_the_seeds_style(cmp):
     assert "[mm]" in ax.get_ylabel() and "[s]" in ax.get_xlabel()
 
 
+@pytest.mark.slow
 def test_every_markdown_link_resolves(report):
     text = (report / "report.md").read_text()
     links = re.findall(r"\]\(([^)]+)\)", text)
@@ -103,6 +105,7 @@ class _Images(HTMLParser):
             self.srcs.append(dict(attrs)["src"])
 
 
+@pytest.mark.slow
 def test_html_opens_and_its_images_load(report):
     parser = _Images()
     parser.feed((report / "report.html").read_text(encoding="utf-8"))
@@ -113,6 +116,7 @@ def test_html_opens_and_its_images_load(report):
         assert base64.b64decode(src.split(",", 1)[1])[:8] == PNG, src[:40]
 
 
+@pytest.mark.slow
 def test_sections_in_the_issues_order(report):
     text = (report / "report.md").read_text()
     order = [
@@ -132,6 +136,7 @@ def test_sections_in_the_issues_order(report):
     assert "python-control" in text.split("## Reproduce")[1]
 
 
+@pytest.mark.slow
 def test_findings_are_written_from_the_numbers(report, cmp):
     text = (report / "report.md").read_text().split("## Findings")[1]
     assert f"{cmp.table.loc['euler', 'h_max [s]']:.4g} s" in text
@@ -148,6 +153,7 @@ def test_refuses_a_directory_that_is_not_a_report(cmp, tmp_path):
     assert (tmp_path / "mine.txt").read_text() == "keep me"
 
 
+@pytest.mark.slow
 def test_replaces_its_own_report(cmp, tmp_path):
     out = tmp_path / "rep"
     write_report(cmp, out)
@@ -157,6 +163,7 @@ def test_replaces_its_own_report(cmp, tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["rep"]
 
 
+@pytest.mark.slow
 def test_a_failure_leaves_no_partial_output(cmp, tmp_path, monkeypatch):
     out = tmp_path / "rep"
     write_report(cmp, out)
@@ -180,6 +187,7 @@ def test_unknown_format(cmp, tmp_path):
         write_report(cmp, tmp_path / "r", formats=("md", "docx"))
 
 
+@pytest.mark.slow
 def test_cli_report_writes_and_prints(tmp_path, capsys):
     out = tmp_path / "rep"
     assert (
@@ -223,6 +231,7 @@ def test_cli_refuses_foreign_directory(tmp_path, capsys):
     assert "refusing to overwrite" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_road_report_has_the_ride_section(tmp_path, capsys):
     out = tmp_path / "road"
     assert (
@@ -315,6 +324,7 @@ def test_cells_are_formatted_per_column_not_upcast():
     assert numeric == [False, True, True, True]
 
 
+@pytest.mark.slow
 def test_modes_and_parameters_print_real_numbers_as_real(report, cmp):
     text = (report / "report.md").read_text(encoding="utf-8")
     assert "+ 0j" not in text and "e+04" not in text
@@ -350,6 +360,7 @@ class _Cells(HTMLParser):
             self._cell = None
 
 
+@pytest.mark.slow
 def test_html_aligns_text_left_and_numbers_right(report):
     html = (report / "report.html").read_text(encoding="utf-8")
     assert re.search(r"\.num \{[^}]*text-align: right", html)
@@ -363,6 +374,7 @@ def test_html_aligns_text_left_and_numbers_right(report):
     assert "|:---|:---|---:|:---|" in md  # the same alignment in Markdown
 
 
+@pytest.mark.slow
 def test_html_is_self_contained(report, tmp_path):
     alone = tmp_path / "mailed" / "report.html"
     alone.parent.mkdir()
@@ -377,6 +389,7 @@ def test_html_is_self_contained(report, tmp_path):
     assert not re.search(r'(?:src|href)="(?!data:)', html)  # no link to another file
 
 
+@pytest.mark.slow
 def test_pdf_is_written_without_a_browser(report, cmp):
     data = (report / "report.pdf").read_bytes()
     assert data[:5] == b"%PDF-" and data.rstrip().endswith(b"%%EOF")
@@ -399,6 +412,7 @@ def _labels(text, kind):
     return [int(n) for n in re.findall(rf"^\*{kind} (\d+):", text, re.M)]
 
 
+@pytest.mark.slow
 def test_figures_and_tables_are_numbered_as_in_the_seed(report):
     text = (report / "report.md").read_text(encoding="utf-8")
     figures = _labels(text, "Figure")
@@ -441,6 +455,7 @@ class _Scenario:
         return "qc-control report --config rep/scenario.toml --out rep"
 
 
+@pytest.mark.slow
 def test_scenario_toml_beside_the_report_and_its_command(cmp, tmp_path):
     with_scenario = copy.copy(cmp)
     with_scenario.scenario = _Scenario()
@@ -450,6 +465,7 @@ def test_scenario_toml_beside_the_report_and_its_command(cmp, tmp_path):
     assert _Scenario().command() in reproduce and "ignored" not in reproduce
 
 
+@pytest.mark.slow
 def test_reproduce_never_claims_a_command_it_does_not_have(cmp, tmp_path):
     out = write_report(cmp, tmp_path / "rep", formats=("md",))
     reproduce = (out / "report.md").read_text(encoding="utf-8").split("## Reproduce")[1]
@@ -479,6 +495,7 @@ def _all_figures(cmp):
     }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("h", [0.01, 0.025])  # 0.025 s: Euler unstable, growing to 80 mm
 def test_legends_never_cover_data(h):
     cmp = qc.compare_methods(qc.QuarterCarParams(), np.linspace(0, 5, round(5 / h) + 1), repeats=1)
@@ -492,6 +509,7 @@ def test_legends_never_cover_data(h):
                 assert not box.overlaps(ax.get_window_extent(renderer)), (name, ax.get_title())
 
 
+@pytest.mark.slow
 def test_midpoint_and_heun_are_shown_to_coincide(cmp):
     assert ("midpoint", "heun") in cmp.coincident
     for name in ("overlay", "error", "convergence", "work_precision"):

@@ -377,6 +377,7 @@ def test_command_redoes_the_scenario(sc, tmp_path):
 # -------------------------------------------------------------------- run
 
 
+@pytest.mark.slow
 def test_run_is_compare_methods_on_the_scenario():
     sc = Scenario(road=BumpRoad(height=0.1, speed=15.0), t_end=1.0, methods=("heun", "rk4"))
     cmp = sc.run()
