@@ -85,10 +85,8 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         OUTPUTS,
         STATES,
         QuarterCarParams,
-        load_config,
         quarter_car,
         quarter_car_model,
-        read_config,
     )
     from .plotting import plot_outputs
     from .report import write_report
@@ -108,7 +106,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         wk_filter,
         wk_weighted,
     )
-    from .scenario import Scenario, ScenarioError
+    from .scenario import Scenario, ScenarioError, load_config, read_config
     from .stability import max_stable_step, stability_function
     from .sweeps import DEFAULT_METRICS, METRICS, SweepChunk, SweepResult, design_grid, sweep
     from .vehicle import Corner, SignalRoles, VehicleModel
@@ -131,9 +129,9 @@ _LAZY: dict[str, str] = {
     "OUTPUTS": "model",
     "STATES": "model",
     "QuarterCarParams": "model",
-    "load_config": "model",
+    "load_config": "scenario",
     "quarter_car": "model",
-    "read_config": "model",
+    "read_config": "scenario",
     "quarter_car_model": "model",
     "Metric": "metrics",
     "RideSignals": "metrics",

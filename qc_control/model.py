@@ -20,21 +20,14 @@ from __future__ import annotations
 
 import functools
 import math
-import sys
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, fields
-from pathlib import Path
 from typing import Any
 
 import control
 import numpy as np
 
 from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
 
 __all__ = [
     "QuarterCarParams",
@@ -47,8 +40,6 @@ __all__ = [
     "STATES",
     "OUTPUTS",
     "UNITS",
-    "load_config",
-    "read_config",
 ]
 
 #: State names: the seed's ``[xs', xu', xs, xu]``.
@@ -245,46 +236,6 @@ class QuarterCarParams:
     def table(self) -> list[tuple[str, str, float, str]]:
         """Rows ``(symbol, description, value, unit)`` for reports."""
         return [(n, _DESCRIPTIONS[n], getattr(self, n), _UNITS[n]) for n in _UNITS]
-
-
-def read_config(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
-    """Read a TOML file into ``(parameter values, scenario table)``, unresolved.
-
-    Parameter keys (``ms``, ``mu``, ``ks``, ``ku``, ``zeta``, ``cs``) stand at
-    the top level; an optional ``[scenario]`` table is returned as it is
-    (its reader checks it). Any other top-level key, or a bad value, raises
-    ``ValueError`` naming the file and the key or value.
-    """
-    path = Path(path)
-    try:
-        with path.open("rb") as fh:
-            data = tomllib.load(fh)
-    except OSError as exc:
-        raise ValueError(f"config file {str(path)!r} cannot be read: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
-    scenario = data.pop("scenario", {})
-    if not isinstance(scenario, dict):
-        raise ValueError(f"config file {str(path)!r}: 'scenario' must be a table")
-    try:
-        QuarterCarParams.from_mapping(data)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"config file {str(path)!r}: {exc}") from None
-    return data, scenario
-
-
-def load_config(path: str | Path) -> tuple[QuarterCarParams, dict[str, Any]]:
-    """Read a TOML config: ``(QuarterCarParams, scenario table)``.
-
-    See `read_config` for the file's layout and errors.
-
-    Examples
-    --------
-    A file holding ``ms = 350.0`` and ``zeta = 0.3`` gives
-    ``QuarterCarParams(ms=350.0, zeta=0.3)`` and ``{}``.
-    """
-    values, scenario = read_config(path)
-    return QuarterCarParams(**values), scenario
 
 
 def as_params(params) -> QuarterCarParams:

@@ -1061,43 +1061,16 @@ def _step(sys, T, auto, X0, inputs, output, transpose, return_x, squeeze, params
         U[i, :] = 1.0
         return U
 
-    yout, xout, uout, parts, labels = _traces(
-        "step", sys, T, auto, lambda i: X0, U_of, inputs, output, opts, params
-    )
-    return _multi_trace(
-        "Step",
-        sys,
-        T,
-        yout,
-        xout,
-        uout,
-        parts,
-        labels,
-        inputs,
-        output,
-        transpose,
-        return_x,
-        squeeze,
-        params,
-    )
+    traces = _traces("step", sys, T, auto, lambda i: X0, U_of, inputs, output, opts, params)
+    shape = (transpose, return_x, squeeze)
+    return _multi_trace("Step", sys, T, traces, inputs, output, shape, params)
 
 
-def _multi_trace(
-    kind,
-    sys,
-    T,
-    yout,
-    xout,
-    uout,
-    parts,
-    labels,
-    inputs,
-    output,
-    transpose,
-    return_x,
-    squeeze,
-    params,
-):
+def _multi_trace(kind, sys, T, traces, inputs, output, shape, params):
+    """One response of the traces `_traces` computed (``shape``: transpose,
+    return_x, squeeze, as python-control takes them)."""
+    yout, xout, uout, parts, labels = traces
+    transpose, return_x, squeeze = shape
     issiso = sys.issiso() or (inputs is not None and output is not None)
     input_labels = sys.input_labels if inputs is None else sys.input_labels[inputs]
     output_labels = sys.output_labels if output is None else sys.output_labels[output]
@@ -1218,25 +1191,9 @@ def _impulse(sys, T, auto, inputs, output, transpose, return_x, squeeze, opts):
             U[i, 0] = 1.0 / sys.dt  # unit area (dt=True counts as 1)
         return U
 
-    yout, xout, uout, parts, labels = _traces(
-        "impulse", sys, T, auto, X0_of, U_of, inputs, output, opts, None
-    )
-    return _multi_trace(
-        "Impulse",
-        sys,
-        T,
-        yout,
-        xout,
-        uout,
-        parts,
-        labels,
-        inputs,
-        output,
-        transpose,
-        return_x,
-        squeeze,
-        None,
-    )
+    traces = _traces("impulse", sys, T, auto, X0_of, U_of, inputs, output, opts, None)
+    shape = (transpose, return_x, squeeze)
+    return _multi_trace("Impulse", sys, T, traces, inputs, output, shape, None)
 
 
 # ---------------------------------------------------------------- nonlinear systems

@@ -39,6 +39,7 @@ import shlex
 import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
+from pathlib import Path
 from typing import Any, ClassVar, cast
 
 import numpy as np
@@ -62,6 +63,8 @@ else:  # pragma: no cover - Python 3.10
 
 __all__ = [
     "Scenario",
+    "read_config",
+    "load_config",
     "ScenarioError",
     "Road",
     "NoRoad",
@@ -876,3 +879,43 @@ def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
             "road",
         )
     return {"vehicle": vehicle, "run": table, "road": road, "road_section": section}
+
+
+def read_config(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Read a TOML file into ``(parameter values, scenario table)``, unresolved.
+
+    Parameter keys (``ms``, ``mu``, ``ks``, ``ku``, ``zeta``, ``cs``) stand at
+    the top level; an optional ``[scenario]`` table is returned as it is
+    (its reader checks it). Any other top-level key, or a bad value, raises
+    ``ValueError`` naming the file and the key or value.
+    """
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            data = tomllib.load(fh)
+    except OSError as exc:
+        raise ValueError(f"config file {str(path)!r} cannot be read: {exc.strerror}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
+    scenario = data.pop("scenario", {})
+    if not isinstance(scenario, dict):
+        raise ValueError(f"config file {str(path)!r}: 'scenario' must be a table")
+    try:
+        QuarterCarParams.from_mapping(data)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"config file {str(path)!r}: {exc}") from None
+    return data, scenario
+
+
+def load_config(path: str | Path) -> tuple[QuarterCarParams, dict[str, Any]]:
+    """Read a TOML config: ``(QuarterCarParams, scenario table)``.
+
+    See `read_config` for the file's layout and errors.
+
+    Examples
+    --------
+    A file holding ``ms = 350.0`` and ``zeta = 0.3`` gives
+    ``QuarterCarParams(ms=350.0, zeta=0.3)`` and ``{}``.
+    """
+    values, scenario = read_config(path)
+    return QuarterCarParams(**values), scenario
