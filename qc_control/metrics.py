@@ -43,9 +43,9 @@ def mean_square(v: np.ndarray) -> np.ndarray:
               - \\frac{v_0^2 + v_{N-1}^2}{2}\\Big)
               = \\frac{1}{t_{N-1} - t_0}\\int v^2\\,dt \\ \\text{(trapezoidal)}
 
-    (no ``v²`` temporary: one contraction per signal).
+    (no ``v²`` temporary: one dot product per signal).
     """
-    squares = np.einsum("...i,...i->...", v, v) - 0.5 * (v[..., 0] ** 2 + v[..., -1] ** 2)
+    squares = np.vecdot(v, v) - 0.5 * (v[..., 0] ** 2 + v[..., -1] ** 2)
     return squares / (v.shape[-1] - 1)
 
 
@@ -132,9 +132,11 @@ def _settling_time(s: RideSignals, _: int) -> np.ndarray:
     """First time after which the body stays within 2 % of its largest
     excursion from its final value (the 2 % settling criterion)."""
     T, y = s.T, s.body_disp
-    dev = np.abs(y[..., ::-1] - y[..., -1:])  # time reversed
-    outside = dev > 0.02 * np.max(dev, axis=-1, keepdims=True)
-    from_end = np.argmax(outside, axis=-1)  # first sample outside, from the end
+    dev = y - y[..., -1:]
+    np.abs(dev, out=dev)
+    outside = dev > 0.02 * dev.max(axis=-1, keepdims=True)
+    # the last sample outside, found from the end on a reversed view (no copy)
+    from_end = np.argmax(outside[..., ::-1], axis=-1)
     settle = np.minimum(np.where(outside.any(axis=-1), T.size - from_end, 0), T.size - 1)
     return T[settle]
 

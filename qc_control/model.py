@@ -163,27 +163,36 @@ class QuarterCarParams:
                 f"cs={self.cs!r} and zeta={self.zeta!r} disagree: "
                 f"cs = 2*zeta*sqrt(ks*ms) = {self.zeta * critical:.6g}; give only one"
             )
-        assert self.cs is not None and self.zeta is not None  # resolved above
-        # every entry of A must be a finite number, or no method can step the model
+        self._check_scales()
+
+    def _check_scales(self) -> None:
+        """Refuse a vehicle whose matrix overflows or whose modes cannot be resolved.
+
+        Every entry of A must be finite, or no method can step the model. And
+        the model's rates [1/s] (its eigenvalues lie among them): A's entries
+        are rates and squared rates, so eigenvalues come out of double
+        precision with a relative error of about eps·(fastest/slowest)²; beyond
+        `MAX_RATE_SPAN` the slow mode loses its digits, and a fixed step that
+        resolves the fast one would need more steps than any run can take.
+        Light damping is harmless (a slow decay), so the slowest rate is a
+        stiffness rate. (Plain arithmetic first: sweeps build thousands.)
+        """
+        ms, mu, ks, ku = self.ms, self.mu, self.ks, self.ku
+        cs = float(self.cs)  # type: ignore[arg-type]  # resolved by __post_init__
         ratios = {
-            "cs": self.cs,
-            "ks/ms": self.ks / self.ms,
-            "ks/mu": self.ks / self.mu,
-            "ku/mu": self.ku / self.mu,
-            "cs/ms": self.cs / self.ms,
-            "cs/mu": self.cs / self.mu,
+            "cs": cs,
+            "ks/ms": ks / ms,
+            "ks/mu": ks / mu,
+            "ku/mu": ku / mu,
+            "cs/ms": cs / ms,
+            "cs/mu": cs / mu,
         }
-        for what, value in ratios.items():
-            if not math.isfinite(value):
-                raise ValueError(
-                    f"{what} overflows to {value!r} for ms={self.ms!r}, mu={self.mu!r}, "
-                    f"ks={self.ks!r}, ku={self.ku!r}: the model's matrix would not be finite"
-                )
-        # The model's rates [1/s]: its eigenvalues lie among them. A's entries are
-        # rates and squared rates, so eigenvalues come out of double precision with a
-        # relative error of about eps·(fastest/slowest)²: beyond MAX_RATE_SPAN the
-        # slow mode loses its digits, and a fixed step resolving the fast one would
-        # need more steps than any run can take.
+        if not math.isfinite(sum(ratios.values())):
+            what = next(k for k, v in ratios.items() if not math.isfinite(v))
+            raise ValueError(
+                f"{what} overflows to {ratios[what]!r} for ms={ms!r}, mu={mu!r}, ks={ks!r}, "
+                f"ku={ku!r}: the model's matrix would not be finite"
+            )
         rates = {
             "sqrt(ks/ms)": math.sqrt(ratios["ks/ms"]),
             "sqrt(ks/mu)": math.sqrt(ratios["ks/mu"]),
@@ -191,15 +200,15 @@ class QuarterCarParams:
             "cs/ms": ratios["cs/ms"],
             "cs/mu": ratios["cs/mu"],
         }
-        # light damping is harmless (a slow decay), so the slowest is a stiffness rate
-        fast = max(rates, key=rates.__getitem__)
-        slow = min(list(rates)[:3], key=rates.__getitem__)
-        if rates[fast] > MAX_RATE_SPAN * rates[slow]:
+        values = list(rates.values())
+        if max(values) > MAX_RATE_SPAN * min(values[:3]):
+            fast = max(rates, key=rates.__getitem__)
+            slow = min(list(rates)[:3], key=rates.__getitem__)
             raise ValueError(
                 f"the vehicle's time scales span more than {MAX_RATE_SPAN:.0e}: {fast} = "
                 f"{rates[fast]:.3g} 1/s against {slow} = {rates[slow]:.3g} 1/s (ms="
-                f"{self.ms!r}, mu={self.mu!r}, ks={self.ks!r}, ku={self.ku!r}, "
-                f"cs={self.cs:.6g}); its modes cannot be resolved in double precision"
+                f"{ms!r}, mu={mu!r}, ks={ks!r}, ku={ku!r}, cs={cs:.6g}); its modes cannot "
+                "be resolved in double precision"
             )
 
     @property
@@ -214,10 +223,9 @@ class QuarterCarParams:
     @classmethod
     def from_mapping(cls, values: Mapping[str, Any]) -> QuarterCarParams:
         """Build from a dict; an unknown key raises ``ValueError`` naming it."""
-        known = {f.name for f in fields(cls)}
-        unknown = sorted(set(values) - known)
+        unknown = sorted(set(values) - _FIELDS)
         if unknown:
-            raise ValueError(f"unknown parameter {unknown[0]!r}; expected one of {sorted(known)}")
+            raise ValueError(f"unknown parameter {unknown[0]!r}; expected one of {sorted(_FIELDS)}")
         return cls(**dict(values))
 
     def to_dict(self, *, changing: Iterable[str] | None = None) -> dict[str, float]:
@@ -236,6 +244,9 @@ class QuarterCarParams:
     def table(self) -> list[tuple[str, str, float, str]]:
         """Rows ``(symbol, description, value, unit)`` for reports."""
         return [(n, _DESCRIPTIONS[n], getattr(self, n), _UNITS[n]) for n in _UNITS]
+
+
+_FIELDS = frozenset(f.name for f in fields(QuarterCarParams))
 
 
 def as_params(params) -> QuarterCarParams:

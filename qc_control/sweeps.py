@@ -340,7 +340,9 @@ def sweep(
     bar.close()
 
     names = list(model.params.to_dict())
-    frame = pd.DataFrame([p.to_dict() if p is not None else dict.fromkeys(names) for p in params])
+    frame = pd.DataFrame(  # column by column: one getattr per value, no dict per design
+        {n: [np.nan if p is None else getattr(p, n) for p in params] for n in names}
+    )
     frame["stable"] = stable
     for column, values in table.items():
         frame[column] = values
