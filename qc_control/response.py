@@ -417,7 +417,7 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
         with warnings.catch_warnings():
             if not success:  # the step-size warning already told the user
                 warnings.simplefilter("ignore", DivergenceWarning)
-            sol = lti_solve(tab, A, B, T, u_samples, x0, substeps)
+            sol = lti_solve(tab, A, B, T, u_samples, x0, substeps, uniform=True)
     else:
         sol = _generic(A, B, T, u_samples, x0, tab, substeps, warn=success)
     if not sol.success:
@@ -541,8 +541,11 @@ def _time_grid(sysdata, T, T_num, is_step: bool):
     return T, False
 
 
-def _forced(sys, T, U, X0, transpose, params, interpolate, return_x, squeeze, opts, auto=False):
-    """`forced_response` for one system."""
+def _forced(
+    sys, T, U, X0, transpose, params, interpolate, return_x, squeeze, opts, auto=False, inner=False
+):
+    """`forced_response` for one system (``inner``: a step of another response,
+    which checks the result itself)."""
     _check_system(sys)
     if _is_nonlinear(sys):
         if interpolate:  # as python-control
@@ -625,7 +628,8 @@ def _forced(sys, T, U, X0, transpose, params, interpolate, return_x, squeeze, op
         success=run["success"],
         message=run["message"] or None,
     )
-    return _finalise(_set_meta(resp, run))
+    resp = _set_meta(resp, run)
+    return resp if inner else _finalise(resp)
 
 
 def _title(kind: str, name: str) -> str:
@@ -888,7 +892,7 @@ def initial_response(
 
 
 def _initial(sys, T, auto, X0, output, params, transpose, return_x, squeeze, opts):
-    response = _forced(sys, T, 0, X0, False, params, False, None, None, opts, auto=auto)
+    response = _forced(sys, T, 0, X0, False, params, False, None, None, opts, auto, inner=True)
     issiso = sys.issiso() or output is not None
     yout = response.y if output is None else response.y[output]
     output_labels = sys.output_labels if output is None else sys.output_labels[output]

@@ -130,6 +130,11 @@ def _run_chunk(
     """
     A, B, C, D = batch.A, batch.B, batch.C, batch.D
     m, n = A.shape[0], A.shape[-1]
+    # only the outputs the metrics read (a custom metric may read any)
+    wanted = _outputs_read(metric_items, roles, labels)
+    rows = [labels.index(label) for label in wanted]
+    if len(rows) < len(labels):
+        C, D, labels = C[:, rows], D[:, rows], wanted
     H = (T[-1] - T[0]) / (T.size - 1)
     phi, g0, g1 = step_matrices(method, A, B, H, substeps)
     W = None
@@ -154,9 +159,9 @@ def _run_chunk(
         x = y[:, :n] if keep_states else None
         y = y[:, n:] if keep_states else y
         if U is not None:  # the feedthrough D u, on the outputs that have one
-            rows = np.flatnonzero(np.any(D != 0, axis=(0, 2)))
-            if rows.size:
-                y[:, rows] += D[:, rows] @ U
+            through = np.flatnonzero(np.any(D != 0, axis=(0, 2)))
+            if through.size:
+                y[:, through] += D[:, through] @ U
         stable = step_is_stable(method, H / substeps, np.linalg.eigvals(A))
         signals = RideSignals(
             T,
@@ -172,6 +177,16 @@ def _run_chunk(
             else:
                 result[column] = np.asarray(metric(signals), dtype=float)
     return result, x
+
+
+def _outputs_read(metric_items, roles: SignalRoles, labels: tuple[str, ...]) -> tuple[str, ...]:
+    """The output labels the metrics read, in the model's order: the body's and
+    every corner's for registered metrics, all of them for a custom one."""
+    if any(not isinstance(metric, str) for _, metric, _ in metric_items):
+        return labels
+    read = {roles.body_acc, roles.body_disp}
+    read |= {label for c in roles.corners for label in (c.susp_travel, c.tire_defl)}
+    return tuple(label for label in labels if label in read)
 
 
 def _metric_items(metrics, roles: SignalRoles) -> list:
