@@ -55,6 +55,7 @@ from .integrate import (
     integrate,
     uniform_step,
 )
+from .limits import check_memory
 from .lti import lti_solve
 from .methods import METHODS, ButcherTableau, get_method
 from .stability import max_stable_step, stability_coefficients, step_is_stable
@@ -602,6 +603,13 @@ def _forced(
     if T.ndim == 2 and 1 in T.shape:
         T = T.reshape(-1)
     T = check_time_grid(T, "T")
+    # states, outputs and inputs over T, with the engines' working copies
+    n, p, m = ss.nstates, ss.noutputs, ss.ninputs
+    check_memory(
+        8.0 * T.size * (3 * n + 2 * p + m + 2),
+        f"a fixed-step response of {ss.name!r} on {T.size} samples",
+        "use fewer samples (a coarser T; substeps refine the step without storing it)",
+    )
     x0 = check_initial_state(X0, ss.nstates)
     u = np.asarray(0.0 if U is None else U)
     if transpose and u.ndim == 2:

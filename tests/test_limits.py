@@ -67,3 +67,17 @@ def test_empty_design_grid_is_refused():
         qc.sweep({}, np.linspace(0, 1, 101))
     with pytest.raises(ValueError, match="no values for 'ks'"):
         qc.sweep({"ks": []}, np.linspace(0, 1, 101))
+
+
+def test_a_response_too_large_for_the_machine_is_refused_before_it_runs(monkeypatch):
+    """Issue 14 item 13: 1e8 samples took 15.4 GB and ended in a raw MemoryError.
+    The estimate is 8 B x N x (3n + 2p + m + 2): 27 GB for the quarter car on
+    1e8 samples, 192 MB on the 1e6 used here against a 10 MiB limit, refused
+    before any array of that size exists."""
+    monkeypatch.setenv(limits.ENV_VAR, "10M")
+    T = np.linspace(0, 1e4, 10**6 + 1)
+    with pytest.raises(limits.ResourceLimitError) as err:
+        qc.initial_response(qc.quarter_car(), T, [0, 0, 0.05, 0])
+    text = str(err.value)
+    assert "a fixed-step response of 'quarter_car' on 1000001 samples" in text
+    assert "about 183 MiB" in text and "more than the limit of 10 MiB" in text
