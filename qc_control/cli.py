@@ -288,8 +288,9 @@ def _cmd_report(args) -> int:
     ):
         print(cmp.summary())
     print(
-        f"\nwrote {path / 'report.md'}, {path / 'report.html'} and the CSV tables and "
-        f"figures in {path}"
+        f"\nwrote {path / 'report.html'} (one file, figures inside), {path / 'report.pdf'}, "
+        f"report.md, the CSV tables, the figures and scenario.toml (the run, to redo it) "
+        f"in {path}"
     )
     return 0
 
