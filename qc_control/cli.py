@@ -22,7 +22,7 @@ import pandas as pd
 
 from .modal import modal_analysis
 from .model import QuarterCarParams
-from .report import MARKER, ReportError, write_report
+from .report import ReportError, check_target, write_report
 from .scenario import ROADS, Scenario, ScenarioError, road_option
 
 __all__ = ["run", "build_parser", "scenario_from_args", "UsageError"]
@@ -240,11 +240,10 @@ def _check_out(out: str) -> Path:
         if path.exists():
             if not path.is_dir():
                 raise UsageError(f"--out {out!r} is a file, not a report directory")
-            if any(path.iterdir()) and not (path / MARKER).exists():
-                raise UsageError(
-                    f"refusing to overwrite {out!r}: it is not a qc-control report "
-                    f"(no {MARKER} file); choose another --out"
-                )
+            try:  # the report's own rule: empty, or an earlier report holding only its files
+                check_target(path)
+            except ReportError as exc:  # in the words of the command line
+                raise UsageError(str(exc).replace(repr(str(path)), repr(out))) from None
             # the new report replaces the old one by renames in the parent
             for d in (path.parent, path):
                 if not writable(d):

@@ -155,11 +155,17 @@ def test_refuses_a_directory_that_is_not_a_report(cmp, tmp_path):
 
 @pytest.mark.slow
 def test_replaces_its_own_report(cmp, tmp_path):
+    """An earlier report is replaced; a file a user put inside it is not deleted
+    (issue 14 item 18): the run is refused naming it, and goes once it is moved."""
     out = tmp_path / "rep"
     write_report(cmp, out)
-    (out / "stale.png").write_bytes(b"old")
+    (out / "notes.png").write_bytes(b"mine")
+    with pytest.raises(ReportError, match="it holds 'notes.png', which qc-control did not"):
+        write_report(cmp, out)
+    assert (out / "notes.png").read_bytes() == b"mine"
+    (out / "notes.png").unlink()
     write_report(cmp, out)
-    assert not (out / "stale.png").exists() and (out / "report.md").exists()
+    assert (out / "report.md").exists()
     assert [p.name for p in tmp_path.iterdir()] == ["rep"]
 
 

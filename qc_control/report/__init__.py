@@ -12,9 +12,12 @@ into place, so a failure never leaves a half-written report.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import datetime as _dt
+import fcntl
 import functools
+import os
 import platform
 import re
 import shutil
@@ -45,6 +48,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 __all__ = [
+    "check_target",
     "write_report",
     "build_blocks",
     "figure_specs",
@@ -409,7 +413,23 @@ def _csv_tables(cmp) -> dict[str, pd.DataFrame]:
     }
 
 
-def _check_target(out: Path, overwrite: bool) -> None:
+def _manifest(out: Path) -> set[str] | None:
+    """The files an earlier report says it wrote (None for a report without a list)."""
+    lines = (out / MARKER).read_text(encoding="utf-8", errors="replace").splitlines()
+    if "files:" not in lines:
+        return None
+    return set(lines[lines.index("files:") + 1 :])
+
+
+def check_target(out_dir, overwrite: bool = True) -> Path:
+    """Where a report may go: a new or empty directory, or an earlier report.
+
+    An earlier report is replaced only if it holds nothing but what
+    qc-control wrote there (its `MARKER` lists the files): a file a user put
+    inside it is never deleted. Raises `ReportError` naming the path, or the
+    first foreign file.
+    """
+    out = Path(out_dir).resolve()
     if out.exists():
         if not out.is_dir():
             raise ReportError(f"{str(out)!r} exists and is not a directory")
@@ -421,6 +441,57 @@ def _check_target(out: Path, overwrite: bool) -> None:
                 )
             if not overwrite:
                 raise ReportError(f"{str(out)!r} already holds a report")
+            listed = _manifest(out)
+            if listed is not None:
+                foreign = sorted(p.name for p in out.iterdir() if p.name not in listed | {MARKER})
+                if foreign:
+                    raise ReportError(
+                        f"refusing to replace the report in {str(out)!r}: it holds "
+                        f"{foreign[0]!r}, which qc-control did not write; move it out first"
+                    )
+    return out
+
+
+@contextlib.contextmanager
+def _exclusive(parent: Path, out: Path):
+    """Hold a lock on the report's parent directory while the report is swapped.
+
+    ``flock`` on the directory itself: nothing is left behind, and a second
+    run into the same place stops with one clear line instead of racing.
+    """
+    fd = os.open(parent, os.O_RDONLY)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise ReportError(
+                f"another qc-control run is writing a report in {str(parent)!r}; wait for it "
+                f"to finish, or choose another --out than {str(out)!r}"
+            ) from None
+        yield
+    finally:
+        os.close(fd)  # closing the descriptor releases the lock
+
+
+def _recover(out: Path) -> None:
+    """Finish what an interrupted run left beside ``out`` (the caller holds the lock).
+
+    Its working copies (``.NAME.partial-*``) are removed. A report moved aside
+    for a swap (``.NAME.old-*/NAME``) is put back when ``out`` is missing,
+    and removed when the swap had completed: it is never lost.
+    """
+    for partial in out.parent.glob(f".{out.name}.partial-*"):
+        shutil.rmtree(partial, ignore_errors=True)
+    for old in sorted(out.parent.glob(f".{out.name}.old-*")):
+        if (old / out.name).is_dir() and not out.exists():
+            (old / out.name).rename(out)
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def write_report(
@@ -464,10 +535,19 @@ def write_report(
             f"unknown report format {bad[0] if bad else '(none)'!r}; "
             f"choose from {', '.join(FORMATS)}"
         )
-    out = Path(out_dir).resolve()
-    _check_target(out, overwrite)
+    out = check_target(out_dir, overwrite)
     out.parent.mkdir(parents=True, exist_ok=True)
+    with _exclusive(out.parent, out):
+        _recover(out)
+        check_target(out, overwrite)  # again: recovery may have put a report back
+        return _write(cmp, out, formats, command)
+
+
+def _write(cmp, out: Path, formats: tuple, command: str | None) -> Path:
+    """Build the report in a working copy and swap it in (see `write_report`)."""
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
+    os.chmod(tmp, 0o777 & ~_umask())  # a directory as the user's umask makes it, not 0700
+    moved: Path | None = None
     try:
         for spec in figure_specs(cmp):
             spec.make().savefig(tmp / spec.name, dpi=DPI)
@@ -484,15 +564,25 @@ def write_report(
         scenario = getattr(cmp, "scenario", None)
         if scenario is not None:
             (tmp / "scenario.toml").write_text(scenario.to_toml(), encoding="utf-8")
-        (tmp / MARKER).write_text(f"qc-control report\n{command or ''}\n", encoding="utf-8")
+        written = sorted(p.name for p in tmp.iterdir())
+        (tmp / MARKER).write_text(
+            f"qc-control report\n{command or ''}\nfiles:\n" + "\n".join(written) + "\n",
+            encoding="utf-8",
+        )
         if out.exists():
             old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
             out.rename(old / out.name)
+            moved = old
             tmp.rename(out)
+            moved = None
             shutil.rmtree(old, ignore_errors=True)
         else:
             tmp.rename(out)
     except BaseException:
+        # the earlier report goes back where it was; the unfinished one is dropped
+        if moved is not None and not out.exists():
+            (moved / out.name).rename(out)
+            shutil.rmtree(moved, ignore_errors=True)
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return out

@@ -1,0 +1,151 @@
+"""The report writer under faults: one complete report afterwards, no litter,
+nothing of the user's lost (issue 14 items 15-19)."""
+
+import fcntl
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import qc_control as qc
+from qc_control import report as rep
+from qc_control.report import MARKER, ReportError, write_report
+
+pytestmark = pytest.mark.slow  # each case writes whole reports (figures, PDF)
+
+
+@pytest.fixture(autouse=True)
+def _coarse_figures(monkeypatch):
+    """What is checked here is the writing, not the pictures: 40 dpi keeps it quick."""
+    monkeypatch.setattr(rep, "DPI", 40)
+
+
+@pytest.fixture(scope="module")
+def cmp():
+    return qc.compare_methods(qc.QuarterCarParams(), np.linspace(0, 1, 101), repeats=1)
+
+
+def marker_command(out: Path) -> str:
+    return (out / MARKER).read_text(encoding="utf-8").splitlines()[1]
+
+
+def litter(parent: Path, name: str) -> list[str]:
+    return sorted(p.name for p in parent.iterdir() if p.name.startswith(f".{name}."))
+
+
+def test_stale_partials_of_a_killed_run_are_cleaned(cmp, tmp_path):
+    """Item 15: a SIGKILL while writing leaves .R.partial-*; the next run removes it."""
+    stale = tmp_path / ".R.partial-abc123"
+    stale.mkdir()
+    (stale / "report.md").write_text("half")
+    write_report(cmp, tmp_path / "R", ("md",), command="second")
+    assert litter(tmp_path, "R") == [] and marker_command(tmp_path / "R") == "second"
+
+
+def test_a_report_stranded_between_the_renames_is_never_lost(cmp, tmp_path):
+    """Item 16: killed between the two renames, R is missing and the old report
+    sits in .R.old-*/R. The next run puts it back before anything else."""
+    out = tmp_path / "R"
+    write_report(cmp, out, ("md",), command="first")
+    aside = tmp_path / ".R.old-xyz"
+    aside.mkdir()
+    out.rename(aside / "R")
+    rep._recover(out)  # what every run does first, under the lock
+    assert marker_command(out) == "first" and litter(tmp_path, "R") == []
+
+
+@pytest.mark.parametrize(
+    ("stage", "fault"),
+    [
+        ("figure", OSError),
+        ("pdf", KeyboardInterrupt),
+        ("csv", OSError),
+        ("swap", KeyboardInterrupt),
+        ("swap", OSError),
+        ("cleanup", KeyboardInterrupt),
+    ],
+)
+def test_a_fault_at_any_stage_leaves_one_complete_report(cmp, tmp_path, monkeypatch, stage, fault):
+    """Fault injection: raise at each stage of a replacing write. Afterwards R is
+    the old report or the new one, complete (its marker lists every file it has),
+    and the next run leaves exactly one report and no litter."""
+    out = tmp_path / "R"
+    # the PDF is the slowest part: written only where it is the stage under test
+    fmts = rep.FORMATS if stage == "pdf" else tuple(f for f in rep.FORMATS if f != "pdf")
+    write_report(cmp, out, fmts, command="old")
+
+    def boom(*args, **kwargs):
+        raise fault("injected")
+
+    if stage == "figure":
+        spec = rep.FigureSpec("broken.png", "Figure 1", "a figure that fails", boom)
+        monkeypatch.setattr(rep, "figure_specs", lambda cmp: [spec])
+    elif stage == "pdf":
+        monkeypatch.setattr(rep, "to_pdf", boom)
+    elif stage == "csv":
+        monkeypatch.setattr(rep, "_csv_tables", boom)
+    elif stage == "swap":  # between the two renames: the old report is aside
+        real = Path.rename
+        calls = []
+
+        def second_fails(self, target):
+            calls.append(target)
+            if len(calls) == 2:
+                raise fault("injected")
+            return real(self, target)
+
+        monkeypatch.setattr(Path, "rename", second_fails)
+    else:  # removing the set-aside old report, after the swap
+        monkeypatch.setattr(rep.shutil, "rmtree", boom)
+    with pytest.raises(fault):
+        write_report(cmp, out, fmts, command="new")
+    monkeypatch.undo()
+    monkeypatch.setattr(rep, "DPI", 40)
+
+    assert out.is_dir()
+    files = {p.name for p in out.iterdir()} - {MARKER}
+    listed = set((out / MARKER).read_text().split("files:\n")[1].split())
+    assert files == listed and "report.md" in files
+    expected = "new" if stage == "cleanup" else "old"
+    assert marker_command(out) == expected
+    write_report(cmp, out, fmts, command="after")
+    assert marker_command(out) == "after" and litter(tmp_path, "R") == []
+    assert [p.name for p in tmp_path.iterdir()] == ["R"]
+
+
+def test_a_second_run_into_the_same_place_stops_with_one_line(cmp, tmp_path):
+    """Item 17: a run holding the lock makes another stop cleanly (not ENOTEMPTY)."""
+    fd = os.open(tmp_path, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        with pytest.raises(ReportError, match="another qc-control run is writing a report"):
+            write_report(cmp, tmp_path / "R", ("md",))
+    finally:
+        os.close(fd)
+    write_report(cmp, tmp_path / "R", ("md",))  # the lock is released with the descriptor
+    assert (tmp_path / "R" / "report.md").exists()
+
+
+def test_the_report_directory_follows_the_umask(cmp, tmp_path):
+    """Item 19: an empty user directory of mode 755 stays 755 (mkdtemp makes 0700)."""
+    out = tmp_path / "R"
+    out.mkdir(mode=0o755)
+    old = os.umask(0o022)
+    try:
+        write_report(cmp, out, ("md",))
+    finally:
+        os.umask(old)
+    assert (out.stat().st_mode & 0o777) == 0o755
+
+
+def test_a_user_file_in_a_report_is_kept(cmp, tmp_path):
+    """Item 18, through the command line: refused in one line, the file kept."""
+    out = tmp_path / "R"
+    write_report(cmp, out, ("md",))
+    (out / "my notes.txt").write_text("keep me")
+    with pytest.raises(ReportError, match="'my notes.txt', which qc-control did not write"):
+        write_report(cmp, out, ("md",))
+    assert (out / "my notes.txt").read_text() == "keep me"
+    shutil.rmtree(out)
