@@ -314,12 +314,6 @@ def quarter_car_abcd(ms, mu, ks, ku, cs, *, road: bool = False, actuator: bool =
     return A, B, C, D
 
 
-def system_matrices(params=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """`seed_matrices` of one vehicle: ``(A, b_road, b_act)``."""
-    p = as_params(params)
-    return seed_matrices(p.ms, p.mu, p.ks, p.ku, p.cs)
-
-
 def _inputs(road: bool, actuator: bool) -> list[str]:
     return [label for label, on in (("zr", road), ("fa", actuator)) if on]
 
