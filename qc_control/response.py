@@ -521,6 +521,14 @@ def _discrete_note(sys) -> str:
     )
 
 
+def _each(sysdata, respond):
+    """python-control's rule for every response: a list (or tuple) of systems
+    gives a `control.TimeResponseList`, one response per system."""
+    if isinstance(sysdata, (list, tuple)):
+        return control.TimeResponseList(respond(s) for s in sysdata)
+    return respond(sysdata)
+
+
 def _time_grid(sysdata, T, T_num, is_step: bool):
     """``(T, auto)``: python-control's own default grid when T is None or a final time."""
     if T is None or np.asarray(T).size == 1:
@@ -782,12 +790,10 @@ def forced_response(
     _not_a_method(transpose, "transpose")
     opts = _Options(method, substeps, engine)
     T, U, X0, return_x = v["timepts"], v["inputs"], v["initial_state"], v["return_states"]
-    if isinstance(sysdata, (list, tuple)):
-        return control.TimeResponseList(
-            _forced(s, T, U, X0, transpose, params, interpolate, return_x, squeeze, opts)
-            for s in sysdata
-        )
-    return _forced(sysdata, T, U, X0, transpose, params, interpolate, return_x, squeeze, opts)
+    return _each(
+        sysdata,
+        lambda s: _forced(s, T, U, X0, transpose, params, interpolate, return_x, squeeze, opts),
+    )
 
 
 def initial_response(
@@ -880,9 +886,7 @@ def initial_response(
     opts = _Options(method, substeps, engine)
     T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=False)
     args = (v["initial_state"], v["output_indices"], params, transpose, v["return_states"])
-    if isinstance(sysdata, (list, tuple)):
-        return control.TimeResponseList(_initial(s, T, auto, *args, squeeze, opts) for s in sysdata)
-    return _initial(sysdata, T, auto, *args, squeeze, opts)
+    return _each(sysdata, lambda s: _initial(s, T, auto, *args, squeeze, opts))
 
 
 def _initial(sys, T, auto, X0, output, params, transpose, return_x, squeeze, opts):
@@ -1036,9 +1040,7 @@ def step_response(
     T = np.atleast_1d(T).reshape(-1)
     args = (v["initial_state"], v["input_indices"], v["output_indices"])
     rest = (transpose, v["return_states"], squeeze, params, opts)
-    if isinstance(sysdata, (list, tuple)):
-        return control.TimeResponseList(_step(s, T, auto, *args, *rest) for s in sysdata)
-    return _step(sysdata, T, auto, *args, *rest)
+    return _each(sysdata, lambda s: _step(s, T, auto, *args, *rest))
 
 
 def _step(sys, T, auto, X0, inputs, output, transpose, return_x, squeeze, params, opts):
@@ -1160,9 +1162,7 @@ def impulse_response(
     T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=False)
     T = np.atleast_1d(T).reshape(-1)
     args = (v["input_indices"], v["output_indices"], transpose, v["return_states"], squeeze)
-    if isinstance(sysdata, (list, tuple)):
-        return control.TimeResponseList(_impulse(s, T, auto, *args, opts) for s in sysdata)
-    return _impulse(sysdata, T, auto, *args, opts)
+    return _each(sysdata, lambda s: _impulse(s, T, auto, *args, opts))
 
 
 def _impulse(sys, T, auto, inputs, output, transpose, return_x, squeeze, opts):
@@ -1598,6 +1598,4 @@ def input_output_response(
         opts=opts,
         auto=False,
     )
-    if isinstance(sys, (list, tuple)):
-        return control.TimeResponseList(_io_response(s, T, U, X0, **args) for s in sys)
-    return _io_response(sys, T, U, X0, **args)
+    return _each(sys, lambda s: _io_response(s, T, U, X0, **args))
