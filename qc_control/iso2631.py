@@ -13,7 +13,7 @@ import scipy.signal
 from .integrate import uniform_step
 from .lti import affine_scan
 
-__all__ = ["wk_filter", "wk_weighted"]
+__all__ = ["wk_filter", "wk_weighted", "wk_discrete"]
 
 
 def wk_filter() -> control.TransferFunction:
@@ -52,16 +52,21 @@ def wk_filter() -> control.TransferFunction:
 
 
 @functools.lru_cache(maxsize=16)
-def _wk_impulse(dt: float, N: int) -> tuple[np.ndarray, np.ndarray]:
-    """Impulse response h and initial-input response v of Wk sampled at dt.
+def wk_discrete(dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray]:
+    """Wk sampled at ``dt`` [s], exactly, for an input linear between samples.
 
     python-control's exact recursion for an input linear between samples,
     ``x_{k+1} = A_d x_k + B_0 u_k + B_1 u_{k+1}``, ``y_k = C x_k + D u_k``,
     becomes with ``x̃ = x - B_1 u`` the ordinary ``x̃_{k+1} = A_d x̃_k + B̃ u_k``,
-    ``y_k = C x̃_k + D̃ u_k``, started from ``x̃_0 = -B_1 u_0``: so
-    ``y = h * u + u_0 v`` with ``h = [D̃, C B̃, C A_d B̃, ...]`` and
-    ``v_k = C A_d^k x̃_0``. (A transfer-function form would lose four digits
-    to the spread of Wk's poles, 0.4 to 100 Hz.)
+    ``y_k = C x̃_k + D̃ u_k``, started from ``x̃_0 = -B_1 u_0`` (zero initial
+    state of the filter).
+
+    Returns
+    -------
+    Ad, Bt, C, Dt, B1
+        ``A_d (n, n)``, ``B̃ = A_d B_1 + B_0 (n,)``, ``C (1, n)``,
+        ``D̃ = C B_1 + D`` and ``B_1 (n,)``. The filter's state can be carried
+        from one block of samples to the next (a streamed sweep does).
     """
     sys = control.ss(wk_filter())
     A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
@@ -72,7 +77,18 @@ def _wk_impulse(dt: float, N: int) -> tuple[np.ndarray, np.ndarray]:
     E = scipy.linalg.expm(M)
     Ad, B1 = E[:n, :n], E[:n, n + 1]
     B0 = E[:n, n] - B1
-    Bt, Dt = Ad @ B1 + B0, float(C[0] @ B1 + D[0, 0])
+    return Ad, Ad @ B1 + B0, C, float(C[0] @ B1 + D[0, 0]), B1
+
+
+@functools.lru_cache(maxsize=16)
+def _wk_impulse(dt: float, N: int) -> tuple[np.ndarray, np.ndarray]:
+    """Impulse response h and initial-input response v of Wk sampled at dt:
+    with `wk_discrete`'s recursion, ``y = h * u + u_0 v``, ``h = [D̃, C B̃,
+    C A_d B̃, ...]`` and ``v_k = C A_d^k x̃_0`` for ``x̃_0 = -B_1``. (A
+    transfer-function form would lose four digits to the spread of Wk's
+    poles, 0.4 to 100 Hz.)
+    """
+    Ad, Bt, C, Dt, B1 = wk_discrete(dt)
     h = np.empty(N)
     h[0] = Dt
     if N > 1:

@@ -30,7 +30,7 @@ from .integrate import DivergenceWarning, Solution, check_substeps, check_time_g
 from .methods import ButcherTableau, get_method
 from .stability import stability_coefficients
 
-__all__ = ["step_matrices", "affine_scan", "lti_trajectory", "lti_solve"]
+__all__ = ["step_matrices", "affine_scan", "OutputStream", "lti_trajectory", "lti_solve"]
 
 
 def step_matrices(
@@ -209,6 +209,168 @@ def affine_scan(
     out[..., : nb * L, :] = body.reshape(batch + (nb * L, p))
     out[..., nb * L, :] = last
     return out[..., :N, :]
+
+
+class OutputStream:
+    r"""The outputs ``y_k = C x_k + D u_k`` of ``x_{k+1} = Φ x_k + Γ₀ u_k + Γ₁ u_{k+1}``,
+    in time order, a segment at a time: nothing of length N is kept.
+
+    For many designs (a batch of ``Φ, Γ₀, Γ₁, C, D``) driven by one input
+    ``U`` that all share (a road), and for the free response (``U = None``).
+    `final` is the last sample, known before the stream starts; iterating
+    yields ``(index, y)``: ``y`` of shape ``(..., p) + index.shape`` holds
+    the samples numbered ``index`` (every sample but the last exactly once
+    over the stream). A segment of ``S`` whole blocks has ``index`` of shape
+    ``(L, S)``, ``index[j, s] = (b0 + s) L + j``: the layout the products
+    give without a transposing copy; the last segment, cut at sample
+    ``N - 2``, has a flat ``index``. A reduction that needs time order reads
+    ``index``.
+
+    Parameters
+    ----------
+    phi : array, shape (..., n, n)
+    x0 : array, shape (..., n)
+    N : int
+        Number of samples (>= 2).
+    C : array, shape (..., p, n)
+    D, g0, g1 : arrays, shapes (..., p, k), (..., n, k), (..., n, k), optional
+        With ``U``: the feedthrough and the step's input matrices
+        (`step_matrices`).
+    U : array, shape (k, N), optional
+        The input samples, the same for every design.
+    block : int, default 32
+        Block length L.
+    segment : int, optional
+        Samples per yielded segment (rounded to whole blocks): the memory
+        bound, ``designs × p × segment`` doubles. By default about 2¹⁷
+        doubles (1 MB) per segment, which stay in cache while the consumer
+        reduces them.
+
+    Notes
+    -----
+    With ``c_b = x_{bL}`` the state where block ``b`` starts,
+
+    .. math::
+
+        y_{bL+j} = C Φ^j c_b + \sum_{r=0}^{j} G_{j,r}\, u_{bL+r}, \quad
+        c_{b+1} = Φ^L c_b + \sum_{r=0}^{L} E_r\, u_{bL+r},
+
+    with ``G_{j,r} = CΦ^{j-1-r}Γ₀ [r<j] + CΦ^{j-r}Γ₁ [1<=r<=j] + D [r=j]`` and
+    ``E_r`` the same for the state at ``j = L`` (no C, no D). Because ``u`` is
+    shared, the input's effect on every block of every design is one matrix
+    product per design, ``(p L, (L+1)k) @ ((L+1)k, blocks)`` with the input
+    windows shared: ``Γ₀u + Γ₁u⁺`` is never formed per design, and each
+    product stays small enough for one BLAS thread (a chunk of designs is
+    the unit of parallelism). The carries ``c_b`` are one product of the same
+    kind and a log-depth scan with powers of ``Φ^L`` (`affine_scan`'s).
+    The work per sample and design is ``2(L+1)kp`` flops for the input and
+    ``2np`` for the carries: the input's part bounds a forced sweep.
+    """
+
+    def __init__(
+        self,
+        phi,
+        x0,
+        N: int,
+        C,
+        D=None,
+        g0=None,
+        g1=None,
+        U=None,
+        block: int = 32,
+        segment: int | None = None,
+    ):
+        phi = np.asarray(phi, dtype=float)
+        self.batch = phi.shape[:-2]
+        n = phi.shape[-1]
+        m = math.prod(self.batch)
+        phi = phi.reshape(m, n, n)
+        C = np.broadcast_to(np.asarray(C, dtype=float), self.batch + np.shape(C)[-2:])
+        p = C.shape[-2]
+        C = C.reshape(m, p, n)
+        x0 = np.broadcast_to(np.asarray(x0, dtype=float), self.batch + (n,)).reshape(m, n)
+        if N < 2:
+            raise ValueError(f"N must be at least 2 samples, got {N}")
+        L = max(1, min(block, N - 1))
+        nb = -(-(N - 1) // L)  # blocks cover samples 0 .. nb L - 1, which hold 0 .. N - 2
+        self.N, self.L, self.nb, self.m, self.n, self.p = N, L, nb, m, n, p
+        if segment is None:
+            segment = (1 << 17) // max(1, m * p)
+        self.step = max(1, segment // L)
+        P = _powers(phi, L)  # (m, L+1, n, n)
+        obs = C[:, None] @ P[:, :L]  # C Φ^j: (m, L, p, n)
+        self._obs = obs
+        # the carries' product: (m, p L, n) @ V (m, n, S) -> (m, p, L, S)
+        self._obs_mat = np.ascontiguousarray(obs.transpose(0, 2, 1, 3)).reshape(m, p * L, n)
+        # the carries, time last: V[:, :, b] = c_b (the products below are then
+        # (n x n) @ (n x blocks) per design, which BLAS does well)
+        V = np.zeros((m, n, nb + 1))
+        V[:, :, 0] = x0
+        self._forced = U is not None
+        if self._forced:
+            U = np.asarray(U, dtype=float)
+            k = U.shape[0]
+            g0 = np.asarray(g0, dtype=float).reshape(m, n, k)
+            g1 = np.asarray(g1, dtype=float).reshape(m, n, k)
+            D = np.broadcast_to(np.asarray(D, dtype=float), self.batch + (p, k)).reshape(m, p, k)
+            padded = np.zeros((nb * L + 1, k))
+            padded[:N] = U.T
+            windows = np.arange(nb)[:, None] * L + np.arange(L + 1)  # u_{bL+r}
+            self._windows = padded[windows].reshape(nb, (L + 1) * k)
+            self._windows_T = np.ascontiguousarray(self._windows.T)
+            PG0 = P[:, :L] @ g0[:, None]  # Φ^i Γ₀, i < L: (m, L, n, k)
+            PG1 = P[:, :L] @ g1[:, None]
+            E = np.zeros((m, L + 1, n, k))  # E_r = Φ^{L-1-r}Γ₀ [r<L] + Φ^{L-r}Γ₁ [r>=1]
+            E[:, :L] += PG0[:, ::-1]
+            E[:, 1:] += PG1[:, ::-1]
+            E_mat = np.ascontiguousarray(E.transpose(0, 2, 1, 3)).reshape(m, n, (L + 1) * k)
+            V[:, :, 1:] = np.matmul(E_mat, self._windows_T)
+            CPG0, CPG1 = C[:, None] @ PG0, C[:, None] @ PG1  # (m, L, p, k)
+            j, r = np.meshgrid(np.arange(L), np.arange(L + 1), indexing="ij")
+            G = np.zeros((m, L, L + 1, p, k))
+            before, after = r < j, (r >= 1) & (r <= j)
+            G[:, j[before], r[before]] += CPG0[:, (j - 1 - r)[before]]
+            G[:, j[after], r[after]] += CPG1[:, (j - r)[after]]
+            G[:, np.arange(L), np.arange(L)] += D[:, None]
+            self._G = G
+            # (m, p L, (L+1) k) @ windows (L+1) k x S: row (output, j), column (r, i)
+            self._G_mat = np.ascontiguousarray(G.transpose(0, 3, 1, 2, 4)).reshape(
+                m, p * L, (L + 1) * k
+            )
+        # V_b <- Σ_{i<=b} Q^{b-i} V_i with Q = Φ^L (Hillis–Steele, log2 rounds)
+        Q, d = P[:, L], 1
+        while d < nb + 1:
+            V[:, :, d:] += Q @ V[:, :, :-d]
+            Q = Q @ Q
+            d *= 2
+        self._V = V
+        # the last sample, from its block's carry: y_{N-1} = CΦ^j c_b + Σ_r G_{j,r} u_{bL+r}
+        b, jl = divmod(N - 1, L)
+        if jl == 0:
+            last = (C @ V[:, :, b, None])[..., 0]
+            if self._forced:
+                last = last + D @ U[:, -1]
+        else:
+            last = (obs[:, jl] @ V[:, :, b, None])[..., 0]
+            if self._forced:
+                u = self._windows[b].reshape(L + 1, k)
+                last = last + np.einsum("mrpk,rk->mp", self._G[:, jl], u)
+        self.final = last.reshape(self.batch + (p,))
+
+    def __iter__(self):
+        p, L, N = self.p, self.L, self.N
+        for b0 in range(0, self.nb, self.step):
+            b1 = min(b0 + self.step, self.nb)
+            S = b1 - b0
+            out = np.matmul(self._obs_mat, self._V[:, :, b0:b1])  # (m, p L, S)
+            if self._forced:
+                out += np.matmul(self._G_mat, self._windows_T[:, b0:b1])
+            index = np.arange(b0, b1)[None, :] * L + np.arange(L)[:, None]  # (L, S)
+            y = out.reshape(self.batch + (p, L, S))
+            if b1 * L > N - 1:  # the last segment: drop the padding past sample N - 2
+                keep = index < N - 1
+                index, y = index[keep], y[..., keep]
+            yield index, y
 
 
 def lti_trajectory(

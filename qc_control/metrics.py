@@ -33,7 +33,13 @@ __all__ = [
     "peak",
     "evaluate",
     "metric_columns",
+    "MetricStream",
+    "WEIGHTED_ACC",
 ]
+
+#: The name under which a metric reads the ISO 2631-1 Wk-weighted body
+#: acceleration (`RideSignals.weighted_acc`, or the streamed filter's output).
+WEIGHTED_ACC = "(Wk-weighted body acceleration)"
 
 
 def mean_square(v: np.ndarray) -> np.ndarray:
@@ -123,37 +129,51 @@ class RideSignals:
     def corner(self, i: int) -> Corner:
         return self.roles.corners[i]
 
+    # -- the reductions a registered metric is written with; `MetricStream`
+    # -- computes the same ones block by block
+    def _signal(self, label: str) -> np.ndarray:
+        return self.weighted_acc if label == WEIGHTED_ACC else self.output(label)
 
-def _rms(v: np.ndarray) -> np.ndarray:
-    return np.sqrt(mean_square(v))
+    def mean_square(self, label: str) -> np.ndarray:
+        """Trapezoidal time mean of the squared signal (`mean_square`), ``(m,)``."""
+        return mean_square(self._signal(label))
+
+    def peak(self, label: str) -> np.ndarray:
+        """``max |v|`` (`peak`), ``(m,)``."""
+        return peak(self._signal(label))
+
+    def quartic_integral(self, label: str) -> np.ndarray:
+        """Trapezoidal ``∫ v⁴ dt`` on the uniform grid, ``(m,)``."""
+        v4 = self._signal(label) ** 4
+        return self.dt * (v4.sum(axis=-1) - 0.5 * (v4[..., 0] + v4[..., -1]))
+
+    def settling_time(self, label: str) -> np.ndarray:
+        """First time after which the signal stays within 2 % of its largest
+        excursion from its final value (the 2 % settling criterion), ``(m,)``."""
+        T, y = self.T, self._signal(label)
+        dev = y - y[..., -1:]
+        np.abs(dev, out=dev)
+        outside = dev > 0.02 * dev.max(axis=-1, keepdims=True)
+        # the last sample outside, found from the end on a reversed view (no copy)
+        from_end = np.argmax(outside[..., ::-1], axis=-1)
+        settle = np.minimum(np.where(outside.any(axis=-1), T.size - from_end, 0), T.size - 1)
+        return T[settle]
+
+    def lifted_count(self, i: int) -> np.ndarray:
+        """Samples where corner ``i``'s dynamic tire load ``-kt·tire_defl``
+        unloads the tire by more than the static load (``kt·tire_defl > static``)."""
+        lifted = self.output(self.corner(i).tire_defl) > _lift_threshold(self, i)[..., None]
+        return np.count_nonzero(lifted, axis=-1)
 
 
-def _settling_time(s: RideSignals, _: int) -> np.ndarray:
-    """First time after which the body stays within 2 % of its largest
-    excursion from its final value (the 2 % settling criterion)."""
-    T, y = s.T, s.body_disp
-    dev = y - y[..., -1:]
-    np.abs(dev, out=dev)
-    outside = dev > 0.02 * dev.max(axis=-1, keepdims=True)
-    # the last sample outside, found from the end on a reversed view (no copy)
-    from_end = np.argmax(outside[..., ::-1], axis=-1)
-    settle = np.minimum(np.where(outside.any(axis=-1), T.size - from_end, 0), T.size - 1)
-    return T[settle]
+def _lift_threshold(s, i: int) -> np.ndarray:
+    """The tire deflection [m] beyond which corner ``i`` would leave the road."""
+    return np.asarray(s.static_load[i] / s.tire_stiffness[i])
 
 
-def _lifted(s: RideSignals, i: int) -> np.ndarray:
-    """Samples where the dynamic tire load ``-kt·tire_defl`` unloads the tire by
-    more than the static load: ``kt·tire_defl > static``."""
+def _rms_tire_load(s, i: int) -> np.ndarray:
     c = s.corner(i)
-    return s.output(c.tire_defl) > (s.static_load[i] / s.tire_stiffness[i])[..., None]
-
-
-def _rms_tire_load(s: RideSignals, i: int) -> np.ndarray:
-    return s.tire_stiffness[i] * _rms(s.output(s.corner(i).tire_defl)) / s.static_load[i]
-
-
-def _vdv(s: RideSignals, _: int) -> np.ndarray:
-    return np.trapezoid(s.weighted_acc**4, s.T, axis=-1) ** 0.25
+    return s.tire_stiffness[i] * np.sqrt(s.mean_square(c.tire_defl)) / s.static_load[i]
 
 
 @dataclass(frozen=True)
@@ -185,37 +205,38 @@ class Metric:
         return f"{self.name}{where} [{self.unit}]" if self.unit else f"{self.name}{where}"
 
 
-def _at_corner(signal: str, reduce: Callable[[np.ndarray], np.ndarray]):
-    """A wheel metric's formula: ``reduce`` of the corner's ``signal`` output."""
-    return lambda s, i: reduce(s.output(getattr(s.corner(i), signal)))
+def _at_corner(signal: str, reduction: str, then=lambda v: v):
+    """A wheel metric's formula: ``then`` of the ``reduction`` of the corner's ``signal``."""
+    return lambda s, i: then(getattr(s, reduction)(getattr(s.corner(i), signal)))
 
 
 # fmt: off
 _ALL = (
     Metric("rms_body_acc", "m/s²", "RMS body acceleration (trapezoidal time mean): comfort",
-           lambda s, _: _rms(s.body_acc)),
+           lambda s, _: np.sqrt(s.mean_square(s.roles.body_acc))),
     Metric("peak_body_acc", "m/s²", "largest |body acceleration|",
-           lambda s, _: peak(s.body_acc)),
+           lambda s, _: s.peak(s.roles.body_acc)),
     Metric("rms_body_acc_wk", "m/s²",
            "ISO 2631-1 Wk-weighted RMS body acceleration (ISO 2631-1:1997, 6.4)",
-           lambda s, _: _rms(s.weighted_acc)),
+           lambda s, _: np.sqrt(s.mean_square(WEIGHTED_ACC))),
     Metric("vdv", "m/s^1.75", "vibration dose value (∫ a_w⁴ dt)^¼ (ISO 2631-1:1997, 6.3.2)",
-           _vdv),
-    Metric("settling_time", "s", "2 % settling time of the body displacement", _settling_time),
+           lambda s, _: s.quartic_integral(WEIGHTED_ACC) ** 0.25),
+    Metric("settling_time", "s", "2 % settling time of the body displacement",
+           lambda s, _: s.settling_time(s.roles.body_disp)),
     Metric("rms_susp_travel", "m", "RMS suspension travel",
-           _at_corner("susp_travel", _rms), per_corner=True),
+           _at_corner("susp_travel", "mean_square", np.sqrt), per_corner=True),
     Metric("peak_susp_travel", "m", "largest |suspension travel|: the rattle space needed",
-           _at_corner("susp_travel", peak), per_corner=True),
+           _at_corner("susp_travel", "peak"), per_corner=True),
     Metric("peak_tire_defl", "m", "largest |dynamic tire deflection|",
-           _at_corner("tire_defl", peak), per_corner=True),
+           _at_corner("tire_defl", "peak"), per_corner=True),
     Metric("rms_tire_load / static", "-",
            "RMS dynamic tire load kt·|tire_defl| over the static wheel load: road holding",
            _rms_tire_load, per_corner=True),
     Metric("lift_off", "", "whether the dynamic load ever exceeds the static wheel load "
            "(the wheel would leave the road; a linear model does not represent it)",
-           lambda s, i: np.asarray(_lifted(s, i).any(axis=-1)), per_corner=True),
+           lambda s, i: np.asarray(s.lifted_count(i) > 0), per_corner=True),
     Metric("lift_off_duration", "s", "total time the wheel would be off the road",
-           lambda s, i: np.count_nonzero(_lifted(s, i), axis=-1) * s.dt, per_corner=True),
+           lambda s, i: s.lifted_count(i) * s.dt, per_corner=True),
 )
 # fmt: on
 
@@ -271,3 +292,188 @@ def evaluate(signals: RideSignals, names: Sequence[str]) -> dict[str, np.ndarray
         col: np.asarray(metric.formula(signals, i))
         for col, metric, i in metric_columns(names, signals.roles)
     }
+
+
+class _NotStreamable(Exception):
+    """A formula read a whole output, not one of the reductions."""
+
+
+class _Recorder:
+    """Runs a formula once to learn which reductions it reads (returns zeros)."""
+
+    def __init__(self, roles: SignalRoles, tire_stiffness, static_load, dt: float):
+        self.roles, self.dt = roles, dt
+        self.tire_stiffness, self.static_load = tire_stiffness, static_load
+        self.needs: set[tuple[str, object]] = set()
+
+    def corner(self, i: int) -> Corner:
+        return self.roles.corners[i]
+
+    def _note(self, kind: str, key) -> np.ndarray:
+        self.needs.add((kind, key))
+        return np.zeros(1)
+
+    def mean_square(self, label):
+        return self._note("sumsq", label)
+
+    def peak(self, label):
+        return self._note("peak", label)
+
+    def quartic_integral(self, label):
+        return self._note("quartic", label)
+
+    def settling_time(self, label):
+        return self._note("settle", label)
+
+    def lifted_count(self, i):
+        return self._note("lifted", i)
+
+    def __getattr__(self, name):  # output(), body_acc, T ...: a whole signal
+        raise _NotStreamable(name)
+
+
+class MetricStream:
+    """Registered metrics computed as the samples go by, from running reductions.
+
+    Nothing of the length of the response is kept: per design and signal a
+    sum of squares, a sum of fourth powers, a running peak, a count, or for
+    the settling time the largest excursion from the final value and the
+    last sample outside 2 % of it. The results equal the metrics of
+    `RideSignals` on the whole response (same formulas, same reductions) to
+    rounding, whatever the order and size of the pieces.
+
+    Parameters
+    ----------
+    items : sequence of ``(column, Metric, corner)``
+        As `metric_columns` gives them.
+    roles, T, tire_stiffness, static_load
+        As for `RideSignals`.
+
+    Use ``start(final)`` with each signal's last sample (the settling time
+    measures from it), then ``update(index, values)`` for each piece (the
+    sample numbers and ``{label: (m, len)}``; the last sample too), then
+    ``result()``.
+    """
+
+    def __init__(self, items, roles: SignalRoles, T: np.ndarray, tire_stiffness, static_load):
+        self.items = list(items)
+        self.roles, self.T, self.N = roles, T, T.size
+        self.dt = float((T[-1] - T[0]) / (T.size - 1))
+        self.tire_stiffness, self.static_load = tuple(tire_stiffness), tuple(static_load)
+        rec = _Recorder(roles, self.tire_stiffness, self.static_load, self.dt)
+        for _, metric, corner in self.items:
+            metric.formula(rec, corner)
+        self.needs = rec.needs
+        labels = {
+            roles.corners[key].tire_defl if isinstance(key, int) else str(key)
+            for _, key in self.needs
+        }
+        #: whether the Wk-weighted body acceleration is read (under `WEIGHTED_ACC`)
+        self.weighted = WEIGHTED_ACC in labels
+        #: the output labels read, the weighted acceleration left out
+        self.labels = tuple(sorted(str(x) for x in labels - {WEIGHTED_ACC}))
+        self._acc: dict = {}
+
+    @staticmethod
+    def supports(items, roles: SignalRoles) -> bool:
+        """Whether every metric is written with the reductions (a formula that
+        reads a whole output cannot be streamed)."""
+        rec = _Recorder(
+            roles, (np.ones(1),) * len(roles.corners), (np.ones(1),) * len(roles.corners), 1.0
+        )
+        try:
+            for _, metric, corner in items:
+                metric.formula(rec, corner)
+        except _NotStreamable:
+            return False
+        return True
+
+    def start(self, final: Mapping[str, np.ndarray]) -> None:
+        self._final = final
+        self._acc = {}
+
+    def update(self, index: np.ndarray, values: Mapping[str, np.ndarray]) -> None:
+        """Fold in one piece: ``values[label]`` of shape ``(m,) + index.shape``
+        holds the samples numbered ``index`` (any order, any shape)."""
+        acc = self._acc
+        index = np.asarray(index)
+        flat = index.reshape(-1)
+        first = np.flatnonzero(flat == 0)
+        for kind, key in self.needs:
+            label = self.roles.corners[key].tire_defl if isinstance(key, int) else str(key)
+            v = values[label]
+            if kind == "settle":
+                self._settle(label, v, index)
+                continue
+            v = v.reshape(v.shape[: v.ndim - index.ndim] + (-1,))  # a view: pieces are contiguous
+            if first.size and kind in ("sumsq", "quartic"):
+                acc[("first", label)] = v[..., first[0]]
+            if kind == "sumsq":
+                acc[(kind, key)] = acc.get((kind, key), 0.0) + np.vecdot(v, v)
+            elif kind == "quartic":
+                v2 = v * v
+                acc[(kind, key)] = acc.get((kind, key), 0.0) + np.vecdot(v2, v2)
+            elif kind == "peak":
+                top = np.maximum(v.max(axis=-1), -v.min(axis=-1))
+                acc[(kind, key)] = np.maximum(acc[(kind, key)], top) if (kind, key) in acc else top
+            elif kind == "lifted" and isinstance(key, int):
+                over = v > _lift_threshold(self, key)[..., None]
+                acc[(kind, key)] = acc.get((kind, key), 0) + np.count_nonzero(over, axis=-1)
+
+    def _settle(self, label: str, v: np.ndarray, index: np.ndarray) -> None:
+        """The last sample outside 2 % of the largest excursion from the final
+        value so far (this piece's included). Over the whole stream it is the
+        last outside 2 % of the final largest excursion: the sample where that
+        occurs is itself outside, and after it the threshold no longer moves."""
+        acc = self._acc
+        final = self._final[label]
+        dev = np.abs(v - final.reshape(final.shape + (1,) * index.ndim))
+        m = dev.shape[0]
+        if index.ndim == 2:  # (L, S) blocks: find the last block column outside, then the sample
+            cols = dev.max(axis=-2)  # (m, S)
+            M = cols.max(axis=-1)
+        else:
+            M = dev.max(axis=-1)
+        M = np.maximum(acc[("settle_max", label)], M) if ("settle_max", label) in acc else M
+        threshold = 0.02 * M
+        if index.ndim == 2:
+            out_cols = cols > threshold[:, None]
+            S = out_cols.shape[-1]
+            s_last = S - 1 - np.argmax(out_cols[:, ::-1], axis=-1)
+            column = dev[np.arange(m), :, s_last]  # (m, L)
+            L = column.shape[-1]
+            j_last = L - 1 - np.argmax((column > threshold[:, None])[:, ::-1], axis=-1)
+            last = np.where(out_cols.any(axis=-1), index[j_last, s_last], -1)
+        else:
+            last = np.where(dev > threshold[:, None], index, -1).max(axis=-1, initial=-1)
+        prev = acc.get(("settle", label), np.full(M.shape, -1))
+        acc[("settle_max", label)] = M
+        acc[("settle", label)] = np.maximum(prev, last)
+
+    def _ends(self, label):
+        return self._acc[("first", label)], self._final[label]
+
+    def mean_square(self, label):
+        v0, vn = self._ends(label)
+        return (self._acc[("sumsq", label)] - 0.5 * (v0**2 + vn**2)) / (self.N - 1)
+
+    def peak(self, label):
+        return self._acc[("peak", label)]
+
+    def quartic_integral(self, label):
+        v0, vn = self._ends(label)
+        return self.dt * (self._acc[("quartic", label)] - 0.5 * (v0**4 + vn**4))
+
+    def settling_time(self, label):
+        last = self._acc[("settle", label)]
+        return self.T[np.minimum(np.where(last >= 0, last + 1, 0), self.N - 1)]
+
+    def lifted_count(self, i):
+        return self._acc[("lifted", i)]
+
+    def corner(self, i: int) -> Corner:
+        return self.roles.corners[i]
+
+    def result(self) -> dict[str, np.ndarray]:
+        """Each metric's column -> values ``(m,)``."""
+        return {col: np.asarray(metric.formula(self, i)) for col, metric, i in self.items}

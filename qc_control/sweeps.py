@@ -14,10 +14,18 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from .integrate import check_substeps, check_time_grid, uniform_step
+from .iso2631 import wk_discrete
 from .limits import check_memory
-from .lti import affine_scan, step_matrices
+from .lti import OutputStream, affine_scan, step_matrices
 from .methods import ButcherTableau, get_method
-from .metrics import METRICS, SWEEP_METRICS, RideSignals, metric_columns
+from .metrics import (
+    METRICS,
+    SWEEP_METRICS,
+    WEIGHTED_ACC,
+    MetricStream,
+    RideSignals,
+    metric_columns,
+)
 from .model import SEED_X0, quarter_car_model
 from .stability import step_is_stable
 from .vehicle import BatchedModel, SignalRoles, VehicleModel
@@ -130,6 +138,10 @@ def _run_chunk(
     """
     A, B, C, D = batch.A, batch.B, batch.C, batch.D
     m, n = A.shape[0], A.shape[-1]
+    if not keep_states and all(isinstance(metric, str) for _, metric, _ in metric_items):
+        items = [(column, METRICS[name], corner) for column, name, corner in metric_items]
+        if MetricStream.supports(items, roles):
+            return _stream_chunk(batch, labels, roles, T, X0, U, method, substeps, items), None
     # only the outputs the metrics read (a custom metric may read any)
     wanted = _outputs_read(metric_items, roles, labels)
     rows = [labels.index(label) for label in wanted]
@@ -179,6 +191,66 @@ def _run_chunk(
     return result, x
 
 
+def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps, items):
+    """One chunk's registered metrics, streamed (`qc_control.lti.OutputStream`
+    into `qc_control.metrics.MetricStream`): no ``(designs, outputs, samples)``
+    array, only a segment of it at a time.
+
+    When a metric reads the Wk-weighted acceleration, the filter (exact for
+    an input linear between samples, `qc_control.iso2631.wk_discrete`) runs
+    inside the scan: its state ``x̃`` joins the car's, so it is carried from
+    block to block,
+
+    .. math:: \\begin{bmatrix} x \\\\ \\tilde x \\end{bmatrix}_{k+1} =
+              \\begin{bmatrix} Φ & 0 \\\\ \\tilde B C_a & A_d \\end{bmatrix}
+              \\begin{bmatrix} x \\\\ \\tilde x \\end{bmatrix}_k + \\dots, \\quad
+              a_w = C_w \\tilde x + \\tilde D a, \\quad \\tilde x_0 = -B_1 a_0,
+
+    the same recursion `qc_control.iso2631.wk_weighted` evaluates by FFT.
+    """
+    A, B, C, D = batch.A, batch.B, batch.C, batch.D
+    m, n = A.shape[0], A.shape[-1]
+    stream = MetricStream(items, roles, T, batch.tire_stiffness, batch.static_load)
+    read = list(stream.labels)
+    rows = [labels.index(label) for label in read]
+    C, D = C[:, rows], D[:, rows]
+    H = (T[-1] - T[0]) / (T.size - 1)
+    phi, g0, g1 = step_matrices(method, A, B, H, substeps)
+    x0 = np.broadcast_to(X0, (m, n))
+    if stream.weighted:
+        acc = labels.index(roles.body_acc)
+        Ca, Da = batch.C[:, acc], batch.D[:, acc]  # (m, n), (m, k)
+        Ad, Bt, Cw, Dt, B1 = wk_discrete(round(float(H), 15))
+        nw = Ad.shape[0]
+        big = np.zeros((m, n + nw, n + nw))
+        big[:, :n, :n] = phi
+        big[:, n:, :n] = Bt[:, None] * Ca[:, None, :]
+        big[:, n:, n:] = Ad
+        phi = big
+        a0 = Ca @ X0 + (Da @ U[:, 0] if U is not None else 0.0)
+        x0 = np.concatenate([x0, -a0[:, None] * B1], axis=1)
+        weighted = np.concatenate([Dt * Ca, np.broadcast_to(Cw[0], (m, nw))], axis=1)
+        C = np.concatenate([np.pad(C, ((0, 0), (0, 0), (0, nw))), weighted[:, None]], axis=1)
+        D = np.concatenate([D, Dt * Da[:, None]], axis=1)
+        g0 = np.concatenate([g0, Bt[:, None] * Da[:, None, :]], axis=1)
+        g1 = np.pad(g1, ((0, 0), (0, nw), (0, 0)))
+        read.append(WEIGHTED_ACC)
+    with np.errstate(over="ignore", invalid="ignore"):
+        if U is None:  # longer blocks: no input Toeplitz to pay for, fewer scan rounds
+            out = OutputStream(phi, x0, T.size, C, block=64)
+        else:
+            out = OutputStream(phi, x0, T.size, C, D=D, g0=g0, g1=g1, U=U, block=16)
+        final = {label: out.final[:, i] for i, label in enumerate(read)}
+        stream.start(final)
+        for index, y in out:
+            stream.update(index, {label: y[:, i] for i, label in enumerate(read)})
+        stream.update(np.array([T.size - 1]), {k: v[:, None] for k, v in final.items()})
+        result = {"stable": step_is_stable(method, H / substeps, np.linalg.eigvals(A))}
+        for column, values in stream.result().items():
+            result[column] = values
+    return result
+
+
 def _outputs_read(metric_items, roles: SignalRoles, labels: tuple[str, ...]) -> tuple[str, ...]:
     """The output labels the metrics read, in the model's order: the body's and
     every corner's for registered metrics, all of them for a custom one."""
@@ -215,7 +287,7 @@ def sweep(
     *,
     model: VehicleModel | None = None,
     substeps: int = 1,
-    chunk_size: int = 16,
+    chunk_size: int = 64,
     progress: bool | None = None,
 ) -> SweepResult:
     """Simulate many designs of a vehicle at once and tabulate their metrics.
@@ -250,10 +322,12 @@ def sweep(
         ``quarter_car_model(road=U is not None)``. Designs are rebuilt with
         its ``batch`` (vectorised for the quarter car).
     substeps : int, default 1
-    chunk_size : int, default 16
+    chunk_size : int, default 64
         Designs per chunk: the unit of vectorisation, of memory and of work
-        sent to the executor. Results do not depend on it. 16 keeps a chunk's
-        outputs (16 × 5 × len(T) doubles) near the cache on 10,001 samples.
+        sent to the executor. Results do not depend on it. Registered metrics
+        are streamed: a chunk holds about 1 MB of outputs at a time whatever
+        ``len(T)`` (see Notes); custom metrics and ``states=True`` hold a
+        chunk's whole outputs (``chunk_size × 5 × len(T)`` doubles).
     progress : bool, optional
         Show a tqdm bar. By default it appears on a terminal when the sweep
         outlasts 1 s, and never when standard error is not a terminal.
@@ -268,7 +342,17 @@ def sweep(
     and solves all trajectories together with one blocked scan, so the
     results equal `qc_control.initial_response` (and ``forced_response``)
     for each design to rounding. The metrics are those of
-    `qc_control.ride_metrics`, column for column. A design that fails
+    `qc_control.ride_metrics`, column for column.
+
+    Registered metrics are computed as the scan goes by
+    (`qc_control.lti.OutputStream` into `qc_control.metrics.MetricStream`):
+    running sums of squares, peaks, counts and the settling time's last
+    excursion, and the Wk filter's state carried inside the scan; no
+    ``(designs × outputs × samples)`` array exists. The road ``U``, shared by
+    every design, enters each block through one product with a window of
+    ``U`` per design, so ``Γ₀u + Γ₁u⁺`` is never formed per design. Custom
+    metrics (callables) and ``states=True`` read whole trajectories, and get
+    them. A design that fails
     validation (a negative mass, say) is reported in ``errors`` by index
     and value, with NaN metrics; the other designs are unaffected.
     """
@@ -302,8 +386,11 @@ def sweep(
     if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
         raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
     metric_items = _metric_items(metrics, model.roles)
-    # a chunk's outputs (and states) with the scan's temporaries, plus every kept trajectory
-    per_chunk = 3 * min(chunk_size, len(designs)) * (sys_.noutputs + n * states) * T.size * 8
+    streamed = not states and not isinstance(metrics, Mapping)
+    rows = min(chunk_size, len(designs)) * (sys_.noutputs + n * states)
+    # streamed: a segment of about 1 MB and the block carries; otherwise a chunk's
+    # outputs (and states) with the scan's temporaries, plus every kept trajectory
+    per_chunk = (2**20 + rows * T.size * 8 // 16) if streamed else 3 * rows * T.size * 8
     check_memory(
         per_chunk + states * len(designs) * n * T.size * 8,
         f"a sweep of {len(designs)} designs over {T.size} samples"
