@@ -107,7 +107,12 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         wk_weighted,
     )
     from .scenario import Scenario, ScenarioError, load_config, read_config
-    from .spectral import iso8608_intensity, lyapunov_variances, white_velocity_variances
+    from .spectral import (
+        ISO8608Road,
+        iso8608_intensity,
+        lyapunov_variances,
+        white_velocity_variances,
+    )
     from .stability import max_stable_step, stability_function
     from .sweeps import DEFAULT_METRICS, METRICS, SweepChunk, SweepResult, design_grid, sweep
     from .vehicle import Corner, SignalRoles, VehicleModel
@@ -168,6 +173,7 @@ _LAZY: dict[str, str] = {
     "lyapunov_variances": "spectral",
     "white_velocity_variances": "spectral",
     "iso8608_intensity": "spectral",
+    "ISO8608Road": "spectral",
 }
 
 
@@ -243,4 +249,5 @@ __all__ = [
     "lyapunov_variances",
     "white_velocity_variances",
     "iso8608_intensity",
+    "ISO8608Road",
 ]

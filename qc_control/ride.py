@@ -20,7 +20,12 @@ from .iso2631 import wk_filter, wk_weighted
 from .metrics import METRICS, RIDE_METRICS, RideSignals, evaluate
 from .model import as_params, quarter_car, quarter_car_model
 from .road import ISO8608_BAND, ISO8608_N0, band_limits, road_class_psd
-from .spectral import iso8608_intensity, white_velocity_variances, white_velocity_wk_variance
+from .spectral import (
+    SPECTRAL_CAPABLE,
+    iso8608_intensity,
+    spectral_metrics,
+    white_velocity_variances,
+)
 from .vehicle import VehicleModel
 
 if TYPE_CHECKING:
@@ -263,35 +268,38 @@ def ride_metrics_spectral(
     labels.append(roles.body_disp)
     labels = list(dict.fromkeys(labels))
     if exact:
-        var = white_velocity_variances(model, intensity=q, outputs=labels)
-        var_wk = white_velocity_wk_variance(model, intensity=q)
-        source = "exact: Lyapunov, unbounded band (white road velocity)"
-    else:
-        lo, hi = band_limits(band)
-        if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 2:
-            raise ValueError(
-                f"points must be an integer >= 2 (frequencies in the band), got {points!r}"
-            )
-        g0 = road_class_psd(road_class)
-        f = np.geomspace(speed * lo, speed * hi, points)
-        sys = model.system
-        roads = [list(sys.input_labels).index(r) for r in model.road_inputs()]
-        if not roads:
-            raise ValueError(f"model {model.name!r} has no road input: build it with road=True")
-        H = np.asarray(control.frequency_response(sys, 2 * np.pi * f).complex)
-        H = H.reshape(sys.noutputs, sys.ninputs, f.size)[:, roads]
-        gain = (np.abs(H) ** 2).sum(axis=1)  # independent tracks: powers add
-        road_psd = g0 * ((f / speed) / ISO8608_N0) ** -2.0 / speed  # one-sided, m²/Hz
-        wk = np.abs(np.asarray(wk_filter()(2j * np.pi * f))).reshape(-1)
-        log_f = np.log(f)
+        values = spectral_metrics(model, q, SPECTRAL_CAPABLE)
+        body = f"rms_{roles.body_disp} [{model.unit(roles.body_disp)}]"
+        # the body's height follows the road's random walk: inf
+        values[body] = math.sqrt(white_velocity_variances(model)[roles.body_disp])
+        series = pd.Series(values)
+        series.attrs["band"] = "exact: Lyapunov, unbounded band (white road velocity)"
+        return series
+    lo, hi = band_limits(band)
+    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 2:
+        raise ValueError(
+            f"points must be an integer >= 2 (frequencies in the band), got {points!r}"
+        )
+    g0 = road_class_psd(road_class)
+    f = np.geomspace(speed * lo, speed * hi, points)
+    sys = model.system
+    roads = [list(sys.input_labels).index(r) for r in model.road_inputs()]
+    if not roads:
+        raise ValueError(f"model {model.name!r} has no road input: build it with road=True")
+    H = np.asarray(control.frequency_response(sys, 2 * np.pi * f).complex)
+    H = H.reshape(sys.noutputs, sys.ninputs, f.size)[:, roads]
+    gain = (np.abs(H) ** 2).sum(axis=1)  # independent tracks: powers add
+    road_psd = g0 * ((f / speed) / ISO8608_N0) ** -2.0 / speed  # one-sided, m²/Hz
+    wk = np.abs(np.asarray(wk_filter()(2j * np.pi * f))).reshape(-1)
+    log_f = np.log(f)
 
-        def integral(h2):
-            return float(np.trapezoid(h2 * road_psd * f, log_f))
+    def integral(h2):
+        return float(np.trapezoid(h2 * road_psd * f, log_f))
 
-        out = list(sys.output_labels)
-        var = {label: integral(gain[out.index(label)]) for label in labels}
-        var_wk = integral(wk**2 * gain[out.index(roles.body_acc)])
-        source = f"ISO 8608 band {lo:g}-{hi:g} cycles/m (quadrature, {points} points)"
+    out = list(sys.output_labels)
+    var = {label: integral(gain[out.index(label)]) for label in labels}
+    var_wk = integral(wk**2 * gain[out.index(roles.body_acc)])
+    source = f"ISO 8608 band {lo:g}-{hi:g} cycles/m (quadrature, {points} points)"
     values = {
         METRICS["rms_body_acc"].column(): math.sqrt(var[roles.body_acc]),
         METRICS["rms_body_acc_wk"].column(): math.sqrt(var_wk),

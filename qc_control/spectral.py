@@ -25,12 +25,14 @@ from __future__ import annotations
 
 import functools
 import math
+from dataclasses import dataclass
 
 import control
 import numpy as np
 import scipy.linalg
 
 from .iso2631 import wk_filter
+from .metrics import metric_columns
 from .road import ISO8608_N0, positive, road_class_psd
 from .vehicle import VehicleModel
 
@@ -41,6 +43,10 @@ __all__ = [
     "white_velocity_variances",
     "white_velocity_wk_variance",
     "iso8608_intensity",
+    "ISO8608Road",
+    "spectral_metrics",
+    "SPECTRAL_METRICS",
+    "SPECTRAL_CAPABLE",
 ]
 
 #: Up to this many states the batched solve uses the Kronecker form (n² unknowns,
@@ -359,3 +365,102 @@ def white_velocity_wk_variance(model: VehicleModel, *, intensity: float = 1.0, b
 def _wk_matrices() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     sys = control.ss(wk_filter())
     return tuple(np.asarray(getattr(sys, k), dtype=float) for k in "ABCD")  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class ISO8608Road:
+    """An ISO 8608 road driven at a constant speed, for exact spectral metrics.
+
+    Over the unbounded band (waviness 2) it is white road velocity of
+    intensity `iso8608_intensity` ``= 2π² n0² Gd(n0) v``: give it to
+    `qc_control.sweep` as ``road=`` for a spectral sweep (no simulation).
+
+    Parameters
+    ----------
+    road_class : str or float, default 'C'
+        ``'A'`` ... ``'H'``, or ``Gd(n0)`` [m³].
+    speed : float, default 20
+        [m/s], > 0.
+
+    Examples
+    --------
+    >>> round(ISO8608Road("C", speed=20.0).intensity, 6)
+    0.001011
+    """
+
+    road_class: str | float = "C"
+    speed: float = 20.0
+
+    def __post_init__(self):
+        iso8608_intensity(self.road_class, self.speed)  # validates both
+
+    @property
+    def intensity(self) -> float:
+        """White road-velocity intensity ``q`` [m²/s]."""
+        return iso8608_intensity(self.road_class, self.speed)
+
+
+#: The metrics a spectral sweep computes unless told otherwise (the
+#: Wk-weighted one costs a 12-state Lyapunov equation per design; ask for it).
+SPECTRAL_METRICS = ("rms_body_acc", "rms_susp_travel", "rms_tire_load / static")
+#: Every metric with an exact stationary value under white road velocity.
+SPECTRAL_CAPABLE = ("rms_body_acc", "rms_body_acc_wk", "rms_susp_travel", "rms_tire_load / static")
+
+
+def spectral_metrics(
+    model: VehicleModel, intensity: float, names=SPECTRAL_METRICS, batch=None
+) -> dict:
+    """Exact stationary RMS metrics of a vehicle (or a batch of designs) on white road velocity.
+
+    ``rms_body_acc``, ``rms_body_acc_wk``, ``rms_susp_travel`` and
+    ``rms_tire_load / static`` (``kt σ(tire_defl) / static load``), under the
+    column names of `qc_control.metrics` (per corner for a wheel's metric),
+    from `white_velocity_variances` and `white_velocity_wk_variance`: the
+    Lyapunov values over the unbounded band.
+
+    Parameters
+    ----------
+    model : VehicleModel
+        With road inputs.
+    intensity : float
+        ``q`` [m²/s] (`iso8608_intensity`, or ``ISO8608Road.intensity``).
+    names : sequence of str, default `SPECTRAL_METRICS`
+        Metric names (or columns) among `SPECTRAL_CAPABLE`.
+    batch : BatchedModel, optional
+        Many designs at once: values are then arrays ``(m,)``.
+
+    Returns
+    -------
+    dict[str, float or ndarray]
+    """
+    items = metric_columns(list(names), model.roles)
+    other = sorted({metric.name for _, metric, _ in items} - set(SPECTRAL_CAPABLE))
+    if other:
+        raise ValueError(
+            f"metric {other[0]!r} has no stationary spectral value; a spectral sweep "
+            f"computes {', '.join(SPECTRAL_CAPABLE)}"
+        )
+    roles = model.roles
+    labels = [roles.body_acc] + [c.susp_travel for c in roles.corners]
+    labels += [c.tire_defl for c in roles.corners]
+    var = white_velocity_variances(
+        model, intensity=intensity, outputs=list(dict.fromkeys(labels)), batch=batch
+    )
+    stiffness = (
+        batch.tire_stiffness if batch is not None else [c.tire_stiffness for c in roles.corners]
+    )
+    load = batch.static_load if batch is not None else [c.static_load for c in roles.corners]
+    out: dict = {}
+    for column, metric, i in items:
+        corner = roles.corners[i]
+        if metric.name == "rms_body_acc":
+            out[column] = np.sqrt(var[roles.body_acc])
+        elif metric.name == "rms_body_acc_wk":
+            out[column] = np.sqrt(
+                white_velocity_wk_variance(model, intensity=intensity, batch=batch)
+            )
+        elif metric.name == "rms_susp_travel":
+            out[column] = np.sqrt(var[corner.susp_travel])
+        else:
+            out[column] = stiffness[i] * np.sqrt(var[corner.tire_defl]) / load[i]
+    return {k: (float(v) if np.ndim(v) == 0 else v) for k, v in out.items()}

@@ -27,6 +27,7 @@ from .metrics import (
     metric_columns,
 )
 from .model import SEED_X0, quarter_car_model
+from .spectral import SPECTRAL_METRICS, ISO8608Road, spectral_metrics
 from .stability import step_is_stable
 from .vehicle import BatchedModel, SignalRoles, VehicleModel
 
@@ -53,13 +54,17 @@ class SweepResult:
         The rejected designs: ``index``, ``value`` and ``error``.
     states : ndarray or None
         ``(designs, 4, len(T))`` when asked for (NaN for rejected designs).
+    road : ISO8608Road or None
+        The road of a spectral sweep (then ``T`` and ``method`` are None, and
+        ``stable`` says the design's ``A`` is Hurwitz).
     """
 
-    T: np.ndarray
-    method: ButcherTableau
+    T: np.ndarray | None
+    method: ButcherTableau | None
     metrics: pd.DataFrame
     errors: pd.DataFrame
     states: np.ndarray | None = None
+    road: ISO8608Road | None = None
 
 
 def design_grid(grid: Mapping[str, Sequence], base=None) -> list[dict]:
@@ -108,7 +113,7 @@ def _validate(designs, params_type) -> tuple[list, list]:
     return out, errors
 
 
-def _take(batch: BatchedModel, idx: slice) -> BatchedModel:
+def _take(batch: BatchedModel, idx) -> BatchedModel:
     return BatchedModel(
         batch.A[idx],
         batch.B[idx],
@@ -277,7 +282,7 @@ def _metric_items(metrics, roles: SignalRoles) -> list:
 
 def sweep(
     designs,
-    T,
+    T=None,
     X0=SEED_X0,
     U=None,
     method="rk4",
@@ -289,6 +294,7 @@ def sweep(
     substeps: int = 1,
     chunk_size: int = 64,
     progress: bool | None = None,
+    road: ISO8608Road | None = None,
 ) -> SweepResult:
     """Simulate many designs of a vehicle at once and tabulate their metrics.
 
@@ -299,7 +305,7 @@ def sweep(
         default model), or ``{'ks': [...], 'zeta': [...]}`` for the cartesian
         product over the model's own parameters (see `design_grid`).
     T : array_like
-        Uniform time grid [s].
+        Uniform time grid [s] (not with ``road``).
     X0 : array_like, default ``(0, 0, 0.05, 0)``
         Initial state, the same for every design (the seed's 5 cm release).
     U : array_like, optional
@@ -331,6 +337,15 @@ def sweep(
     progress : bool, optional
         Show a tqdm bar. By default it appears on a terminal when the sweep
         outlasts 1 s, and never when standard error is not a terminal.
+    road : ISO8608Road, optional
+        A spectral sweep instead of a simulation: the exact stationary RMS
+        metrics on this road (`qc_control.spectral.spectral_metrics`, the
+        Lyapunov equation of each design on white road velocity, batched),
+        for a linear model with road inputs (default
+        ``quarter_car_model(road=True)``). Give no ``T``, ``U`` or ``X0``;
+        ``metrics`` among `qc_control.spectral.SPECTRAL_CAPABLE` (default
+        `qc_control.spectral.SPECTRAL_METRICS`). Runs here, vectorised over
+        all designs (``executor`` is not used).
 
     Returns
     -------
@@ -356,6 +371,10 @@ def sweep(
     validation (a negative mass, say) is reported in ``errors`` by index
     and value, with NaN metrics; the other designs are unaffected.
     """
+    if road is not None:
+        return _spectral_sweep(designs, T, U, road, metrics, model)
+    if T is None:
+        raise ValueError("give T (a time grid) for a simulated sweep, or road= for a spectral one")
     model = quarter_car_model(road=U is not None) if model is None else model
     if isinstance(designs, Mapping):
         designs = design_grid(designs, model.params)
@@ -441,6 +460,12 @@ def sweep(
             kept[idx] = x
     bar.close()
 
+    frame, err_frame = _tables(designs, params, errors, model, stable, table)
+    return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)
+
+
+def _tables(designs, params, errors, model, stable, table) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The result's ``metrics`` and ``errors`` frames; warns about rejected designs."""
     names = list(model.params.to_dict())
     frame = pd.DataFrame(  # column by column: one getattr per value, no dict per design
         {n: [np.nan if p is None else getattr(p, n) for p in params] for n in names}
@@ -457,7 +482,48 @@ def sweep(
             f"{len(errors)} of {len(designs)} designs were rejected; first: design "
             f"{errors[0][0]}: {errors[0][2]} (see .errors)",
             RuntimeWarning,
-            stacklevel=2,
+            stacklevel=3,
         )
     frame.index.name = "design"
-    return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)
+    return frame, err_frame
+
+
+def _spectral_sweep(designs, T, U, road, metrics, model) -> SweepResult:
+    """`sweep` with ``road=``: exact stationary RMS metrics, no simulation."""
+    if not isinstance(road, ISO8608Road):
+        raise TypeError(f"road must be an ISO8608Road, got {type(road).__name__}")
+    if T is not None or U is not None:
+        raise ValueError(
+            "a spectral sweep (road=) takes no T or U: its metrics are stationary, "
+            "over the unbounded band"
+        )
+    model = quarter_car_model(road=True) if model is None else model
+    if isinstance(designs, Mapping):
+        designs = design_grid(designs, model.params)
+    designs = list(designs)
+    if not designs:
+        raise ValueError("designs is empty: give at least one design")
+    names = (
+        SPECTRAL_METRICS
+        if metrics is None
+        else ([metrics] if isinstance(metrics, str) else metrics)
+    )
+    if isinstance(names, Mapping):
+        raise TypeError("a spectral sweep computes registered metrics only, not callables")
+    columns = [column for column, _, _ in metric_columns(list(names), model.roles)]
+    params, errors = _validate(designs, type(model.params))
+    good = np.array([i for i, p in enumerate(params) if p is not None], dtype=int)
+    table = {column: np.full(len(designs), np.nan) for column in columns}
+    stable = np.zeros(len(designs), dtype=bool)
+    if good.size:
+        batch = model.batch([params[i] for i in good])
+        hurwitz = np.linalg.eigvals(batch.A).real.max(axis=-1) < 0
+        stable[good] = hurwitz
+        keep = np.flatnonzero(hurwitz)
+        for start in range(0, keep.size, 4096):  # bounds the Kronecker systems' memory
+            part = keep[start : start + 4096]
+            values = spectral_metrics(model, road.intensity, names, batch=_take(batch, part))
+            for column in columns:
+                table[column][good[part]] = values[column]
+    frame, err_frame = _tables(designs, params, errors, model, stable, table)
+    return SweepResult(T=None, method=None, metrics=frame, errors=err_frame, road=road)

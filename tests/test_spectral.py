@@ -176,3 +176,46 @@ def test_bad_input():
     with pytest.raises(ValueError, match="intensity must be a finite number > 0"):
         white_velocity_variances(quarter_car_model(road=True), intensity=0.0)
     assert road.ISO8608_N0 == 0.1
+
+
+def test_spectral_sweep_equals_single_designs():
+    """qc.sweep(..., road=ISO8608Road) against ride_metrics_spectral(exact=True)
+    one design at a time (the Kronecker and the eigendecomposition paths,
+    batched against single): 1e-9 relative; an undamped design (cs = 0, not
+    Hurwitz) is flagged unstable with NaN metrics, the others unaffected."""
+    from qc_control.spectral import SPECTRAL_CAPABLE, ISO8608Road
+
+    grid = {"ks": [15e3, 30e3, 45e3], "zeta": [0.0, 0.1, 0.35, 0.8]}
+    road_ = ISO8608Road("D", speed=25.0)
+    r = qc.sweep(grid, road=road_, metrics=list(SPECTRAL_CAPABLE))
+    assert r.T is None and r.road == road_
+    for i, d in enumerate(qc.design_grid(grid)):
+        row = r.metrics.loc[i]
+        if d["zeta"] == 0.0:
+            assert not row["stable"] and np.isnan(row["rms_body_acc [m/s²]"])
+            continue
+        single = ride_metrics_spectral(qc.QuarterCarParams(**d), "D", 25.0, exact=True)
+        assert row["stable"]
+        for column in (
+            "rms_body_acc [m/s²]",
+            "rms_body_acc_wk [m/s²]",
+            "rms_susp_travel [m]",
+            "rms_tire_load / static [-]",
+        ):
+            assert row[column] == pytest.approx(single[column], rel=1e-9), column
+
+
+def test_spectral_sweep_bad_input():
+    from qc_control.spectral import ISO8608Road
+
+    road_ = ISO8608Road("C", 20.0)
+    with pytest.raises(ValueError, match="takes no T or U"):
+        qc.sweep({"ks": [2e4]}, np.linspace(0, 1, 11), road=road_)
+    with pytest.raises(ValueError, match="'peak_body_acc' has no stationary spectral value"):
+        qc.sweep({"ks": [2e4]}, road=road_, metrics=["peak_body_acc"])
+    with pytest.raises(TypeError, match="road must be an ISO8608Road"):
+        qc.sweep({"ks": [2e4]}, road="C")
+    with pytest.raises(ValueError, match="give T"):
+        qc.sweep({"ks": [2e4]})
+    with pytest.raises(ValueError, match="speed must be a finite number > 0"):
+        ISO8608Road("C", 0.0)
