@@ -120,10 +120,35 @@ def _free_response(phi, x0, N, C, time_last):
     return out if time_last else np.swapaxes(out, -1, -2)
 
 
+def _input_offsets(P, g0, g1, U, N: int, L: int, nb: int) -> np.ndarray:
+    """``Y[b, q] = Σ_{i<=q} Φ^{q-i} (Γ₀ u_{bL+i} + Γ₁ u_{bL+i+1})`` from the input samples.
+
+    With ``k`` inputs (fewer than the ``n`` states) one product of each
+    block's window ``u_{bL} .. u_{bL+L}`` with the ``((L+1)k, L n)`` matrix of
+    ``Φ^{q-r}Γ₀ [r<=q] + Φ^{q+1-r}Γ₁ [1<=r<=q+1]``: ``2(L+1)kn`` flops per step
+    instead of the ``2L n²`` of the Toeplitz product with ``W``.
+    """
+    n, k = P.shape[-1], U.shape[0]
+    batch = P.shape[:-3]
+    padded = np.zeros((nb * L + 1, k))
+    padded[:N] = U.T
+    windows = padded[np.arange(nb)[:, None] * L + np.arange(L + 1)].reshape(nb, (L + 1) * k)
+    PG0 = P[..., :L, :, :] @ g0[..., None, :, :]  # Φ^i Γ₀: (..., L, n, k)
+    PG1 = P[..., :L, :, :] @ g1[..., None, :, :]
+    q, r = np.meshgrid(np.arange(L), np.arange(L + 1), indexing="ij")
+    E = np.zeros(batch + (L, L + 1, n, k))  # (q, r)
+    lo, hi = r <= q, (r >= 1) & (r <= q + 1)
+    E[..., q[lo], r[lo], :, :] += PG0[..., (q - r)[lo], :, :]
+    E[..., q[hi], r[hi], :, :] += PG1[..., (q + 1 - r)[hi], :, :]
+    # rows (r, input), columns (q, state)
+    E = np.moveaxis(E, (-4, -3, -2, -1), (-2, -4, -1, -3)).reshape(batch + ((L + 1) * k, L * n))
+    return (windows @ E).reshape(batch + (nb, L, n))
+
+
 def affine_scan(
     phi: np.ndarray,
     x0: np.ndarray,
-    W: np.ndarray | None,
+    W: np.ndarray | tuple | None,
     N: int,
     block: int = 16,
     C: np.ndarray | None = None,
@@ -136,6 +161,9 @@ def affine_scan(
     phi : array, shape (..., n, n)
     x0 : array, shape (..., n)
     W : array, shape (..., N-1, n), or None for ``W = 0``
+        Or a tuple ``(Γ₀, Γ₁, U)``, ``U`` of shape ``(k, N)`` and ``W_k = Γ₀
+        u_k + Γ₁ u_{k+1}``: the input's effect on each block is then formed
+        from windows of ``U`` (`_input_offsets`), never ``W`` itself.
     N : int
         Number of samples.
     block : int, default 16
@@ -177,14 +205,18 @@ def affine_scan(
     L = max(1, min(block, N - 1))
     nb = -(-(N - 1) // L)
     P = _powers(phi, L)
-    # Y_{b, q+1} for every block: one product with the block-Toeplitz matrix
-    # M[(i, a), (q, c)] = (Φ^{q-i})[c, a] for i <= q (row block i feeds Y_{b, q+1})
-    Wb = np.zeros(batch + (nb * L, n))
-    Wb[..., : N - 1, :] = W
-    lag = np.arange(L)[None, :] - np.arange(L)[:, None]  # q - i
-    M = np.swapaxes(P[..., np.clip(lag, 0, L), :, :], -1, -2)  # (..., i, q, a, c)
-    M = np.swapaxes(M * (lag >= 0)[:, :, None, None], -3, -2).reshape(batch + (L * n, L * n))
-    Y = (Wb.reshape(batch + (nb, L * n)) @ M).reshape(batch + (nb, L, n))
+    if isinstance(W, tuple):  # (Γ₀, Γ₁, U): the input's samples, not W = Γ₀u + Γ₁u⁺
+        g0, g1, U = W
+        Y = _input_offsets(P, g0, g1, U, N, L, nb)
+    else:
+        # Y_{b, q+1} for every block: one product with the block-Toeplitz matrix
+        # M[(i, a), (q, c)] = (Φ^{q-i})[c, a] for i <= q (row block i feeds Y_{b, q+1})
+        Wb = np.zeros(batch + (nb * L, n))
+        Wb[..., : N - 1, :] = W
+        lag = np.arange(L)[None, :] - np.arange(L)[:, None]  # q - i
+        M = np.swapaxes(P[..., np.clip(lag, 0, L), :, :], -1, -2)  # (..., i, q, a, c)
+        M = np.swapaxes(M * (lag >= 0)[:, :, None, None], -3, -2).reshape(batch + (L * n, L * n))
+        Y = (Wb.reshape(batch + (nb, L * n)) @ M).reshape(batch + (nb, L, n))
     # the carries c_b: V_0 = x0, V_{b+1} = Y_{b,L}, scanned with powers of Φ^L
     V = np.empty(batch + (nb + 1, n))
     V[..., 0, :] = x0
@@ -397,10 +429,12 @@ def lti_trajectory(
         phi, g_lo, g_hi = step_matrices(method, A, B, H, substeps)
         W = None
         if U is not None and U.size and np.any(U):
-            W = U[:, :-1].T @ g_lo.T + U[:, 1:].T @ g_hi.T
+            n, k = phi.shape[-1], U.shape[0]
+            # fewer inputs than states: the windows of U carry the input, not W
+            W = (g_lo, g_hi, U) if k < n else U[:, :-1].T @ g_lo.T + U[:, 1:].T @ g_hi.T
         # Without input there is no block-Toeplitz product, so longer blocks
         # (fewer scan rounds) win; with input, 16 keeps that product small.
-        return affine_scan(phi, x0, W, T.size, block=16 if W is not None else 32).T
+        return affine_scan(phi, x0, W, T.size, block=16 if W is not None else 32, time_last=True)
 
 
 def lti_solve(method, A, B, T, U, x0, substeps: int = 1, *, uniform: bool = False) -> Solution:
