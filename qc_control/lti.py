@@ -389,6 +389,47 @@ class OutputStream:
                 last = last + np.einsum("mrpk,rk->mp", self._G[:, jl], u)
         self.final = last.reshape(self.batch + (p,))
 
+    def keep_rows(self, rows) -> None:
+        """Stream only these output rows (`final` keeps them all)."""
+        rows = list(rows)
+        obs = self._obs[:, :, rows]
+        self.p = len(rows)
+        self._obs_mat = np.ascontiguousarray(obs.transpose(0, 2, 1, 3)).reshape(
+            self.m, self.p * self.L, self.n
+        )
+        if self._forced:
+            G = self._G[..., rows, :]
+            self._G_mat = np.ascontiguousarray(G.transpose(0, 3, 1, 2, 4)).reshape(
+                self.m, self.p * self.L, -1
+            )
+
+    def sum_squares(self) -> np.ndarray:
+        r"""``Σ_k y_k²`` over every sample, per output, of the free response,
+        without the samples: the block Gram matrices of the step map.
+
+        .. math:: \\sum_{k<N} y_{k,r}^2 = \\sum_b c_b^T G_r c_b + y_{N-1,r}^2,
+                  \\quad G_r = \\sum_{j<L} (c_r Φ^j)^T (c_r Φ^j)
+
+        (the last, partial block with its own ``G_r``): the same finite sum,
+        grouped by block, so exact to rounding, at ``O(n²)`` per block instead
+        of ``O(L n)``. Only without input (``U = None``).
+        """
+        if self._forced:
+            raise ValueError("sum_squares is the free response's: this stream has an input")
+        L, nb, N = self.L, self.nb, self.N
+        obs = self._obs  # (m, L, p, n): C Φ^j
+        gram = np.einsum("mjra,mjrb->mrab", obs, obs)  # (m, p, n, n)
+        full = self._V[:, :, : nb - 1]
+        K = full @ np.swapaxes(full, -1, -2)  # Σ_b c_b c_bᵀ over the whole blocks
+        total = np.einsum("mrab,mab->mr", gram, K)
+        J = (N - 1) - (nb - 1) * L  # samples of the last block before sample N - 1
+        part = np.einsum("mjra,mjrb->mrab", obs[:, :J], obs[:, :J])
+        c = self._V[:, :, nb - 1]
+        total += np.einsum("mrab,ma,mb->mr", part, c, c)
+        final = self.final.reshape(self.m, -1)
+        total += final * final
+        return total.reshape(self.batch + (final.shape[-1],))
+
     def __iter__(self):
         p, L, N = self.p, self.L, self.N
         for b0 in range(0, self.nb, self.step):

@@ -373,6 +373,7 @@ class MetricStream:
         #: the output labels read, the weighted acceleration left out
         self.labels = tuple(sorted(str(x) for x in labels - {WEIGHTED_ACC}))
         self._acc: dict = {}
+        self._given: set = set()
 
     @staticmethod
     def supports(items, roles: SignalRoles) -> bool:
@@ -388,9 +389,24 @@ class MetricStream:
             return False
         return True
 
-    def start(self, final: Mapping[str, np.ndarray]) -> None:
+    def only_mean_square(self, label: str) -> bool:
+        """Whether the metrics read ``label`` only through its mean square."""
+        kinds = {
+            kind
+            for kind, key in self.needs
+            if (self.roles.corners[key].tire_defl if isinstance(key, int) else key) == label
+        }
+        return kinds == {"sumsq"}
+
+    def start(self, final: Mapping[str, np.ndarray], sums=None) -> None:
+        """Begin: each signal's last sample; optionally ``{label: (Σ v², v_0)}``
+        known in closed form (then its samples are not needed)."""
         self._final = final
         self._acc = {}
+        self._given = set(sums or ())
+        for label, (total, first) in (sums or {}).items():
+            self._acc[("sumsq", label)] = total
+            self._acc[("first", label)] = first
 
     def update(self, index: np.ndarray, values: Mapping[str, np.ndarray]) -> None:
         """Fold in one piece: ``values[label]`` of shape ``(m,) + index.shape``
@@ -401,6 +417,8 @@ class MetricStream:
         first = np.flatnonzero(flat == 0)
         for kind, key in self.needs:
             label = self.roles.corners[key].tire_defl if isinstance(key, int) else str(key)
+            if kind == "sumsq" and label in self._given:
+                continue
             v = values[label]
             if kind == "settle":
                 self._settle(label, v, index)

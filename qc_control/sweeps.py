@@ -241,14 +241,26 @@ def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps
         g1 = np.pad(g1, ((0, 0), (0, nw), (0, 0)))
         read.append(WEIGHTED_ACC)
     with np.errstate(over="ignore", invalid="ignore"):
+        sums = None
         if U is None:  # longer blocks: no input Toeplitz to pay for, fewer scan rounds
             out = OutputStream(phi, x0, T.size, C, block=64)
+            # a signal read only through its mean square needs no samples: its
+            # sum of squares is the block Gram form (OutputStream.sum_squares)
+            gram = [i for i, label in enumerate(read) if stream.only_mean_square(label)]
+            if gram:
+                total = out.sum_squares()
+                first = np.einsum("mra,ma->mr", C, x0)  # y_0 = C x0
+                sums = {read[i]: (total[:, i], first[:, i]) for i in gram}
         else:
             out = OutputStream(phi, x0, T.size, C, D=D, g0=g0, g1=g1, U=U, block=16)
         final = {label: out.final[:, i] for i, label in enumerate(read)}
-        stream.start(final)
+        stream.start(final, sums)
+        rows = [i for i, label in enumerate(read) if sums is None or label not in sums]
+        if len(rows) < len(read):
+            out.keep_rows(rows)
+        streamed = [read[i] for i in rows]
         for index, y in out:
-            stream.update(index, {label: y[:, i] for i, label in enumerate(read)})
+            stream.update(index, {label: y[:, i] for i, label in enumerate(streamed)})
         stream.update(np.array([T.size - 1]), {k: v[:, None] for k, v in final.items()})
         result = {"stable": step_is_stable(method, H / substeps, np.linalg.eigvals(A))}
         for column, values in stream.result().items():

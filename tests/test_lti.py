@@ -177,3 +177,5 @@ def test_output_stream_equals_the_recurrence(N, block):
         seen[-1] += 1
         assert (seen == 1).all()
         np.testing.assert_allclose(got, ref, rtol=0, atol=1e-13 * np.abs(ref).max())
+        if not forced:  # the block Gram sum of squares: the same sum, regrouped
+            np.testing.assert_allclose(stream.sum_squares(), (ref**2).sum(-1), rtol=1e-12)
