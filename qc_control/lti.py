@@ -277,6 +277,10 @@ class OutputStream:
         bound, ``designs × p × segment`` doubles. By default about 2¹⁷
         doubles (1 MB) per segment, which stay in cache while the consumer
         reduces them.
+    run : int, optional
+        Segments per run of carries (by default about 2 MB of carries): the
+        carries are computed a run at a time, twice (once to find the last
+        sample, once while streaming), so memory does not grow with ``N``.
 
     Notes
     -----
@@ -311,6 +315,7 @@ class OutputStream:
         U=None,
         block: int = 32,
         segment: int | None = None,
+        run: int | None = None,
     ):
         phi = np.asarray(phi, dtype=float)
         self.batch = phi.shape[:-2]
@@ -329,34 +334,32 @@ class OutputStream:
         if segment is None:
             segment = (1 << 17) // max(1, m * p)
         self.step = max(1, segment // L)
+        # the carries go by longer runs of blocks (about 2 MB of them), each
+        # holding whole output segments
+        if run is None:
+            run = max(1, (1 << 18) // max(1, m * n * self.step))
+        self.run = self.step * run
         P = _powers(phi, L)  # (m, L+1, n, n)
         obs = C[:, None] @ P[:, :L]  # C Φ^j: (m, L, p, n)
         self._obs = obs
         # the carries' product: (m, p L, n) @ V (m, n, S) -> (m, p, L, S)
         self._obs_mat = np.ascontiguousarray(obs.transpose(0, 2, 1, 3)).reshape(m, p * L, n)
-        # the carries, time last: V[:, :, b] = c_b (the products below are then
-        # (n x n) @ (n x blocks) per design, which BLAS does well)
-        V = np.zeros((m, n, nb + 1))
-        V[:, :, 0] = x0
         self._forced = U is not None
+        self._k = 0
         if self._forced:
             U = np.asarray(U, dtype=float)
-            k = U.shape[0]
+            k = self._k = U.shape[0]
             g0 = np.asarray(g0, dtype=float).reshape(m, n, k)
             g1 = np.asarray(g1, dtype=float).reshape(m, n, k)
             D = np.broadcast_to(np.asarray(D, dtype=float), self.batch + (p, k)).reshape(m, p, k)
-            padded = np.zeros((nb * L + 1, k))
-            padded[:N] = U.T
-            windows = np.arange(nb)[:, None] * L + np.arange(L + 1)  # u_{bL+r}
-            self._windows = padded[windows].reshape(nb, (L + 1) * k)
-            self._windows_T = np.ascontiguousarray(self._windows.T)
+            self._padded = np.zeros((k, nb * L + 1))
+            self._padded[:, :N] = U
             PG0 = P[:, :L] @ g0[:, None]  # Φ^i Γ₀, i < L: (m, L, n, k)
             PG1 = P[:, :L] @ g1[:, None]
             E = np.zeros((m, L + 1, n, k))  # E_r = Φ^{L-1-r}Γ₀ [r<L] + Φ^{L-r}Γ₁ [r>=1]
             E[:, :L] += PG0[:, ::-1]
             E[:, 1:] += PG1[:, ::-1]
-            E_mat = np.ascontiguousarray(E.transpose(0, 2, 1, 3)).reshape(m, n, (L + 1) * k)
-            V[:, :, 1:] = np.matmul(E_mat, self._windows_T)
+            self._E_mat = np.ascontiguousarray(E.transpose(0, 2, 1, 3)).reshape(m, n, (L + 1) * k)
             CPG0, CPG1 = C[:, None] @ PG0, C[:, None] @ PG1  # (m, L, p, k)
             j, r = np.meshgrid(np.arange(L), np.arange(L + 1), indexing="ij")
             G = np.zeros((m, L, L + 1, p, k))
@@ -369,25 +372,68 @@ class OutputStream:
             self._G_mat = np.ascontiguousarray(G.transpose(0, 3, 1, 2, 4)).reshape(
                 m, p * L, (L + 1) * k
             )
-        # V_b <- Σ_{i<=b} Q^{b-i} V_i with Q = Φ^L (Hillis–Steele, log2 rounds)
-        Q, d = P[:, L], 1
-        while d < nb + 1:
-            V[:, :, d:] += Q @ V[:, :, :-d]
-            Q = Q @ Q
-            d *= 2
-        self._V = V
+        self._Q = P[:, L]
+        # first pass: the carries segment by segment, keeping only where each
+        # segment starts (memory: designs × n × segments, not × blocks)
+        starts = np.empty((m, n, -(-nb // self.run) + 1))
+        c = np.asarray(x0, dtype=float).copy()
+        self._gram_K = np.zeros((m, n, n))  # Σ c_b c_bᵀ over the whole blocks b < nb - 1
+        b_last, jl = divmod(N - 1, L)
+        carry_last = None
+        for i, b0 in enumerate(range(0, nb, self.run)):
+            starts[:, :, i] = c
+            V = self._carries(c, b0, min(b0 + self.run, nb))
+            upto = min(V.shape[-1] - 1, nb - 1 - b0)
+            if upto > 0:
+                self._gram_K += V[:, :, :upto] @ np.swapaxes(V[:, :, :upto], -1, -2)
+            if b0 <= b_last <= b0 + V.shape[-1] - 1:
+                carry_last = V[:, :, b_last - b0].copy()
+            if b0 <= nb - 1 <= b0 + V.shape[-1] - 1:
+                self._c_partial = V[:, :, nb - 1 - b0].copy()
+            c = V[:, :, -1].copy()
+        self._starts = starts
         # the last sample, from its block's carry: y_{N-1} = CΦ^j c_b + Σ_r G_{j,r} u_{bL+r}
-        b, jl = divmod(N - 1, L)
+        assert carry_last is not None
         if jl == 0:
-            last = (C @ V[:, :, b, None])[..., 0]
+            last = (C @ carry_last[..., None])[..., 0]
             if self._forced:
                 last = last + D @ U[:, -1]
         else:
-            last = (obs[:, jl] @ V[:, :, b, None])[..., 0]
+            last = (obs[:, jl] @ carry_last[..., None])[..., 0]
             if self._forced:
-                u = self._windows[b].reshape(L + 1, k)
+                u = self._window(b_last, b_last + 1)[:, 0].reshape(L + 1, self._k)
                 last = last + np.einsum("mrpk,rk->mp", self._G[:, jl], u)
         self.final = last.reshape(self.batch + (p,))
+
+    def _window(self, b0: int, b1: int) -> np.ndarray:
+        """``((L+1)k, b1 - b0)``: column b holds ``u_{bL} .. u_{bL+L}`` (input by input)."""
+        L, k = self.L, self._k
+        part = self._padded[:, b0 * L : b1 * L + 1]
+        view = np.lib.stride_tricks.as_strided(
+            part,
+            shape=(L + 1, k, b1 - b0),
+            strides=(part.strides[1], part.strides[0], L * part.strides[1]),
+            writeable=False,
+        )
+        return view.reshape((L + 1) * k, b1 - b0)
+
+    def _carries(self, c: np.ndarray, b0: int, b1: int) -> np.ndarray:
+        """``(m, n, b1 - b0 + 1)``: the carries ``c_{b0} .. c_{b1}`` from ``c = c_{b0}``.
+
+        ``V_0 = c``, ``V_{i+1}`` = the input's effect over block ``b0 + i``,
+        then ``V_i <- Σ_{j<=i} Q^{i-j} V_j`` with ``Q = Φ^L`` (Hillis–Steele,
+        log2 rounds). The same arithmetic on both passes, so the same bits.
+        """
+        V = np.zeros((self.m, self.n, b1 - b0 + 1))
+        V[:, :, 0] = c
+        if self._forced:
+            V[:, :, 1:] = np.matmul(self._E_mat, self._window(b0, b1))
+        Q, d = self._Q, 1
+        while d < V.shape[-1]:
+            V[:, :, d:] += Q @ V[:, :, :-d]
+            Q = Q @ Q
+            d *= 2
+        return V
 
     def keep_rows(self, rows) -> None:
         """Stream only these output rows (`final` keeps them all)."""
@@ -419,12 +465,10 @@ class OutputStream:
         L, nb, N = self.L, self.nb, self.N
         obs = self._obs  # (m, L, p, n): C Φ^j
         gram = np.einsum("mjra,mjrb->mrab", obs, obs)  # (m, p, n, n)
-        full = self._V[:, :, : nb - 1]
-        K = full @ np.swapaxes(full, -1, -2)  # Σ_b c_b c_bᵀ over the whole blocks
-        total = np.einsum("mrab,mab->mr", gram, K)
+        total = np.einsum("mrab,mab->mr", gram, self._gram_K)
         J = (N - 1) - (nb - 1) * L  # samples of the last block before sample N - 1
         part = np.einsum("mjra,mjrb->mrab", obs[:, :J], obs[:, :J])
-        c = self._V[:, :, nb - 1]
+        c = self._c_partial
         total += np.einsum("mrab,ma,mb->mr", part, c, c)
         final = self.final.reshape(self.m, -1)
         total += final * final
@@ -432,18 +476,21 @@ class OutputStream:
 
     def __iter__(self):
         p, L, N = self.p, self.L, self.N
-        for b0 in range(0, self.nb, self.step):
-            b1 = min(b0 + self.step, self.nb)
-            S = b1 - b0
-            out = np.matmul(self._obs_mat, self._V[:, :, b0:b1])  # (m, p L, S)
-            if self._forced:
-                out += np.matmul(self._G_mat, self._windows_T[:, b0:b1])
-            index = np.arange(b0, b1)[None, :] * L + np.arange(L)[:, None]  # (L, S)
-            y = out.reshape(self.batch + (p, L, S))
-            if b1 * L > N - 1:  # the last segment: drop the padding past sample N - 2
-                keep = index < N - 1
-                index, y = index[keep], y[..., keep]
-            yield index, y
+        for i, r0 in enumerate(range(0, self.nb, self.run)):
+            r1 = min(r0 + self.run, self.nb)
+            V = self._carries(self._starts[:, :, i], r0, r1)
+            for b0 in range(r0, r1, self.step):
+                b1 = min(b0 + self.step, r1)
+                S = b1 - b0
+                out = np.matmul(self._obs_mat, V[:, :, b0 - r0 : b1 - r0])  # (m, p L, S)
+                if self._forced:
+                    out += np.matmul(self._G_mat, self._window(b0, b1))
+                index = np.arange(b0, b1)[None, :] * L + np.arange(L)[:, None]  # (L, S)
+                y = out.reshape(self.batch + (p, L, S))
+                if b1 * L > N - 1:  # the last segment: drop the padding past sample N - 2
+                    keep = index < N - 1
+                    index, y = index[keep], y[..., keep]
+                yield index, y
 
 
 def lti_trajectory(

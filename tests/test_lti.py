@@ -150,7 +150,8 @@ def test_output_stream_equals_the_recurrence(N, block):
     """OutputStream, segment by segment, against the plain recurrence
     x_{k+1} = Φ x_k + Γ₀ u_k + Γ₁ u_{k+1}, y = C x + D u stepped in Python:
     every sample once, equal to rounding (1e-13 of the largest output), for
-    lengths that do and do not fill the last block, and the free response."""
+    lengths that do and do not fill the last block, with the carries in runs
+    of two segments, and the free response."""
     from qc_control.lti import OutputStream
 
     rng = np.random.default_rng(N + block)
@@ -168,7 +169,7 @@ def test_output_stream_equals_the_recurrence(N, block):
                 if forced:
                     x += g0 @ U[:, i] + g1 @ U[:, i + 1]
         args = (D, g0, g1, U) if forced else ()
-        stream = OutputStream(phi, x0, N, C, *args, block=block, segment=3 * block)
+        stream = OutputStream(phi, x0, N, C, *args, block=block, segment=3 * block, run=2)
         got, seen = np.full((m, p, N), np.nan), np.zeros(N, int)
         for index, y in stream:
             got[..., index] = y
