@@ -19,6 +19,7 @@ import platform
 import statistics
 import sys
 import time
+import tracemalloc
 from pathlib import Path
 
 import control
@@ -57,6 +58,240 @@ def paired_medians(fn_a, fn_b, repeats: int) -> tuple[float, float, float]:
             times[side].append(time.process_time() - start)
     ratios = [b / a for a, b in zip(*times)]
     return statistics.median(times[0]), statistics.median(times[1]), statistics.median(ratios)
+
+
+def timed_runs(fn, repeats: int) -> list[float]:
+    """Wall times [s] of ``repeats`` calls after one untimed warm-up."""
+    fn()
+    out = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - start)
+    return out
+
+
+def med_spread(times: list[float], scale: float = 1.0) -> str:
+    """``median (min–max)`` of ``times · scale``, three significant figures."""
+    xs = sorted(t * scale for t in times)
+    return f"{g(statistics.median(xs))} ({g(xs[0])}–{g(xs[-1])})"
+
+
+def peak_memory(fn) -> float:
+    """Peak memory [MB] that ``fn`` allocates above what is live when it starts
+    (tracemalloc: numpy's buffers included), from one run."""
+    tracemalloc.start()
+    tracemalloc.reset_peak()
+    base = tracemalloc.get_traced_memory()[0]
+    try:
+        fn()
+        return (tracemalloc.get_traced_memory()[1] - base) / 1e6
+    finally:
+        tracemalloc.stop()
+
+
+def slope(xs, ys) -> float:
+    """Least-squares slope of log y against log x."""
+    return float(np.polyfit(np.log(xs), np.log(ys), 1)[0])
+
+
+def sweep_comparison(T, quick: bool):
+    """Free and road-step sweeps of the ks × ζ grid against loops of control calls.
+
+    Medians of at least 5 runs on each side, side by side (alternating). The
+    loop's time per design does not depend on the design, so each run times
+    every 10th design and scales by 10 (stated in the table).
+    """
+    n_ks, n_zeta = (4, 5) if quick else (40, 25)
+    grid = {"ks": np.linspace(15e3, 45e3, n_ks), "zeta": np.linspace(0.1, 0.6, n_zeta)}
+    designs = design_grid(grid)
+    every = 1 if quick else 10
+    subset = designs[::every]
+    U = np.where(T >= 0.5, 0.05, 0.0)
+    free_sys = [qc.quarter_car(qc.QuarterCarParams(**d)) for d in subset]
+    road_sys = [qc.quarter_car(qc.QuarterCarParams(**d), road=True) for d in subset]
+    X0r = np.zeros(4)
+    cases = {
+        "free (released from 5 cm)": (
+            lambda: sweep(grid, T, X0, progress=False),
+            lambda: [control.initial_response(s, T, X0) for s in free_sys],
+            "≥ 300",
+        ),
+        "5 cm road step": (
+            lambda: sweep(grid, T, X0r, U=U, progress=False),
+            lambda: [control.forced_response(s, T, U, X0r) for s in road_sys],
+            "≥ 100",
+        ),
+    }
+    runs = 5
+    rows = []
+    for name, (ours, theirs, target) in cases.items():
+        ours()
+        theirs()
+        t_ours, t_loop, ratios = [], [], []
+        for r in range(runs):  # alternating, so that load drifts hit both sides
+            pair = [(ours, t_ours, 1), (theirs, t_loop, every)]
+            for fn, out, scale in pair if r % 2 == 0 else pair[::-1]:
+                start = time.perf_counter()
+                fn()
+                out.append((time.perf_counter() - start) * scale)
+            ratios.append(t_loop[-1] / t_ours[-1])
+        rows.append(
+            [
+                name,
+                str(len(designs)),
+                med_spread(t_ours),
+                med_spread(t_loop),
+                med_spread(ratios),
+                target,
+            ]
+        )
+    head = [
+        "workload",
+        "designs",
+        "qc.sweep [s]",
+        f"loop of control calls [s] (1 in {every} designs timed, × {every})",
+        "ratio",
+        "target",
+    ]
+    return head, rows, len(designs)
+
+
+def memory_and_spectral(T, quick: bool):
+    """Peak memory of 10,000-design sweeps, and the spectral sweep's time."""
+    n = 10 if quick else 100
+    grid = {"ks": np.linspace(15e3, 45e3, n), "zeta": np.linspace(0.1, 0.6, n)}
+    U = np.where(T >= 0.5, 0.05, 0.0)
+    rows = []
+    for name, fn in (
+        ("free", lambda: sweep(grid, T, X0, progress=False)),
+        ("5 cm road step", lambda: sweep(grid, T, np.zeros(4), U=U, progress=False)),
+    ):
+        times = timed_runs(fn, 1 if not quick else 1)
+        rows.append([name, str(n * n), str(T.size), med_spread(times), g(peak_memory(fn))])
+    road = qc.ISO8608Road("C", speed=20.0)
+    spectral = lambda: sweep(grid, road=road)  # noqa: E731
+    times = timed_runs(spectral, 5)
+    rows.append(
+        [
+            "spectral, ISO 8608 C at 20 m/s (exact)",
+            str(n * n),
+            "–",
+            med_spread(times),
+            g(peak_memory(spectral)),
+        ]
+    )
+    # the spectral sweep against one design at a time
+    result = sweep(grid, road=road).metrics
+    worst = 0.0
+    for i in range(0, n * n, max(1, n * n // 25)):
+        d = {k: result.loc[i, k] for k in ("ms", "mu", "ks", "ku", "cs")}
+        single = qc.ride_metrics_spectral(d, "C", 20.0, exact=True)
+        for col in ("rms_body_acc [m/s²]", "rms_susp_travel [m]", "rms_tire_load / static [-]"):
+            worst = max(worst, abs(result.loc[i, col] / single[col] - 1))
+    head = ["sweep", "designs", "samples", "time [s], median (min–max)", "peak memory [MB]"]
+    return head, rows, worst
+
+
+def scaling(quick: bool, out_dir: Path):
+    """Time and peak memory against designs and samples (road step, RK4),
+    with log-log plots and fitted slopes."""
+    designs_axis = [10, 100] if quick else [100, 1000, 10_000, 100_000]
+    samples_axis = [101, 1001] if quick else [1001, 10_001, 100_001, 1_000_001]
+    base_samples, base_designs = (101, 10) if quick else (1001, 100)
+
+    def run(m, N):
+        T = np.linspace(0.0, (N - 1) * 1e-3, N)
+        U = np.where(T >= 0.05 * T[-1], 0.05, 0.0)
+        ks = np.linspace(15e3, 45e3, m)
+        fn = lambda: sweep({"ks": ks}, T, np.zeros(4), U=U, progress=False)  # noqa: E731
+        times = timed_runs(fn, 3 if m * N <= 10**7 else 1)
+        return statistics.median(times), peak_memory(fn)
+
+    by_designs = [run(m, base_samples) for m in designs_axis]
+    by_samples = [run(base_designs, N) for N in samples_axis]
+    rows = []
+    for label, axis, data in (
+        (f"designs (at {base_samples} samples)", designs_axis, by_designs),
+        (f"samples (at {base_designs} designs)", samples_axis, by_samples),
+    ):
+        t = [d[0] for d in data]
+        mem = [d[1] for d in data]
+        rows.append(
+            [
+                label,
+                ", ".join(str(a) for a in axis),
+                ", ".join(g(x) for x in t),
+                g(slope(axis, t), 2),
+                ", ".join(g(x) for x in mem),
+                g(slope(axis, mem), 2),
+            ]
+        )
+    if not quick:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(9, 3.8), layout="constrained")
+        for ax, axis, data, what in zip(
+            fig.subplots(1, 2),
+            (designs_axis, samples_axis),
+            (by_designs, by_samples),
+            ("designs", "samples"),
+        ):
+            ax.loglog(axis, [d[0] for d in data], "o-", label="time [s]")
+            ax.loglog(axis, [d[1] for d in data], "s--", label="peak memory [MB]")
+            ax.set(xlabel=what, title=f"road-step sweep against {what}")
+            ax.grid(alpha=0.3, which="both")
+            ax.legend()
+        fig.savefig(out_dir / "scaling.png", dpi=110)
+    head = ["against", "values", "time [s]", "time slope", "peak memory [MB]", "memory slope"]
+    return head, rows
+
+
+def dask_comparison(quick: bool):
+    """A 100,000-design road-step sweep on a two-worker Dask LocalCluster
+    against one process: speed-up and overhead per chunk."""
+    if quick:  # starting a cluster takes seconds: not in the smoke run
+        return None
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        return None
+    m = 2_000 if quick else 100_000
+    chunk = 500 if quick else 5_000
+    T = np.linspace(0.0, 1.0, 1001)
+    U = np.where(T >= 0.1, 0.05, 0.0)
+    grid = {"ks": np.linspace(15e3, 45e3, m // 100), "zeta": np.linspace(0.1, 0.6, 100)}
+    one = timed_runs(lambda: sweep(grid, T, np.zeros(4), U=U, chunk_size=chunk, progress=False), 1)
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+        pool = client.get_executor()
+        two = timed_runs(
+            lambda: sweep(
+                grid, T, np.zeros(4), U=U, chunk_size=chunk, executor=pool, progress=False
+            ),
+            1 if not quick else 1,
+        )
+    chunks = -(-m // chunk)
+    t1, t2 = statistics.median(one), statistics.median(two)
+    overhead = (2 * t2 - t1) / chunks  # worker time beyond the single process's, per chunk
+    head = [
+        "designs",
+        "chunk",
+        "chunks",
+        "one process [s]",
+        "LocalCluster, 2 workers [s]",
+        "speed-up",
+        "overhead per chunk [ms]",
+    ]
+    rows = [[str(m), str(chunk), str(chunks), g(t1), g(t2), g(t1 / t2), g(overhead * 1e3)]]
+    return head, rows
 
 
 # -- hand-written loops: what a student writes, the yardstick for the generic stepper
@@ -347,33 +582,85 @@ def main(argv=None) -> int:
     ]
     say("\n" + table(head, rows))
 
-    # -- 4. sweep against a loop of control calls
-    n_ks, n_zeta = (4, 5) if quick else (40, 25)
-    grid = {"ks": np.linspace(15e3, 45e3, n_ks), "zeta": np.linspace(0.1, 0.6, n_zeta)}
-    designs = design_grid(grid)
-    systems = [qc.quarter_car(qc.QuarterCarParams(**d)) for d in designs]  # built outside timing
-    sweep(grid, T, X0, progress=False)  # warm-up
-    t_sweep = best_of(lambda: sweep(grid, T, X0, progress=False), max(1, repeats // 2))
-    t_loop = best_of(lambda: [control.initial_response(s, T, X0) for s in systems], 1)
-    head = [
-        "designs",
-        "qc.sweep (RK4, metrics) [s]",
-        "loop of control.initial_response [s]",
-        "ratio (target ≥ 100)",
-    ]
-    rows = [[str(len(designs)), g(t_sweep), g(t_loop), g(t_loop / t_sweep)]]
+    # -- 4. sweeps against loops of control calls, memory, spectral, scaling, Dask
+    head, rows, n_designs = sweep_comparison(T, quick)
     md += [
-        "### Design sweep",
+        "### Design sweeps",
         "",
-        "The control loop times only the `initial_response` calls "
-        "(systems built beforehand); the sweep's time includes validating the designs and "
-        f"computing its {len(DEFAULT_METRICS)} default metrics per design "
-        f"({', '.join(DEFAULT_METRICS)}).",
+        f"{n_designs} designs (ks × ζ grid), RK4 at h = {h * 1e3:g} ms, {n_samples} samples; "
+        f"the sweep computes its {len(DEFAULT_METRICS)} default metrics per design "
+        f"({', '.join(DEFAULT_METRICS)}), streamed; the loop only calls control (systems "
+        "built beforehand). Medians of 5 runs on each side, alternating, with (min–max); "
+        "the ratio is the median of the runs' ratios.",
+        "",
+        table(head, rows),
+        "",
+        "What bounds the forced sweep: per sample and design, the road's effect inside a "
+        "block is one product of (L+1) input samples with the design's p·L coefficients "
+        "(2(L+1)p flops, L = 16, p = 4 outputs read) and the carries' part is 2np flops; "
+        "both run as small per-design BLAS products, and the streamed reductions (sums of "
+        "squares, peaks, the settling time's excursions, lift-off counts) read every "
+        "sample once. The free sweep has no input product: its time is the carries' "
+        "product and the reductions, i.e. memory traffic over designs × samples × outputs.",
+        "",
+    ]
+    say("\n" + table(head, rows))
+
+    head, rows, worst = memory_and_spectral(T, quick)
+    md += [
+        "### 10,000 designs: peak memory, and the spectral sweep",
+        "",
+        "Peak memory by tracemalloc (numpy's buffers included) above what was live before "
+        "the call; times of one run for the simulated sweeps and median (min–max) of 5 for "
+        "the spectral one (`qc.sweep(grid, road=qc.ISO8608Road('C', speed=20))`: batched "
+        "Lyapunov equations, exact over the unbounded band). Targets: ≤ 500 MB, spectral "
+        f"≤ 1 s. Spectral sweep against one design at a time: largest relative difference "
+        f"{g(worst, 2)} (target ≤ 1e-9).",
         "",
         table(head, rows),
         "",
     ]
     say("\n" + table(head, rows))
+
+    head, rows = scaling(quick, Path(__file__).parent)
+    md += [
+        "### Scaling",
+        "",
+        "Road-step sweeps (RK4, h = 1 ms, default metrics): time (median of 3 runs, 1 for "
+        "the largest) and peak memory against the number of designs and of samples; the "
+        "slope is that of the least-squares line in log-log "
+        + ("(plot: `benchmarks/scaling.png`)." if not quick else "(quick mode: no plot)."),
+        "",
+        table(head, rows),
+        "",
+        "Time is linear in both (slope near 1) once the fixed costs (validating designs, "
+        "building each chunk's powers) are amortised; memory is flat in the samples "
+        "(streamed segments, plus the block carries: designs × 4 × samples/16 doubles per "
+        "chunk) and grows with the designs only through the result table and the design "
+        "objects.",
+        "",
+    ]
+    say("\n" + table(head, rows))
+    if not quick:
+        md += ["![scaling](scaling.png)", ""]
+
+    dask_rows = dask_comparison(quick)
+    if dask_rows is not None:
+        head, rows = dask_rows
+        md += [
+            "### Distributed: Dask LocalCluster",
+            "",
+            "A road-step sweep (1001 samples) on a two-worker `LocalCluster` (one thread "
+            "each) against one process, chunks of `chunk_size` designs sent with "
+            "`client.get_executor()`; the overhead per chunk is the workers' total time "
+            "beyond the single process's, per chunk (pickling the chunk's matrices and the "
+            "result, scheduling). On a 2-core machine shared with other work the speed-up "
+            "is bounded by the cores actually free.",
+            "",
+            table(head, rows),
+            "",
+        ]
+        say("\n" + table(head, rows))
 
     md += [
         "## What failed",
@@ -383,9 +670,10 @@ def main(argv=None) -> int:
         "",
         "## Conclusion",
         "",
-        "Ratios above are this run's; the issue's targets are ≥ 30× control for the LTI "
-        "engine, ≤ 1.2× a hand loop for the generic stepper, ≥ 100× a control loop for "
-        "the sweep.",
+        "Ratios above are this run's; the targets are ≥ 60× control for single "
+        "responses (issue 15), ≤ 1.2× a hand loop for the generic stepper, ≥ 300× "
+        "(free) and ≥ 100× (road step) a loop of control calls for the sweeps, ≤ 500 MB "
+        "for 10,000 designs and ≤ 1 s for a 10,000-design spectral sweep.",
         "",
         "## Versions and command",
         "",
