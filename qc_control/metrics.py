@@ -10,7 +10,9 @@ A metric about a wheel (``per_corner``) is evaluated at every corner of the
 model, with the corner's name in its column (``"peak_susp_travel front [m]"``
 on a half car, ``"peak_susp_travel [m]"`` on a quarter car).
 
-Add a metric by adding one `Metric` to `METRICS`.
+Add a metric by adding one `Metric` to `METRICS`. Its formula reads the
+signals through reductions (mean square, peak, ...), which `RideSignals`
+computes on whole responses and `MetricStream` as a sweep's blocks go by.
 """
 
 from __future__ import annotations
@@ -189,6 +191,11 @@ class Metric:
     description : str
         One line, with its source where there is one.
     formula : callable ``(RideSignals, corner index) -> ndarray (m,)``
+        Written with the signals' reductions (``s.mean_square(label)``,
+        ``s.peak``, ``s.quartic_integral``, ``s.settling_time``,
+        ``s.lifted_count``), so that a sweep can evaluate the same formula on
+        a `MetricStream`; one that reads ``s.output(label)`` whole works too,
+        and sweeps then materialise their chunks for it.
     per_corner : bool
         Evaluated at every corner (a wheel's metric) or once (the body's).
     """
