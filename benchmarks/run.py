@@ -666,8 +666,9 @@ def main(argv=None) -> int:
             "each) against one process, chunks of `chunk_size` designs sent with "
             "`client.get_executor()`; the overhead per chunk is the workers' total time "
             "beyond the single process's, per chunk (pickling the chunk's matrices and the "
-            "result, scheduling). On a 2-core machine shared with other work the speed-up "
-            "is bounded by the cores actually free.",
+            "result, scheduling), which assumes both workers had a core each. On a 2-core "
+            "machine shared with other work they do not, and the speed-up and overhead "
+            "measure the load as much as Dask.",
             "",
             table(head, rows),
             "",
