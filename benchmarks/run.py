@@ -646,10 +646,11 @@ def main(argv=None) -> int:
         table(head, rows),
         "",
         "Time is linear in both (slope near 1) once the fixed costs (validating designs, "
-        "building each chunk's powers) are amortised; memory is flat in the samples "
-        "(streamed segments, plus the block carries: designs × 4 × samples/16 doubles per "
-        "chunk) and grows with the designs only through the result table and the design "
-        "objects.",
+        "building each chunk's powers) are amortised. Memory grows with the samples only "
+        "through the input itself (T, U and its padded copy: 24 bytes a sample); a chunk "
+        "holds a segment of outputs (~1 MB) and a run of block carries (~2 MB) whatever the "
+        "length. It grows with the designs through what is kept per design: the parameters, "
+        "their matrices and the result table (about 1 kB a design).",
         "",
     ]
     say("\n" + table(head, rows))

@@ -419,9 +419,10 @@ def sweep(
     metric_items = _metric_items(metrics, model.roles)
     streamed = not states and not isinstance(metrics, Mapping)
     rows = min(chunk_size, len(designs)) * (sys_.noutputs + n * states)
-    # streamed: a segment of about 1 MB and the block carries; otherwise a chunk's
-    # outputs (and states) with the scan's temporaries, plus every kept trajectory
-    per_chunk = (2**20 + rows * T.size * 8 // 16) if streamed else 3 * rows * T.size * 8
+    # streamed: a segment of outputs (~1 MB), a run of carries (~2 MB) and the padded
+    # input; otherwise a chunk's outputs (and states) with the scan's temporaries,
+    # plus every kept trajectory
+    per_chunk = (2**22 + 16 * T.size) if streamed else 3 * rows * T.size * 8
     check_memory(
         per_chunk + states * len(designs) * n * T.size * 8,
         f"a sweep of {len(designs)} designs over {T.size} samples"
