@@ -124,7 +124,30 @@ def _take(batch: BatchedModel, idx) -> BatchedModel:
     )
 
 
-def _run_chunk(
+#: Designs vectorised together inside a chunk: a chunk sent to an executor may
+#: be much larger (fewer, bigger tasks), and is computed this many at a time.
+VECTOR_DESIGNS = 64
+
+
+def _run_chunk(batch: BatchedModel, *args):
+    """Simulate one chunk of designs; module level so that executors can pickle it.
+
+    The chunk is computed `VECTOR_DESIGNS` designs at a time (the size at
+    which a segment of streamed outputs stays in cache), whatever its size.
+    """
+    m = batch.A.shape[0]
+    if m <= VECTOR_DESIGNS:
+        return _run_designs(batch, *args)
+    parts = [
+        _run_designs(_take(batch, slice(s, s + VECTOR_DESIGNS)), *args)
+        for s in range(0, m, VECTOR_DESIGNS)
+    ]
+    result = {key: np.concatenate([r[key] for r, _ in parts]) for key in parts[0][0]}
+    states = None if parts[0][1] is None else np.concatenate([x for _, x in parts])
+    return result, states
+
+
+def _run_designs(
     batch: BatchedModel,
     labels: tuple[str, ...],
     roles: SignalRoles,
@@ -136,7 +159,7 @@ def _run_chunk(
     metric_items,
     keep_states: bool,
 ):
-    """Simulate one chunk of designs; module level so that executors can pickle it.
+    """Simulate up to `VECTOR_DESIGNS` designs together.
 
     ``metric_items`` are ``(column, name or callable, corner)``: registered
     metrics travel by name (their formulas live in this module's imports).
@@ -341,11 +364,13 @@ def sweep(
         its ``batch`` (vectorised for the quarter car).
     substeps : int, default 1
     chunk_size : int, default 64
-        Designs per chunk: the unit of vectorisation, of memory and of work
-        sent to the executor. Results do not depend on it. Registered metrics
-        are streamed: a chunk holds about 1 MB of outputs at a time whatever
-        ``len(T)`` (see Notes); custom metrics and ``states=True`` hold a
-        chunk's whole outputs (``chunk_size × 5 × len(T)`` doubles).
+        Designs per chunk: the unit of work sent to the executor (make it
+        large, thousands, for a cluster: fewer tasks). Each chunk is computed
+        `VECTOR_DESIGNS` (64) designs at a time. Results do not depend on it.
+        Registered metrics are streamed: about 3 MB of outputs and carries at
+        a time whatever ``len(T)`` (see Notes); custom metrics and
+        ``states=True`` hold 64 designs' whole outputs (``64 × 5 × len(T)``
+        doubles) at a time.
     progress : bool, optional
         Show a tqdm bar. By default it appears on a terminal when the sweep
         outlasts 1 s, and never when standard error is not a terminal.
@@ -418,7 +443,7 @@ def sweep(
         raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
     metric_items = _metric_items(metrics, model.roles)
     streamed = not states and not isinstance(metrics, Mapping)
-    rows = min(chunk_size, len(designs)) * (sys_.noutputs + n * states)
+    rows = min(chunk_size, len(designs), VECTOR_DESIGNS) * (sys_.noutputs + n * states)
     # streamed: a segment of outputs (~1 MB), a run of carries (~2 MB) and the padded
     # input; otherwise a chunk's outputs (and states) with the scan's temporaries,
     # plus every kept trajectory
