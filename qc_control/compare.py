@@ -371,13 +371,14 @@ def error_table(responses: dict, reference: Reference, model: VehicleModel) -> p
     body = labels.index(model.body_disp)
     rows = {}
     for name, resp in responses.items():
-        with np.errstate(invalid="ignore"):
+        # a diverged run's errors are inf (or overflow to it): that is the answer
+        with np.errstate(invalid="ignore", over="ignore"):
             err = _outputs(resp, ref.shape[1]) - ref
-        row = {}
-        for i, label in enumerate(labels):
-            unit = model.unit(label)
-            row[f"max |{label} err| [{unit}]"] = float(np.max(np.abs(err[i])))
-            row[f"rms {label} err [{unit}]"] = float(np.sqrt(np.mean(err[i] ** 2)))
+            row = {}
+            for i, label in enumerate(labels):
+                unit = model.unit(label)
+                row[f"max |{label} err| [{unit}]"] = float(np.max(np.abs(err[i])))
+                row[f"rms {label} err [{unit}]"] = float(np.sqrt(np.mean(err[i] ** 2)))
         row[f"final |{model.body_disp} err| [{model.unit(model.body_disp)}]"] = float(
             abs(err[body, -1])
         )
