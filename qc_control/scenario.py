@@ -381,6 +381,9 @@ def road_from_mapping(values: Mapping[str, Any]) -> Road:
 # ------------------------------------------------------------- scenario
 
 
+#: The largest |x0| entry: its square (RMS errors, energies) stays far inside float range.
+MAX_STATE = 1e150
+
 #: Vehicle parameter types and their state names (the order of ``x0``).
 _STATES = {QuarterCarParams: STATES}
 _X0_UNITS = {QuarterCarParams: "m/s, m/s, m, m"}
@@ -602,6 +605,15 @@ class Scenario:
             raise ScenarioError(
                 f"x0 must be {len(names)} comma-separated numbers, all finite: "
                 f"{', '.join(names)} [{_X0_UNITS[type(self.vehicle)]}]; got {x0!r}",
+                "scenario",
+                "x0",
+            )
+        big = [v for v in values if abs(v) > MAX_STATE]
+        if big:
+            raise ScenarioError(
+                f"x0 = {big[0]!r} is beyond {MAX_STATE:.0e}: the comparison squares the "
+                "states (RMS errors, energies), and the square of such a value overflows "
+                "double precision; the car is linear, so a smaller x0 scales the response",
                 "scenario",
                 "x0",
             )
