@@ -77,6 +77,16 @@ except PackageNotFoundError:  # pragma: no cover - a source tree that was never 
 if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from . import road
     from .compare import MethodComparison, compare_methods
+    from .controllers import (
+        HinfDesign,
+        add_damper,
+        closed_loop,
+        groundhook,
+        hinf_controller,
+        hybrid,
+        lqr_controller,
+        skyhook,
+    )
     from .integrate import DivergenceWarning, Solution
     from .methods import METHODS, ButcherTableau, get_method
     from .metrics import Metric, RideSignals
@@ -118,6 +128,14 @@ _LAZY: dict[str, str] = {
     "road": "road",
     "MethodComparison": "compare",
     "compare_methods": "compare",
+    "closed_loop": "controllers",
+    "skyhook": "controllers",
+    "groundhook": "controllers",
+    "hybrid": "controllers",
+    "add_damper": "controllers",
+    "lqr_controller": "controllers",
+    "hinf_controller": "controllers",
+    "HinfDesign": "controllers",
     "DivergenceWarning": "integrate",
     "Solution": "integrate",
     "METHODS": "methods",
@@ -234,4 +252,12 @@ __all__ = [
     "ride_metrics_spectral",
     "wk_filter",
     "wk_weighted",
+    "closed_loop",
+    "skyhook",
+    "groundhook",
+    "hybrid",
+    "add_damper",
+    "lqr_controller",
+    "hinf_controller",
+    "HinfDesign",
 ]
