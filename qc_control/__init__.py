@@ -75,7 +75,7 @@ except PackageNotFoundError:  # pragma: no cover - a source tree that was never 
     __version__ = "0+unknown"
 
 if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
-    from . import road
+    from . import road, spectral
     from .compare import MethodComparison, compare_methods
     from .controllers import (
         HinfDesign,
@@ -117,6 +117,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         wk_weighted,
     )
     from .scenario import Scenario, ScenarioError, load_config, read_config
+    from .spectral import iso8608_intensity, lyapunov_variances, white_velocity_variances
     from .stability import max_stable_step, stability_function
     from .sweeps import DEFAULT_METRICS, METRICS, SweepChunk, SweepResult, design_grid, sweep
     from .vehicle import Corner, SignalRoles, VehicleModel
@@ -181,6 +182,10 @@ _LAZY: dict[str, str] = {
     "SweepResult": "sweeps",
     "design_grid": "sweeps",
     "sweep": "sweeps",
+    "spectral": "spectral",
+    "lyapunov_variances": "spectral",
+    "white_velocity_variances": "spectral",
+    "iso8608_intensity": "spectral",
 }
 
 
@@ -252,6 +257,10 @@ __all__ = [
     "ride_metrics_spectral",
     "wk_filter",
     "wk_weighted",
+    "spectral",
+    "lyapunov_variances",
+    "white_velocity_variances",
+    "iso8608_intensity",
     "closed_loop",
     "skyhook",
     "groundhook",
