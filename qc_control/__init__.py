@@ -87,6 +87,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         lqr_controller,
         skyhook,
     )
+    from .damping import DampingOptimum, ParetoFront, optimal_damping, pareto_front
     from .integrate import DivergenceWarning, Solution
     from .methods import METHODS, ButcherTableau, get_method
     from .metrics import Metric, RideSignals
@@ -129,6 +130,10 @@ _LAZY: dict[str, str] = {
     "road": "road",
     "MethodComparison": "compare",
     "compare_methods": "compare",
+    "optimal_damping": "damping",
+    "pareto_front": "damping",
+    "DampingOptimum": "damping",
+    "ParetoFront": "damping",
     "closed_loop": "controllers",
     "skyhook": "controllers",
     "groundhook": "controllers",
@@ -261,6 +266,10 @@ __all__ = [
     "lyapunov_variances",
     "white_velocity_variances",
     "iso8608_intensity",
+    "optimal_damping",
+    "pareto_front",
+    "DampingOptimum",
+    "ParetoFront",
     "closed_loop",
     "skyhook",
     "groundhook",
