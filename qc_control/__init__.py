@@ -77,6 +77,7 @@ except PackageNotFoundError:  # pragma: no cover - a source tree that was never 
 if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from . import road, spectral
     from .compare import MethodComparison, compare_methods
+    from .control_study import ControlComparison, compare_controllers
     from .controllers import (
         HinfDesign,
         add_damper,
@@ -130,6 +131,8 @@ _LAZY: dict[str, str] = {
     "road": "road",
     "MethodComparison": "compare",
     "compare_methods": "compare",
+    "compare_controllers": "control_study",
+    "ControlComparison": "control_study",
     "optimal_damping": "damping",
     "pareto_front": "damping",
     "DampingOptimum": "damping",
@@ -266,6 +269,8 @@ __all__ = [
     "lyapunov_variances",
     "white_velocity_variances",
     "iso8608_intensity",
+    "compare_controllers",
+    "ControlComparison",
     "optimal_damping",
     "pareto_front",
     "DampingOptimum",

@@ -61,6 +61,9 @@ try:  # optional: qc-control[robust], for hinf_controller
 except ImportError:  # pragma: no cover - depends on the installation
     slycot = None
 
+#: Whether `hinf_controller` can run (slycot is installed).
+HINF_AVAILABLE = slycot is not None
+
 __all__ = [
     "skyhook",
     "groundhook",
@@ -70,7 +73,10 @@ __all__ = [
     "hinf_controller",
     "HinfDesign",
     "closed_loop",
+    "relative_coordinates",
+    "lqr_weights",
     "SEMI_ACTIVE_MODES",
+    "HINF_AVAILABLE",
     "MATLAB_ACTIVE_SUSPENSION",
 ]
 
@@ -341,10 +347,50 @@ def lqr_weights(car: VehicleModel, weights: Mapping[str, float] | None = None):
 #: [m²·s] and the accelerometer [(m/s²)²·s].
 ESTIMATOR_NOISE = {"body_acc": 1e-3}
 _DISPLACEMENT_NOISE = 1e-7
+#: Default road-velocity intensity of the Kalman filter [m²/s]: about an ISO
+#: 8608 class C road at 20 m/s (2π²·n0²·Gd(n0)·v = 1.0e-3).
+ROAD_VELOCITY_INTENSITY = 1e-3
 
 
 def _default_rn(measured: Sequence[str]) -> list[float]:
     return [ESTIMATOR_NOISE.get(label, _DISPLACEMENT_NOISE) for label in measured]
+
+
+def relative_coordinates(car: VehicleModel):
+    """The car in the coordinates ``z = [vs, vu, susp_travel, tire_defl]``.
+
+    ``z = T x + t_r zr`` (``tire_defl = xu - zr``). In these coordinates the
+    road enters only through its velocity: ``z' = A_z z + b_z fa + t_r zr'``
+    with ``A_z = T A T⁻¹``, ``b_z = T b`` (the road height's own term
+    vanishes, checked here). Returns ``(labels, T, t_r, A_z, b_z)``.
+    """
+    A, B, j = _actuated(car)
+    sys = car.system
+    corner = car.corners[0]
+    if corner.road is None:
+        raise ValueError(f"car {car.name!r} has no road input; build it with road=True")
+    r = sys.input_labels.index(corner.road)
+    states = list(sys.state_labels)
+    labels = [s for s in _VELOCITIES if s in states] + [corner.susp_travel, corner.tire_defl]
+    rows, t_r = [], []
+    for label in labels:
+        if label in states:
+            rows.append(np.eye(len(states))[states.index(label)])
+            t_r.append(0.0)
+        else:
+            k = car.output(label)
+            rows.append(np.asarray(sys.C, float)[k])
+            t_r.append(float(np.asarray(sys.D, float)[k, r]))
+    T = np.array(rows)
+    if T.shape != A.shape or np.linalg.cond(T) > 1e12:
+        raise ValueError(f"car {car.name!r}: {labels} are not coordinates of its states {states}")
+    Ti = np.linalg.inv(T)
+    Az = T @ A @ Ti
+    tr = np.array(t_r)[:, None]
+    residual = T @ B[:, [r]] - Az @ tr
+    if np.abs(residual).max() > 1e-9 * (np.abs(T @ B[:, [r]]).max() + 1.0):
+        raise ValueError(f"car {car.name!r}: the road height does not drop out of {labels}")
+    return labels, T, tr, Az, T @ B[:, [j]]
 
 
 def lqr_controller(
@@ -354,29 +400,36 @@ def lqr_controller(
     estimator: Mapping[str, Any] | None = None,
     name: str = "lqr",
 ) -> control.StateSpace:
-    """Linear-quadratic regulator on the actuator force, by ``control.lqr``.
+    r"""Linear-quadratic regulator on the actuator force, by ``control.lqr``.
 
     Minimises the cost of `lqr_weights` (a weight per car output, e.g.
     ``body_acc``, ``susp_travel``, ``tire_defl``, and ``'fa'`` on the force)
-    with ``K, S, E = control.lqr(A, B_fa, Q, R, N)``; the law is
-    ``fa = -K x`` (full state; Anderson & Moore, *Optimal Control: Linear
-    Quadratic Methods*, 1990, §2.4 and §3.4 for the cross term).
+    with ``K, S, E = control.lqr(A, B_fa, Q, R, N)`` (Anderson & Moore,
+    *Optimal Control: Linear Quadratic Methods*, 1990, §2.4 and §3.4 for the
+    cross term). The law is full-state feedback written in the coordinates
+    of `relative_coordinates`, ``fa = -K_z [vs, vu, susp_travel,
+    tire_defl]`` with ``K_z = K T⁻¹``: the same law as ``-K x`` on a flat
+    road, but measured against the road, so that the car follows a road
+    that rises instead of holding its body at an absolute height (the
+    classic full-state active suspension, Hrovat, "Survey of advanced
+    suspension developments and related optimal control applications",
+    Automatica 33(10), 1997).
 
     With ``estimator``, the state comes from a Kalman filter
-    (``control.lqe``) on measured outputs: ``{'outputs': ['susp_travel',
-    'body_acc'], 'QN': road-height noise intensity [m²·s] (default 1e-5),
-    'RN': a list of sensor noise intensities}`` (default 1e-7 m²·s on a
-    displacement, 1e-3 (m/s²)²·s on ``body_acc``). The road height is the process noise (it
-    enters through the car's ``zr`` column). The controller is then the
-    observer-based compensator
+    (``control.lqe``) on measured outputs, the road velocity being the
+    process noise: ``{'outputs': ['susp_travel', 'body_acc'], 'QN':
+    road-velocity intensity [m²/s] (default `ROAD_VELOCITY_INTENSITY`),
+    'RN': sensor noise intensities}`` (default 1e-7 m²·s on a displacement,
+    1e-3 (m/s²)²·s on ``body_acc``). The controller is the observer-based
+    compensator in ``z``:
 
-    .. math:: \\dot{\\hat x} = (A - B K - L(C - D K))\\hat x + L y,
-              \\qquad f_a = -K\\hat x
+    .. math:: \dot{\hat z} = (A_z - b_z K_z - L(C_z - D K_z))\hat z + L y,
+              \qquad f_a = -K_z\hat z
 
     Parameters
     ----------
     car : VehicleModel
-        A linear car with the input ``'fa'`` (and ``'zr'`` for the filter).
+        A linear car with the inputs ``'zr'`` and ``'fa'``.
     weights : mapping, optional
         Output label (or ``'fa'``) -> weight >= 0; default
         `DEFAULT_LQR_WEIGHTS`.
@@ -386,49 +439,46 @@ def lqr_controller(
     Returns
     -------
     control.StateSpace
-        Full state: a static gain ``-K`` with the car's state labels as
-        inputs. With an estimator: inputs the measured outputs, states
-        ``xhat_<state>``. Output ``['fa']`` either way.
+        Full state: a static gain ``-K_z`` with inputs ``['vs', 'vu',
+        'susp_travel', 'tire_defl']``. With an estimator: inputs the
+        measured outputs, states ``zhat_<label>``. Output ``['fa']``.
     """
     A, B, j = _actuated(car)
     Q, R, N = lqr_weights(car, weights)
     b = B[:, [j]]
     K, _, _ = control.lqr(A, b, Q, R, N)
-    K = np.asarray(K, dtype=float)
-    states = list(car.system.state_labels)
+    labels, T, tr, Az, bz = relative_coordinates(car)
+    Kz = np.asarray(K, dtype=float) @ np.linalg.inv(T)
     if estimator is None:
         return control.ss(
             np.zeros((0, 0)),
-            np.zeros((0, len(states))),
+            np.zeros((0, len(labels))),
             np.zeros((1, 0)),
-            -K,
-            inputs=states,
+            -Kz,
+            inputs=labels,
             outputs=["fa"],
             name=name,
         )
     est = dict(estimator)
     measured = list(est.pop("outputs", ["susp_travel", "body_acc"]))
-    QN = np.atleast_2d(est.pop("QN", 1e-5))
+    QN = np.atleast_2d(est.pop("QN", ROAD_VELOCITY_INTENSITY))
     RN = np.diag(np.atleast_1d(np.asarray(est.pop("RN", _default_rn(measured)), float)))
     if est:
         raise ValueError(f"unknown estimator option(s) {sorted(est)}; expected outputs, QN, RN")
-    road = [c.road for c in car.corners if c.road is not None]
-    if not road:
-        raise ValueError(f"car {car.name!r} has no road input for the estimator's process noise")
-    G = B[:, [car.system.input_labels.index(r) for r in road]]
     rows = [car.output(label) for label in measured]
-    C = np.asarray(car.system.C, dtype=float)[rows]
+    Ti = np.linalg.inv(T)
+    Cz = np.asarray(car.system.C, dtype=float)[rows] @ Ti
     D = np.asarray(car.system.D, dtype=float)[rows][:, [j]]
-    L, _, _ = control.lqe(A, G, C, QN, RN)
+    L, _, _ = control.lqe(Az, tr, Cz, QN, RN)
     L = np.asarray(L, dtype=float)
-    Ak = A - b @ K - L @ (C - D @ K)
+    Ak = Az - bz @ Kz - L @ (Cz - D @ Kz)
     return control.ss(
         Ak,
         L,
-        -K,
+        -Kz,
         np.zeros((1, len(measured))),
         inputs=measured,
-        states=[f"xhat_{s}" for s in states],
+        states=[f"zhat_{s}" for s in labels],
         outputs=["fa"],
         name=name,
     )
@@ -737,7 +787,7 @@ def closed_loop(car: VehicleModel, controller, *, name: str | None = None) -> Ve
     if isinstance(controller, control.StateSpace):
         # an estimator's states are the car's own quantities; others have no unit
         for s, label in zip(controller.state_labels, ctrl_states):
-            units[label] = car.unit(s[5:]) if s.startswith("xhat_") else "-"
+            units[label] = car.unit(s[5:]) if s.startswith("zhat_") else "-"
     else:
         for s, label in zip(controller.state_labels, ctrl_states):
             units[label] = "m/s" if s == "acc_filter" else "-"

@@ -79,8 +79,10 @@ def test_lqr_gain_solves_the_riccati_equation_and_places_the_poles():
     Q, R, N = Cz.T @ W @ Cz, Dz.T @ W @ Dz + 1e-6, Cz.T @ W @ Dz
     P = scipy.linalg.solve_continuous_are(A, b, Q, R, s=N)
     K = np.linalg.solve(R, b.T @ P + N.T)
-    np.testing.assert_allclose(-np.asarray(ctrl.D), K, rtol=1e-8)
-    assert ctrl.input_labels == ["vs", "vu", "xs", "xu"]
+    # fed back in relative coordinates z = [vs, vu, xs - xu, xu - zr] = T x (flat road)
+    T = np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -1], [0, 0, 0, 1]], dtype=float)
+    np.testing.assert_allclose(-np.asarray(ctrl.D), K @ np.linalg.inv(T), rtol=1e-8)
+    assert ctrl.input_labels == ["vs", "vu", "susp_travel", "tire_defl"]
     cl = qc.closed_loop(CAR, ctrl)
     assert isinstance(cl.system, control.StateSpace)
     want = np.sort_complex(np.linalg.eigvals(A - b @ K))
@@ -89,17 +91,24 @@ def test_lqr_gain_solves_the_riccati_equation_and_places_the_poles():
 
 
 def test_lqr_with_estimator_poles_are_regulator_and_filter_poles():
-    """Separation principle: the closed loop's poles are eig(A-bK) and eig(A-LC)."""
+    """Separation principle: the closed loop's poles are eig(A-bK) and eig(A_z-LC_z).
+
+    The filter runs in z = [vs, vu, travel, tire_defl], driven by the road
+    velocity (intensity 1e-3 m²/s by default); its gain here from scipy's
+    dual Riccati equation.
+    """
     ctrl = C.lqr_controller(CAR, estimator={"outputs": ["susp_travel", "body_acc"]})
     assert ctrl.input_labels == ["susp_travel", "body_acc"] and ctrl.nstates == 4
     A, B = np.asarray(CAR.system.A), np.asarray(CAR.system.B)
-    K = -np.asarray(C.lqr_controller(CAR).D)
-    Cm = np.asarray(CAR.system.C)[[2, 4]]
-    # the filter's gain from the dual Riccati equation (scipy), defaults QN, RN
-    G, QN, RN = B[:, [0]], np.array([[1e-5]]), np.diag([1e-7, 1e-3])
-    S = scipy.linalg.solve_continuous_are(A.T, Cm.T, G @ QN @ G.T, RN)
-    L = S @ Cm.T @ np.linalg.inv(RN)
-    want = np.concatenate([np.linalg.eigvals(A - B[:, [1]] @ K), np.linalg.eigvals(A - L @ Cm)])
+    T = np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -1], [0, 0, 0, 1]], dtype=float)
+    Az = T @ A @ np.linalg.inv(T)
+    G = np.array([[0.0], [0.0], [0.0], [-1.0]])  # tire_defl' = vu - zr'
+    Cz = np.asarray(CAR.system.C)[[2, 4]] @ np.linalg.inv(T)
+    QN, RN = np.array([[1e-3]]), np.diag([1e-7, 1e-3])
+    S = scipy.linalg.solve_continuous_are(Az.T, Cz.T, G @ QN @ G.T, RN)
+    L = S @ Cz.T @ np.linalg.inv(RN)
+    K = -np.asarray(C.lqr_controller(CAR).D) @ T  # back in x coordinates
+    want = np.concatenate([np.linalg.eigvals(A - B[:, [1]] @ K), np.linalg.eigvals(Az - L @ Cz)])
     got = qc.closed_loop(CAR, ctrl).system.poles()
     np.testing.assert_allclose(np.sort_complex(got), np.sort_complex(want), rtol=1e-7)
 
