@@ -68,7 +68,9 @@ def control_figures(cmp) -> list[FigureSpec]:
 
 
 def _design_table(cmp) -> pd.DataFrame:
-    return pd.DataFrame({"design": list(cmp.designs), "what": list(cmp.designs.values())})
+    return pd.DataFrame(
+        {"what": list(cmp.designs.values())}, index=pd.Index(list(cmp.designs), name="design")
+    )
 
 
 def control_blocks(cmp, command: str | None = None) -> list:
