@@ -76,6 +76,7 @@ __all__ = [
     "relative_coordinates",
     "lqr_weights",
     "SEMI_ACTIVE_MODES",
+    "semi_active_coefficient",
     "HINF_AVAILABLE",
     "MATLAB_ACTIVE_SUSPENSION",
 ]
@@ -277,7 +278,8 @@ def add_damper(cmin: float, cmax: float, *, sensor_hz: float = 50.0, name: str =
 
     def output(t, x, u, params):
         acc, vrel = wc * (u[0] - x[0]), u[0] - u[1]
-        c = hi if acc * vrel > 0 else lo
+        # on-off toward the force -acc·(anything > 0): cmax when acc·vrel > 0
+        c = semi_active_coefficient(-acc, vrel, lo, hi, "on-off")
         return np.array([-c * vrel])
 
     return control.nlsys(
