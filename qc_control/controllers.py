@@ -20,7 +20,8 @@ law                           ideal force (active), source
                               (Goncalves & Ahmadian 2003)
 `add_damper`                  semi-active only (Savaresi et al. 2005;
                               Savaresi & Spelta 2007)
-`lqr_controller`              ``fa = -K x``, ``control.lqr``
+`lqr_controller`              ``fa = -K_z [vs, vu, travel, tire_defl]``,
+                              ``control.lqr`` (+ ``control.lqe``)
 `hinf_controller`             ``control``'s H∞ plant, slycot ``sb10ad``
 ============================  ===========================================
 
