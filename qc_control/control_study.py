@@ -39,7 +39,7 @@ from .controllers import (
     lqr_controller,
     skyhook,
 )
-from .damping import optimal_damping
+from .damping import ParetoFront, optimal_damping, pareto_front, spectral_ride
 from .integrate import check_time_grid
 from .metrics import mean_square
 from .model import QuarterCarParams, as_params, quarter_car_model
@@ -94,6 +94,13 @@ class ControlComparison:
     method : str
     dt : dict
         The time step [s] of the bump and road runs.
+    exact : pandas.DataFrame
+        Linear design -> its exact stationary RMS metrics on the road's
+        white road velocity (`qc_control.damping.spectral_ride`: Lyapunov,
+        unbounded band), free of the finite run's sampling spread.
+    pareto : ParetoFront or None
+        The passive comfort / road-holding front (cs x ks around the car)
+        with the linear controllers marked.
     notes : list[str]
     """
 
@@ -106,6 +113,8 @@ class ControlComparison:
     road: dict
     method: str
     dt: dict
+    exact: pd.DataFrame = field(default_factory=pd.DataFrame)
+    pareto: ParetoFront | None = None
     notes: list = field(default_factory=list)
 
 
@@ -272,6 +281,25 @@ def compare_controllers(
             j = model.system.input_labels.index("zr")
             H = np.asarray(control.frequency_response(model.system, 2 * np.pi * f).complex)
             trans[name] = {s: np.abs(H[model.output(s), j]) for s in ("body_acc", "tire_defl")}
+    linear = {
+        name: model
+        for name, (model, _) in built.items()
+        if isinstance(model.system, control.StateSpace)
+    }
+    exact = pd.concat(
+        [spectral_ride(m, (road_class, speed)).set_axis([n]) for n, m in linear.items()]
+    )
+    exact.index.name = "design"
+    critical = 2 * math.sqrt(p.ks * p.ms)
+    front = pareto_front(
+        p,
+        {
+            "cs": list(np.geomspace(0.1, 3.0, 40) * critical),
+            "ks": [k * p.ks for k in (0.5, 0.75, 1.0, 1.5, 2.0)],
+        },
+        road=(road_class, speed),
+        controllers={n: m for n, m in linear.items() if not n.startswith("passive")},
+    )
     table = pd.DataFrame.from_dict(rows, orient="index").astype(float)
     table.index.name = "design"
     semi = [n for n, (m, _) in built.items() if not isinstance(m.system, control.StateSpace)]
@@ -296,5 +324,7 @@ def compare_controllers(
         },
         method=method,
         dt={"bump": dt_bump, "road": dt_road},
+        exact=exact,
+        pareto=front,
         notes=notes,
     )

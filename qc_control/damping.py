@@ -479,7 +479,7 @@ def _pareto_figure(frame, front, markers, cols, travel_limit, sigmas) -> Figure:
         title += f" ({sigmas:g}σ travel <= {1e3 * travel_limit:g} mm)"
     ax.set_title(title)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize="small", loc="upper right")
+    ax.legend(fontsize="small", loc="best")
     return fig
 
 

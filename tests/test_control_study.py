@@ -56,11 +56,26 @@ def test_invariant_point_holds_for_every_linear_design(cmp):
         assert mags["body_acc"][1] == pytest.approx(P.ku / P.ms, rel=1e-9), name
 
 
+def test_exact_metrics_and_the_front(cmp):
+    """The passive row of the exact table against the Gobbi & Mastinu closed form (1e-9).
+
+    (The issue quotes 1.25911 m/s² unbounded for the seed car on class C at 20 m/s.)
+    """
+    assert list(cmp.exact.index) == ["passive (seed)", "skyhook", "LQR"]
+    q = 2 * math.pi**2 * 0.1**2 * 256e-6 * 20.0  # ISO 8608 class C (Gd(n0) = 256e-6 m³), 20 m/s
+    var = q * (P.cs**2 * P.ku + P.ks**2 * (P.ms + P.mu)) / (2 * P.cs * P.ms**2)
+    acc = cmp.exact.loc["passive (seed)", "rms_body_acc [m/s²]"]
+    assert acc == pytest.approx(math.sqrt(var), rel=1e-9)
+    assert round(acc, 5) == 1.25911
+    assert {"skyhook", "LQR"} <= set(cmp.pareto.markers.index)
+
+
 def test_report_files_and_axes(cmp, tmp_path):
     out = write_control_report(cmp, tmp_path / "r", formats=("md", "html", "csv"))
     names = {p.name for p in out.iterdir()}
     assert {"report.md", "report.html", "control_table.csv", "transmissibility.csv"} <= names
     assert {"transmissibility_body_acc.png", "transmissibility_tire_defl.png"} <= names
+    assert {"pareto.png", "exact_metrics.csv"} <= names
     md = (out / "report.md").read_text(encoding="utf-8")
     assert "skyhook semi-active" in md and "Figure 2" in md
     ax = transmissibility_chart(cmp, "tire_defl").axes[0]

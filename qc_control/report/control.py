@@ -64,6 +64,17 @@ def control_figures(cmp) -> list[FigureSpec]:
                 functools.partial(transmissibility_chart, cmp, signal),
             )
         )
+    if cmp.pareto is not None:
+        specs.append(
+            FigureSpec(
+                "pareto.png",
+                "Figure 3",
+                "Passive designs (cs × ks around the car) by exact RMS body acceleration and "
+                "tire load on the road's white road velocity, the non-dominated ones coloured by "
+                "RMS travel; the passive optima and the linear controllers marked.",
+                lambda: cmp.pareto.figure,
+            )
+        )
     return specs
 
 
@@ -111,7 +122,21 @@ def control_blocks(cmp, command: str | None = None) -> list:
         ),
         Heading("Transmissibility"),
     ]
-    for spec in control_figures(cmp):
+    specs = control_figures(cmp)
+    for spec in specs[:2]:
+        blocks.append(Image(spec.name, spec.caption, spec.label))
+    if not cmp.exact.empty:
+        blocks += [
+            Heading("Exact stationary metrics"),
+            Table(
+                cmp.exact,
+                "Linear designs on the road's white road velocity (ISO 8608 of waviness 2 at "
+                "constant speed): stationary RMS from a Lyapunov equation over the unbounded "
+                "band, no simulation. Semi-active designs are nonlinear: Table 3 only.",
+                "Table 4",
+            ),
+        ]
+    for spec in specs[2:]:
         blocks.append(Image(spec.name, spec.caption, spec.label))
     if cmp.notes:
         blocks.append(Heading("Notes"))
@@ -138,7 +163,11 @@ def write_control_report(
             for name, mags in cmp.transmissibility.items()
         }
         trans = pd.DataFrame(cols, index=pd.Index(cmp.freqs_hz, name="f [Hz]"))
-        return {"control_table.csv": cmp.table, "transmissibility.csv": trans}
+        return {
+            "control_table.csv": cmp.table,
+            "transmissibility.csv": trans,
+            "exact_metrics.csv": cmp.exact,
+        }
 
     return write_document(
         out_dir,
