@@ -324,6 +324,8 @@ def test_hinf_without_slycot_says_how_to_install(monkeypatch):
         (lambda: C.hybrid(1.0, alpha=1.5), "alpha"),
         (lambda: C.add_damper(0.0, 10.0, sensor_hz=0.0), "sensor_hz"),
         (lambda: C.lqr_controller(CAR, {"nope": 1.0}), "nope"),
+        (lambda: C.hinf_controller(CAR, beta=1.5), "beta"),
+        (lambda: C.hinf_controller(CAR, rtol=2.0), "rtol"),
         (lambda: C.lqr_controller(SEED), "actuator input 'fa'"),
         (lambda: qc.closed_loop(SEED, C.skyhook(1.0)), "actuator input 'fa'"),
         (
