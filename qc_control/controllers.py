@@ -654,13 +654,13 @@ def hinf_controller(
     ImportError
         Without slycot (``pip install 'qc-control[robust]'``).
     """
-    if slycot is None:
-        raise ImportError("hinf_controller needs slycot: pip install 'qc-control[robust]'")
     w = MATLAB_ACTIVE_SUSPENSION if weights is None else weights
     P = hinf_plant(car, beta, w)
     gamma_max = _positive("gamma_max", gamma_max, "")
     if not 0 < _positive("rtol", rtol, "") < 1:
         raise ValueError(f"rtol (relative width of the γ bracket) must be in (0, 1), got {rtol!r}")
+    if slycot is None:
+        raise ImportError("hinf_controller needs slycot: pip install 'qc-control[robust]'")
     best = _hinf_attempt(P, gamma_max, 1, 2)
     if best is None:
         raise ValueError(
