@@ -75,8 +75,20 @@ except PackageNotFoundError:  # pragma: no cover - a source tree that was never 
     __version__ = "0+unknown"
 
 if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
-    from . import road
+    from . import road, spectral
     from .compare import MethodComparison, compare_methods
+    from .control_study import ControlComparison, compare_controllers
+    from .controllers import (
+        HinfDesign,
+        add_damper,
+        closed_loop,
+        groundhook,
+        hinf_controller,
+        hybrid,
+        lqr_controller,
+        skyhook,
+    )
+    from .damping import DampingOptimum, ParetoFront, optimal_damping, pareto_front
     from .integrate import DivergenceWarning, Solution
     from .methods import METHODS, ButcherTableau, get_method
     from .metrics import Metric, RideSignals
@@ -107,6 +119,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         wk_weighted,
     )
     from .scenario import Scenario, ScenarioError, load_config, read_config
+    from .spectral import iso8608_intensity, lyapunov_variances, white_velocity_variances
     from .stability import max_stable_step, stability_function
     from .sweeps import DEFAULT_METRICS, METRICS, SweepChunk, SweepResult, design_grid, sweep
     from .vehicle import Corner, SignalRoles, VehicleModel
@@ -118,6 +131,20 @@ _LAZY: dict[str, str] = {
     "road": "road",
     "MethodComparison": "compare",
     "compare_methods": "compare",
+    "compare_controllers": "control_study",
+    "ControlComparison": "control_study",
+    "optimal_damping": "damping",
+    "pareto_front": "damping",
+    "DampingOptimum": "damping",
+    "ParetoFront": "damping",
+    "closed_loop": "controllers",
+    "skyhook": "controllers",
+    "groundhook": "controllers",
+    "hybrid": "controllers",
+    "add_damper": "controllers",
+    "lqr_controller": "controllers",
+    "hinf_controller": "controllers",
+    "HinfDesign": "controllers",
     "DivergenceWarning": "integrate",
     "Solution": "integrate",
     "METHODS": "methods",
@@ -163,6 +190,10 @@ _LAZY: dict[str, str] = {
     "SweepResult": "sweeps",
     "design_grid": "sweeps",
     "sweep": "sweeps",
+    "spectral": "spectral",
+    "lyapunov_variances": "spectral",
+    "white_velocity_variances": "spectral",
+    "iso8608_intensity": "spectral",
 }
 
 
@@ -234,4 +265,22 @@ __all__ = [
     "ride_metrics_spectral",
     "wk_filter",
     "wk_weighted",
+    "spectral",
+    "lyapunov_variances",
+    "white_velocity_variances",
+    "iso8608_intensity",
+    "compare_controllers",
+    "ControlComparison",
+    "optimal_damping",
+    "pareto_front",
+    "DampingOptimum",
+    "ParetoFront",
+    "closed_loop",
+    "skyhook",
+    "groundhook",
+    "hybrid",
+    "add_damper",
+    "lqr_controller",
+    "hinf_controller",
+    "HinfDesign",
 ]

@@ -22,9 +22,12 @@ from typing import Any
 
 import pandas as pd
 
+from .control_study import DESIGNS, compare_controllers
+from .controllers import HINF_AVAILABLE
 from .modal import modal_analysis
 from .model import QuarterCarParams
 from .report import ReportError, check_target, write_report
+from .report.control import write_control_report
 from .scenario import ROADS, Scenario, ScenarioError, road_option
 
 __all__ = ["run", "build_parser", "scenario_from_args", "summarise_warnings", "UsageError"]
@@ -168,6 +171,38 @@ def build_parser() -> argparse.ArgumentParser:
         "-q", "--quiet", action="store_true", help="no progress lines on stderr, only the summary"
     )
     report.set_defaults(run=_cmd_report)
+
+    ctl = sub.add_parser(
+        "control-report",
+        help="compare passive, semi-active and active suspensions (skyhook ... H∞) and "
+        "write the report",
+        allow_abbrev=False,
+    )
+    _add_vehicle(ctl)
+    ctl.add_argument(
+        "--designs",
+        metavar="A,B,...",
+        help=f"designs to compare (default all: {', '.join(DESIGNS)}; 'hinf' for H∞)",
+    )
+    ctl.add_argument("--road-class", default="C", metavar="A-H", help="ISO 8608 class (default C)")
+    ctl.add_argument("--speed", type=float, default=20.0, metavar="M/S", help="default 20")
+    ctl.add_argument(
+        "--road-duration", type=float, default=10.0, metavar="S", help="road run [s] (default 10)"
+    )
+    ctl.add_argument(
+        "--bump-duration", type=float, default=15.0, metavar="S", help="bump run [s] (default 15)"
+    )
+    ctl.add_argument("--method", default="rk4", help="fixed-step method (default rk4)")
+    ctl.add_argument(
+        "--cmax",
+        type=float,
+        default=4000.0,
+        metavar="N·S/M",
+        help="semi-active damper's largest damping (default 4000)",
+    )
+    ctl.add_argument("--out", default="control-report", metavar="DIR", help="report directory")
+    ctl.add_argument("-q", "--quiet", action="store_true", help="no progress line on stderr")
+    ctl.set_defaults(run=_cmd_control_report)
     return parser
 
 
@@ -293,6 +328,64 @@ def _cmd_report(args) -> int:
         f"report.md, the CSV tables, the figures and scenario.toml (the run, to redo it) "
         f"in {path}"
     )
+    return 0
+
+
+def _designs(text: str | None) -> list[str]:
+    if text is None:
+        return [d for d in DESIGNS if d != "H∞" or HINF_AVAILABLE]
+    names = [("H∞" if n.strip().lower() in ("hinf", "h∞") else n.strip()) for n in text.split(",")]
+    unknown = [n for n in names if n not in DESIGNS]
+    if unknown:
+        raise UsageError(f"--designs: unknown design {unknown[0]!r}; choose from {list(DESIGNS)}")
+    if "H∞" in names and not HINF_AVAILABLE:
+        raise UsageError("--designs: H∞ needs slycot: pip install 'qc-control[robust]'")
+    return names
+
+
+def _control_command(args, designs: list[str]) -> str:
+    """The command line that redoes this control report."""
+    parts = [_PROG, "control-report"]
+    if getattr(args, "config", None):
+        parts += ["--config", str(args.config)]
+    for f in fields(QuarterCarParams):
+        if getattr(args, f.name, None) is not None:
+            parts += [f"--{f.name}", repr(getattr(args, f.name))]
+    parts += ["--designs", "'" + ",".join("hinf" if d == "H∞" else d for d in designs) + "'"]
+    for option in ("road_class", "speed", "road_duration", "bump_duration", "method", "cmax"):
+        parts += ["--" + option.replace("_", "-"), str(getattr(args, option))]
+    return " ".join(parts + ["--out", str(args.out)])
+
+
+def _cmd_control_report(args) -> int:
+    params = scenario_from_args(args).vehicle
+    designs = _designs(args.designs)
+    out = _check_out(args.out)
+    if not args.quiet:
+        _progress(f"qc-control control-report: {len(designs)} designs, bump and road runs")
+    try:
+        cmp = compare_controllers(
+            params,
+            designs=designs,
+            road_class=args.road_class,
+            speed=args.speed,
+            road_duration=args.road_duration,
+            bump_duration=args.bump_duration,
+            method=args.method,
+            cmax=args.cmax,
+        )
+    except ValueError as exc:  # the library names the bad value
+        raise UsageError(str(exc)) from None
+    command = _control_command(args, designs)
+    try:
+        path = write_control_report(cmp, out, command=command)
+    except ReportError as exc:
+        raise UsageError(str(exc)) from None
+    with pd.option_context(
+        "display.width", 200, "display.max_columns", 20, "display.float_format", "{:.4g}".format
+    ):
+        print(cmp.table)
+    print(f"\nwrote {path / 'report.html'}, report.pdf, report.md, the CSV tables and figures")
     return 0
 
 

@@ -202,3 +202,24 @@ def test_no_example_or_library_figure_calls_show():
         text = path.read_text(encoding="utf-8")
         assert ".show(" not in text, path
         assert "import matplotlib.pyplot" not in text, path
+
+
+def test_active_suspension(tmp_path):
+    out = tmp_path / "a" / "s"
+    stdout = run("active_suspension", out)
+    p = qc_params()
+    printed = float(re.search(r"cs = (\S+) N·s/m", stdout).group(1))
+    assert printed == pytest.approx(p.ks * np.sqrt((p.ms + p.mu) / p.ku), abs=0.05)  # closed form
+    with open(out / "control_table.csv", newline="", encoding="utf-8") as fh:
+        rows = {r["design"]: r for r in csv.DictReader(fh)}
+    acc = "road: rms_body_acc [m/s²]"
+    assert float(rows["skyhook"][acc]) < float(rows["passive (seed)"][acc])
+    for name in ("transmissibility_body_acc", "transmissibility_tire_defl"):
+        assert png_size(out / f"{name}.png") == (800, 500)  # 8 × 5 in at 100 dpi
+    assert png_size(out / "pareto.png") == (800, 600)
+
+
+def qc_params():
+    from qc_control import QuarterCarParams
+
+    return QuarterCarParams()

@@ -50,6 +50,7 @@ if TYPE_CHECKING:
 __all__ = [
     "check_target",
     "write_report",
+    "write_document",
     "build_blocks",
     "figure_specs",
     "FigureSpec",
@@ -528,6 +529,41 @@ def write_report(
     ValueError
         For an unknown format.
     """
+    scenario = getattr(cmp, "scenario", None)
+    return write_document(
+        out_dir,
+        TITLE,
+        lambda: build_blocks(cmp, command),
+        figure_specs(cmp),
+        lambda: _csv_tables(cmp),
+        formats,
+        extra={"scenario.toml": scenario.to_toml()} if scenario is not None else None,
+        command=command,
+        overwrite=overwrite,
+    )
+
+
+def write_document(
+    out_dir,
+    title: str,
+    blocks: Callable[[], list],
+    figures=(),
+    tables: Callable[[], dict[str, pd.DataFrame]] | None = None,
+    formats=FORMATS,
+    *,
+    extra: dict[str, str] | None = None,
+    command: str | None = None,
+    overwrite: bool = True,
+) -> Path:
+    """Write a report's files into ``out_dir``, atomically (what `write_report` does).
+
+    ``figures`` are `FigureSpec` (drawn first, as PNG), ``blocks()`` the
+    document (Markdown, HTML, PDF per ``formats``), ``tables()`` the CSV
+    files by name, ``extra`` more text files by name. The directory is built
+    beside the target and swapped in under a lock; an existing directory is
+    replaced only if it is an earlier report holding nothing foreign
+    (`check_target`).
+    """
     formats = tuple(formats)
     bad = [f for f in formats if f not in FORMATS]
     if bad or not formats:
@@ -540,30 +576,29 @@ def write_report(
     with _exclusive(out.parent, out):
         _recover(out)
         check_target(out, overwrite)  # again: recovery may have put a report back
-        return _write(cmp, out, formats, command)
+        return _write(out, title, blocks, figures, tables, formats, extra, command)
 
 
-def _write(cmp, out: Path, formats: tuple, command: str | None) -> Path:
-    """Build the report in a working copy and swap it in (see `write_report`)."""
+def _write(out: Path, title, blocks_of, figures, tables_of, formats, extra, command) -> Path:
+    """Build the report in a working copy and swap it in (see `write_document`)."""
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
     os.chmod(tmp, 0o777 & ~_umask())  # a directory as the user's umask makes it, not 0700
     moved: Path | None = None
     try:
-        for spec in figure_specs(cmp):
+        for spec in figures:
             spec.make().savefig(tmp / spec.name, dpi=DPI)
-        blocks = build_blocks(cmp, command)
+        blocks = blocks_of()
         if "md" in formats:
-            (tmp / "report.md").write_text(to_markdown(TITLE, blocks), encoding="utf-8")
+            (tmp / "report.md").write_text(to_markdown(title, blocks), encoding="utf-8")
         if "html" in formats:
-            (tmp / "report.html").write_text(to_html(TITLE, blocks, tmp), encoding="utf-8")
+            (tmp / "report.html").write_text(to_html(title, blocks, tmp), encoding="utf-8")
         if "pdf" in formats:
-            to_pdf(TITLE, blocks, tmp, tmp / "report.pdf")
-        if "csv" in formats:
-            for name, frame in _csv_tables(cmp).items():
+            to_pdf(title, blocks, tmp, tmp / "report.pdf")
+        if "csv" in formats and tables_of is not None:
+            for name, frame in tables_of().items():
                 frame.to_csv(tmp / name)
-        scenario = getattr(cmp, "scenario", None)
-        if scenario is not None:
-            (tmp / "scenario.toml").write_text(scenario.to_toml(), encoding="utf-8")
+        for name, text in (extra or {}).items():
+            (tmp / name).write_text(text, encoding="utf-8")
         written = sorted(p.name for p in tmp.iterdir())
         (tmp / MARKER).write_text(
             f"qc-control report\n{command or ''}\nfiles:\n" + "\n".join(written) + "\n",

@@ -1,0 +1,361 @@
+"""Exact stationary variances of linear vehicles on random roads (Lyapunov equations).
+
+A stable linear system ``x' = A x + B w`` driven by white noise of unit
+intensity, ``E[w(t) w(s)ᵀ] = I δ(t - s)``, settles to a stationary state
+covariance ``P``, the solution of the Lyapunov equation
+
+.. math:: A P + P A^T + B B^T = 0,
+
+and an output ``y = C x`` has the variances ``diag(C P Cᵀ)`` (the squared
+H2 norm of each output channel). No simulation and no frequency
+quadrature: the variance is exact over the unbounded band.
+
+An ISO 8608 road of waviness 2 is exactly white road *velocity* at a
+constant speed: its displacement PSD ``Gd(n) = Gd(n0)(n/n0)^-2`` makes the
+velocity PSD flat, of two-sided intensity
+``q = 2 π² n0² Gd(n0) v`` (`iso8608_intensity`). `white_velocity_variances`
+drives a vehicle's road inputs with it.
+
+Sources: Gobbi & Mastinu, J. Sound Vib. 245(3), 2001 (closed forms for the
+quarter car); Dahlberg, J. Sound Vib. 58(2), 1978; Kwakernaak & Sivan,
+*Linear Optimal Control Systems*, 1972, §1.11 (the Lyapunov equation).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import control
+import numpy as np
+import scipy.linalg
+
+from .iso2631 import wk_filter
+from .road import ISO8608_N0, positive, road_class_psd
+from .vehicle import VehicleModel
+
+__all__ = [
+    "lyapunov_variances",
+    "stationary_covariance",
+    "white_velocity_system",
+    "white_velocity_variances",
+    "white_velocity_wk_variance",
+    "iso8608_intensity",
+]
+
+#: Up to this many states the batched solve uses the Kronecker form (n² unknowns,
+#: one LU per design, backward stable); above it, the eigendecomposition.
+_KRONECKER_MAX_STATES = 6
+
+
+def _as_batch(A, B, C=None):
+    A = np.asarray(A, dtype=float)
+    B = np.asarray(B, dtype=float)
+    if A.ndim < 2 or A.shape[-1] != A.shape[-2]:
+        raise ValueError(f"A must be square, of shape (n, n) or (m, n, n), got shape {A.shape}")
+    n = A.shape[-1]
+    if B.ndim < 2 or B.shape[-2] != n:
+        raise ValueError(f"B must be of shape (..., {n}, k) to match A, got shape {B.shape}")
+    if C is not None:
+        C = np.asarray(C, dtype=float)
+        if C.ndim < 2 or C.shape[-1] != n:
+            raise ValueError(f"C must be of shape (..., p, {n}) to match A, got shape {C.shape}")
+    return A, B, C
+
+
+def _check_hurwitz(A: np.ndarray) -> None:
+    """ValueError naming the first design whose A has an eigenvalue with Re >= 0."""
+    flat = A.reshape((-1,) + A.shape[-2:])
+    finite = np.isfinite(flat).all(axis=(-1, -2))
+    if not finite.all():
+        i = int(np.argmin(finite))
+        raise ValueError(f"A of design {i} is not finite")
+    top = np.linalg.eigvals(flat).real.max(axis=-1)
+    bad = np.flatnonzero(top >= 0)
+    if bad.size:
+        i = int(bad[0])
+        where = f"design {i}" if A.ndim == 3 else "the system"
+        raise ValueError(
+            f"A of {where} is not Hurwitz (largest real part of an eigenvalue {top[i]:.6g} "
+            ">= 0): it has no stationary variance"
+        )
+
+
+def stationary_covariance(A, B) -> np.ndarray:
+    """``P`` solving ``A P + P Aᵀ + B Bᵀ = 0``, for one system or a batch.
+
+    Parameters
+    ----------
+    A : array_like, shape (n, n) or (m, n, n)
+        Hurwitz.
+    B : array_like, shape (n, k) or (m, n, k)
+
+    Returns
+    -------
+    ndarray, shape (n, n) or (m, n, n)
+        The stationary state covariance under unit-intensity white noise
+        (the controllability Gramian of ``(A, B)``).
+
+    Notes
+    -----
+    Up to six states, each design's equation is solved in its Kronecker
+    form ``(I ⊗ A + A ⊗ I) vec P = -vec(B Bᵀ)`` (one batched LU of n²
+    unknowns, backward stable). Larger systems use the eigendecomposition
+    ``A = V Λ V⁻¹``: ``P̂ = -Q̂ / (λ_i + λ̄_j)`` with ``Q̂ = V⁻¹ Q V⁻ᴴ``; a
+    design whose eigenvectors are ill-conditioned (``cond(V) > 1e6``, near a
+    defective A) is solved instead by Bartels–Stewart
+    (`scipy.linalg.solve_continuous_lyapunov`).
+    """
+    A, B, _ = _as_batch(A, B)
+    _check_hurwitz(A)
+    single = A.ndim == 2
+    A3 = A.reshape((-1,) + A.shape[-2:])
+    B3 = np.broadcast_to(B, A.shape[:-2] + B.shape[-2:]).reshape((A3.shape[0],) + B.shape[-2:])
+    m, n = A3.shape[0], A3.shape[-1]
+    Q = B3 @ np.swapaxes(B3, -1, -2)
+    if n <= _KRONECKER_MAX_STATES:
+        eye = np.eye(n)
+        # row-major vec: vec(A P) = (A ⊗ I) vec P, vec(P Aᵀ) = (I ⊗ A) vec P
+        K = np.einsum("mij,kl->mikjl", A3, eye).reshape(m, n * n, n * n)
+        K += np.einsum("ij,mkl->mikjl", eye, A3).reshape(m, n * n, n * n)
+        P = np.linalg.solve(K, -Q.reshape(m, n * n, 1)).reshape(m, n, n)
+    else:
+        lam, V = np.linalg.eig(A3)
+        Vinv = np.linalg.inv(V)
+        Qh = Vinv @ Q @ np.swapaxes(Vinv.conj(), -1, -2)
+        Ph = -Qh / (lam[:, :, None] + lam[:, None, :].conj())
+        P = (V @ Ph @ np.swapaxes(V.conj(), -1, -2)).real
+        bad = np.flatnonzero(np.linalg.cond(V) > 1e6)
+        if bad.size:
+            for i in bad:
+                P[i] = scipy.linalg.solve_continuous_lyapunov(A3[i], -Q[i])
+    P = 0.5 * (P + np.swapaxes(P, -1, -2))
+    return P[0] if single else P.reshape(A.shape)
+
+
+def lyapunov_variances(A, B, C) -> np.ndarray:
+    """Stationary output variances ``diag(C P Cᵀ)`` under unit-intensity white noise.
+
+    .. math:: A P + P A^T + B B^T = 0, \\qquad σ_i^2 = (C P C^T)_{ii}
+
+    for ``x' = A x + B w``, ``y = C x``, ``E[w(t) w(s)ᵀ] = I δ(t - s)``.
+    ``σ_i²`` is the squared H2 norm of output ``i``, the variance over the
+    unbounded frequency band.
+
+    Parameters
+    ----------
+    A : array_like, shape (n, n) or (m, n, n)
+        ``m`` designs; each must be Hurwitz.
+    B : array_like, shape (..., n, k)
+    C : array_like, shape (..., p, n)
+
+    Returns
+    -------
+    ndarray, shape (p,) or (m, p)
+
+    Raises
+    ------
+    ValueError
+        If the shapes disagree, or a design's ``A`` is not Hurwitz (the
+        message names the design).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> # x' = -a x + w: σ² = 1/(2a)
+    >>> float(lyapunov_variances([[-2.0]], [[1.0]], [[1.0]])[0])
+    0.25
+    """
+    A, B, C = _as_batch(A, B, C)
+    P = stationary_covariance(A, B)
+    return np.einsum("...ij,...jk,...ik->...i", C, P, C)
+
+
+def white_velocity_system(model: VehicleModel, batch=None):
+    """``(Ã, B̃, C)`` of a vehicle whose road inputs are driven by white road velocity.
+
+    With the road displacement ``zr`` integrated from a white velocity
+    ``w = zr'``, the state measured from the static equilibrium over the
+    current road height, ``x̃ = x + A⁻¹ B_r zr``, obeys
+
+    .. math:: \\tilde x' = A \\tilde x + A^{-1} B_r\\, w, \\qquad
+              y = C \\tilde x + G_r(0)\\, z_r,
+
+    with ``G_r(0) = D_r - C A⁻¹ B_r`` the static gain from the road. The
+    outputs that do not follow a constant road height (``G_r(0) = 0``:
+    body acceleration, suspension travel, tire deflection) are therefore
+    ``C x̃``, stationary, with the Lyapunov variances of ``(A, A⁻¹B_r, C)``;
+    the others (the body and wheel heights) follow the road's random walk
+    and have no stationary variance.
+
+    Parameters
+    ----------
+    model : VehicleModel
+        With at least one road input (`VehicleModel.road_inputs`).
+    batch : BatchedModel, optional
+        Many designs of ``model`` (``model.batch(designs)``); default the
+        model itself.
+
+    Returns
+    -------
+    A, Bw, C, static_gain : ndarray
+        ``(..., n, n)``, ``(..., n, r)`` for the ``r`` road inputs,
+        ``(..., p, n)`` and ``(..., p)``: the largest ``|G_r(0)|`` of each
+        output over the road inputs.
+    """
+    if not isinstance(model, VehicleModel):
+        raise TypeError(f"model must be a VehicleModel, got {type(model).__name__}")
+    roads = model.road_inputs()
+    if not roads:
+        raise ValueError(
+            f"model {model.name!r} has no road input: build it with road=True "
+            f"(inputs are {list(model.system.input_labels)})"
+        )
+    cols = [list(model.system.input_labels).index(r) for r in roads]
+    if batch is None:
+        A, B, C, D = (np.asarray(getattr(model.system, k), dtype=float) for k in "ABCD")
+    else:
+        A, B, C, D = batch.A, batch.B, batch.C, batch.D
+    _check_hurwitz(A)
+    Br, Dr = B[..., cols], D[..., cols]
+    Bw = np.linalg.solve(A, Br)  # A⁻¹ B_r
+    gain = np.abs(Dr - C @ Bw).max(axis=-1)
+    return A, Bw, C, gain
+
+
+def white_velocity_variances(
+    model: VehicleModel, *, intensity: float = 1.0, outputs=None, batch=None
+) -> dict:
+    """Stationary output variances of a vehicle on white road velocity.
+
+    Every road input of ``model`` is driven by its own white road velocity
+    of two-sided intensity ``intensity`` [m²/s], ``E[zr'(t) zr'(s)] =
+    intensity · δ(t - s)``, the road displacement being its integral; the
+    tracks are independent (a rear wheel that follows the front one with a
+    wheelbase delay is not represented).
+
+    .. math:: σ_y^2 = q\\, \\mathrm{diag}(C P C^T), \\qquad
+              A P + P A^T + A^{-1} B_r B_r^T A^{-T} = 0
+
+    (see `white_velocity_system`). For the quarter car and unit intensity
+    the results equal the closed forms of Gobbi & Mastinu (2001):
+    ``σ²(body_acc) = (cs² kt + ks² (ms + mu)) / (2 cs ms²)`` and
+    ``σ²(susp_travel) = (ms + mu) / (2 cs)``.
+
+    Parameters
+    ----------
+    model : VehicleModel
+        A linear vehicle with road inputs (e.g. ``quarter_car_model(road=True)``).
+    intensity : float, default 1
+        ``q`` [m²/s]; `iso8608_intensity` gives an ISO 8608 road's.
+    outputs : sequence of str, optional
+        Output labels; default all.
+    batch : BatchedModel, optional
+        Many designs at once: each value is then an array ``(m,)``.
+
+    Returns
+    -------
+    dict[str, float or ndarray]
+        Variance of each output [unit²]; ``inf`` for an output that follows
+        the road height (``xs``, ``xu``), which has no stationary variance
+        under a random-walk road (see `iso8608` for a band-limited road).
+
+    Examples
+    --------
+    >>> from qc_control.model import quarter_car_model
+    >>> v = white_velocity_variances(quarter_car_model(road=True))
+    >>> round(v["susp_travel"], 9)           # (ms + mu) / (2 cs)
+    0.133466666
+    """
+    q = positive("intensity", intensity, "m²/s")
+    labels = list(model.system.output_labels)
+    wanted = labels if outputs is None else list(outputs)
+    unknown = [o for o in wanted if o not in labels]
+    if unknown:
+        raise ValueError(f"no output {unknown[0]!r}; outputs are {labels}")
+    A, Bw, C, gain = white_velocity_system(model, batch)
+    rows = [labels.index(o) for o in wanted]
+    var = q * lyapunov_variances(A, Bw, C[..., rows, :])
+    scale = np.abs(C[..., rows, :]).max(axis=-1) + 1.0
+    follows = gain[..., rows] > 1e-9 * scale
+    var = np.where(follows, np.inf, var)
+    return {o: (float(var[..., i]) if var.ndim == 1 else var[..., i]) for i, o in enumerate(wanted)}
+
+
+def iso8608_intensity(road_class, speed: float) -> float:
+    """White road-velocity intensity [m²/s] of an ISO 8608 road at ``speed`` [m/s].
+
+    .. math:: q = 2 π^2 n_0^2 G_d(n_0)\\, v
+
+    The displacement PSD ``Gd(n) = Gd(n0)(n/n0)^-2`` (one-sided, spatial)
+    gives the road velocity ``v dz/dx`` a one-sided temporal PSD
+    ``(2πf)² Gd(f/v)/v = 4π² n0² Gd(n0) v``, flat in ``f``: white noise of
+    two-sided intensity ``q`` (ISO 8608:2016; Gobbi & Mastinu, 2001).
+
+    Parameters
+    ----------
+    road_class : str or float
+        A class ``'A'`` ... ``'H'`` (its geometric mean ``Gd(n0)``), or
+        ``Gd(n0)`` [m³] itself.
+    speed : float
+        Vehicle speed [m/s], > 0.
+
+    Examples
+    --------
+    >>> round(iso8608_intensity("C", 20.0), 6)
+    0.001011
+    """
+    if isinstance(road_class, str):
+        g0 = road_class_psd(road_class)
+    else:
+        g0 = positive("road_class (Gd(n0))", road_class, "m³")
+    v = positive("speed", speed, "m/s")
+    return 2.0 * math.pi**2 * ISO8608_N0**2 * g0 * v
+
+
+def white_velocity_wk_variance(model: VehicleModel, *, intensity: float = 1.0, batch=None):
+    """Stationary variance of the ISO 2631-1 Wk-weighted body acceleration on white road velocity.
+
+    The car of `white_velocity_system` in series with `qc_control.iso2631.wk_filter`
+    (``x_w' = A_w x_w + B_w a``, ``a_w = C_w x_w + D_w a`` with ``a`` the body
+    acceleration ``C_a x̃``):
+
+    .. math:: A_c = \\begin{bmatrix} A & 0 \\\\ B_w C_a & A_w \\end{bmatrix}, \\quad
+              B_c = \\begin{bmatrix} A^{-1} B_r \\\\ 0 \\end{bmatrix}, \\quad
+              C_c = [D_w C_a \\;\\; C_w],
+
+    and ``σ² = q · C_c P C_cᵀ`` with ``A_c P + P A_cᵀ + B_c B_cᵀ = 0``.
+
+    Returns
+    -------
+    float, or ndarray (m,) for a ``batch``
+    """
+    q = positive("intensity", intensity, "m²/s")
+    A, Bw, C, gain = white_velocity_system(model, batch)
+    row = list(model.system.output_labels).index(model.body_acc)
+    if np.any(gain[..., row] > 1e-9 * (np.abs(C[..., row, :]).max(axis=-1) + 1.0)):
+        raise ValueError(
+            f"the body acceleration {model.body_acc!r} follows the road height: "
+            "it has no stationary variance under white road velocity"
+        )
+    Aw, Bk, Cw, Dw = _wk_matrices()
+    n, nw = A.shape[-1], Aw.shape[0]
+    Ca = C[..., row, :]  # (..., n)
+    batch_shape = A.shape[:-2]
+    Ac = np.zeros(batch_shape + (n + nw, n + nw))
+    Ac[..., :n, :n] = A
+    Ac[..., n:, :n] = Bk[:, :1] * Ca[..., None, :]
+    Ac[..., n:, n:] = Aw
+    Bc = np.zeros(batch_shape + (n + nw, Bw.shape[-1]))
+    Bc[..., :n, :] = Bw
+    Cc = np.zeros(batch_shape + (1, n + nw))
+    Cc[..., 0, :n] = Dw[0, 0] * Ca
+    Cc[..., 0, n:] = Cw[0]
+    var = q * lyapunov_variances(Ac, Bc, Cc)[..., 0]
+    return float(var) if var.ndim == 0 else var
+
+
+@functools.lru_cache(maxsize=1)
+def _wk_matrices() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    sys = control.ss(wk_filter())
+    return tuple(np.asarray(getattr(sys, k), dtype=float) for k in "ABCD")  # type: ignore[return-value]
