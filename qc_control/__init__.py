@@ -77,6 +77,14 @@ except PackageNotFoundError:  # pragma: no cover - a source tree that was never 
 if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from . import road
     from .compare import MethodComparison, compare_methods
+    from .halfcar import (
+        FullCarParams,
+        HalfCarParams,
+        full_car,
+        full_car_model,
+        half_car,
+        half_car_model,
+    )
     from .integrate import DivergenceWarning, Solution
     from .methods import METHODS, ButcherTableau, get_method
     from .metrics import Metric, RideSignals
@@ -163,6 +171,12 @@ _LAZY: dict[str, str] = {
     "SweepResult": "sweeps",
     "design_grid": "sweeps",
     "sweep": "sweeps",
+    "HalfCarParams": "halfcar",
+    "FullCarParams": "halfcar",
+    "half_car": "halfcar",
+    "half_car_model": "halfcar",
+    "full_car": "halfcar",
+    "full_car_model": "halfcar",
 }
 
 
@@ -234,4 +248,10 @@ __all__ = [
     "ride_metrics_spectral",
     "wk_filter",
     "wk_weighted",
+    "HalfCarParams",
+    "FullCarParams",
+    "half_car",
+    "half_car_model",
+    "full_car",
+    "full_car_model",
 ]
