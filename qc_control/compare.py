@@ -140,16 +140,14 @@ class MethodComparison:
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""
-        cols = [
-            "order",
-            "RHS evals",
-            "wall time [ms]",
-            "max |xs err| [m]",
-            "max |xu err| [m]",
-            "observed order",
-            "h_max [s]",
-        ]
-        return self.table[cols]
+        model = self.model
+        errors = [f"max |{model.body_disp if model else 'xs'} err| [m]"]
+        if model is not None and len(model.corners) > 1:  # each corner's travel error
+            errors += [f"max |{c.susp_travel} err| [m]" for c in model.corners]
+        else:
+            errors.append("max |xu err| [m]")
+        cols = ["order", "RHS evals", "wall time [ms]", *errors, "observed order", "h_max [s]"]
+        return self.table[[c for c in cols if c in self.table.columns]]
 
 
 def best_time(fn: Callable[[], object], repeats: int, warmup: bool = False) -> float:
@@ -693,9 +691,11 @@ def compare_methods(
 
     ride, ride_error, trans = None, None, None
     roads = model.road_inputs()
-    if U is not None and len(roads) == 1 and list(sys.input_labels) == roads:
+    if U is not None and roads and list(sys.input_labels) == roads:
         ride, ride_error = ride_comparison(reference, responses, model)
-        trans = transmissibility(sys) if params is not None else None
+        # one road input: the quarter car's transmissibility (a car on several axles
+        # needs the speed for its wheelbase delay: qc.transmissibility(model, speed=V))
+        trans = transmissibility(sys) if params is not None and len(roads) == 1 else None
     return MethodComparison(
         system=sys,
         params=params,

@@ -386,8 +386,8 @@ def vehicle_abcd(kind: str, p: Mapping[str, np.ndarray], *, road=True, actuator=
         inertia.append(np.asarray(p["Ix"], dtype=float) * one)
     minv = 1.0 / np.concatenate([np.stack(inertia, -1), mu], axis=-1)  # (..., n)
     A = np.zeros(batch + (2 * n, 2 * n))
-    A[..., :n, :n] = -minv[..., :, None] * Cm
-    A[..., :n, n:] = -minv[..., :, None] * K
+    A[..., :n, :n] = -minv[..., :, None] * Cm + 0.0  # + 0.0: no -0.0 entries
+    A[..., :n, n:] = -minv[..., :, None] * K + 0.0
     A[..., n:, :n] = np.eye(n)
     columns = []
     if road:
@@ -406,7 +406,7 @@ def vehicle_abcd(kind: str, p: Mapping[str, np.ndarray], *, road=True, actuator=
     C[..., n : n + nc, n:] = E
     C[..., n + nc : n + 2 * nc, n:] = W
     if road:
-        D[..., n + nc : n + 2 * nc, :nc] = -np.eye(nc)
+        D[..., n + nc : n + 2 * nc, :nc] = 0.0 - np.eye(nc)
     acc = n + 2 * nc
     C[..., acc : acc + nb, :] = A[..., :nb, :]
     D[..., acc : acc + nb, :] = B[..., :nb, :]
