@@ -2,6 +2,7 @@
 
 import dataclasses
 import math
+from pathlib import Path
 
 import control
 import numpy as np
@@ -166,3 +167,25 @@ def test_vehicle_modes_accepts_models_and_labelled_systems():
         )
     with pytest.raises(ValueError, match="not in vehicle form"):
         qc.modal_analysis(control.ss(-np.eye(6), np.zeros((6, 1)), np.eye(6), 0))
+
+
+def readme_table(title):
+    """The rows of the README's modal table after the line ``title``."""
+    text = (Path(__file__).parent.parent / "README.md").read_text(encoding="utf-8")
+    block = text.split(f"\n{title}\n", 1)[1].lstrip("\n").split("\n\n", 1)[0]
+    rows = [line.strip("|").split("|") for line in block.splitlines()[2:]]
+    return {r[0].strip(): [float(v) if v.strip() != "–" else math.nan for v in r[1:]] for r in rows}
+
+
+@pytest.mark.parametrize(
+    ("title", "params"),
+    [("Half car:", HalfCarParams()), ("Full car (no anti-roll bars):", FullCarParams())],
+)
+def test_the_readme_modal_tables_are_the_example_vehicles(title, params):
+    table = readme_table(title)
+    ma = qc.modal_analysis(params)
+    assert list(table) == [m.name for m in ma.modes]
+    for m in ma.modes:
+        expected = [m.fn, m.zeta, m.fd, m.fn_undamped, m.node_x]
+        # printed to 3 decimals
+        np.testing.assert_allclose(table[m.name], expected, atol=5.1e-4, equal_nan=True)
