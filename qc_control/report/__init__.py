@@ -73,6 +73,12 @@ class ReportError(ValueError):
     """The report cannot be written where it was asked to go."""
 
 
+def _body(cmp) -> str:
+    """The label of the body displacement the errors are measured on (``xs``, ``z``)."""
+    model = getattr(cmp, "model", None)
+    return model.body_disp if model is not None else "xs"
+
+
 def _versions() -> dict[str, str]:
     """The installed versions behind the numbers, from the distributions' metadata."""
     names = {
@@ -152,7 +158,7 @@ def figure_specs(cmp) -> list[FigureSpec]:
             (
                 f"method_{_slug(name)}.png",
                 f"{name}: displacement of the suspension (sprung mass, red solid) and of "
-                f"the wheel (blue dashed) against the exact xs (dark grey) and xu (light "
+                f"the wheel (blue dashed) against the exact ones (dark grey, light "
                 f"grey, dashed), h = {cmp.h:g} s",
                 functools.partial(method_figure, cmp, name),
                 SEED_FIGURES.get(name),
@@ -167,13 +173,13 @@ def figure_specs(cmp) -> list[FigureSpec]:
         ),
         (
             "convergence.png",
-            "Max |xs error| against h, with slope guides of each order",
+            f"Max |{_body(cmp)} error| against h, with slope guides of each order",
             lambda: convergence_figure(cmp),
             None,
         ),
         (
             "work_precision.png",
-            "Max |xs error| against RHS evaluations (machine-independent) and against "
+            f"Max |{_body(cmp)} error| against RHS evaluations (machine-independent) and against "
             "wall time (measured on this machine)",
             lambda: work_precision_figure(cmp),
             None,
@@ -317,7 +323,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
     conv = cmp.convergence.pivot(index="h", columns="method", values="error")
     conv = conv.sort_index(ascending=False)[[t.name for t in cmp.methods]]
     conv.index.name = "h [s]"
-    blocks.append(Table(conv, "Max |xs error| [m] at h, h/2, …, h/32"))
+    blocks.append(Table(conv, f"Max |{_body(cmp)} error| [m] at h, h/2, …, h/32"))
     blocks.append(
         Table(
             table[["order", "observed order"]],
@@ -352,7 +358,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
     blocks.append(
         Table(
             reach,
-            "RHS evaluations to reach each max |xs error| "
+            f"RHS evaluations to reach each max |{_body(cmp)} error| "
             "(i: interpolated between refinements, e: extrapolated with "
             "e = C·h^p, never beyond h_max)",
         )

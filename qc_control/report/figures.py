@@ -263,7 +263,7 @@ def convergence_figure(cmp) -> Figure:
     ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set(
         xlabel="step h [s]",
-        ylabel="max |xs error| [m]",
+        ylabel=f"max |{_body_wheel(cmp)[0]} error| [m]",
         title="Convergence (dotted: slope of the method's order)",
     )
     ax.grid(alpha=0.3, which="both")
@@ -298,7 +298,7 @@ def work_precision_figure(cmp) -> Figure:
         right.loglog(rows["time"] * 1e3, rows["error"], **{**style, "ls": "none"})
     left.set(
         xlabel="right-hand-side evaluations",
-        ylabel="max |xs error| [m]",
+        ylabel=f"max |{_body_wheel(cmp)[0]} error| [m]",
         title="Against work",
     )
     right.set(
