@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 import scipy.signal
 
+from .halfcar import FullCarParams, HalfCarParams
 from .integrate import DivergenceWarning, check_time_grid, uniform_step
 from .limits import check_memory
 from .methods import ButcherTableau, get_method
@@ -531,6 +532,9 @@ def _as_model(sys, U, params) -> tuple[control.StateSpace, VehicleModel | None, 
     """(system, model, params) from a system, parameters, a model, or None."""
     if isinstance(sys, VehicleModel):
         return sys.system, sys, sys.params
+    if isinstance(sys, (HalfCarParams, FullCarParams)):
+        model = sys.model(road=U is not None)
+        return model.system, model, model.params
     if sys is None or isinstance(sys, (QuarterCarParams, dict)):
         model = quarter_car_model(as_params(sys), road=U is not None)
         return model.system, model, model.params
@@ -576,9 +580,10 @@ def compare_methods(
 
     Parameters
     ----------
-    sys : control.StateSpace, VehicleModel or QuarterCarParams
-        The vehicle. Parameters build
-        ``quarter_car_model(params, road=U is not None)``.
+    sys : control.StateSpace, VehicleModel, QuarterCarParams, HalfCarParams or FullCarParams
+        The vehicle. Parameters build their model with the road inputs when
+        ``U`` is given (``quarter_car_model(params, road=U is not None)``);
+        a half or full car then needs ``X0`` of its 8 or 14 states.
     T : array_like, optional
         Uniform output grid [s]; default 0-10 s at 0.01 s.
     X0 : array_like, default ``(0, 0, 0.05, 0)``

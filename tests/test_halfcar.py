@@ -324,6 +324,12 @@ def test_compare_methods_and_ride_metrics_on_the_half_car(half_car_comparison):
         )
     # RK4 at h = 10 ms is within 1 % of the exact ride metrics
     assert cmp.ride_error.loc["rk4"].abs().max() < 1.0
+    # parameters alone build the same model
+    short = qc.compare_methods(
+        HALF, cmp.T[:51], np.zeros(8), U=cmp.U[:, :51], methods=["rk4"], timing=False
+    )
+    np.testing.assert_array_equal(np.asarray(short.system.A), np.asarray(cmp.system.A))
+    assert short.model.road_inputs() == ["zr_front", "zr_rear"]
 
 
 @pytest.mark.slow  # the report's figures: about 9 s here
