@@ -185,7 +185,7 @@ def iso8608_profile(
     """
     N, amplitude = _harmonics(length, dx, road_class, band)
     phase = np.random.default_rng(_seed(seed)).uniform(0, 2 * np.pi, amplitude.size)
-    return _synthesise(N, dx, length, amplitude * np.exp(1j * phase))
+    return _synthesise(N, dx, length, amplitude, np.exp(1j * phase))
 
 
 def _seed(seed) -> int:
@@ -216,9 +216,9 @@ def _harmonics(length, dx, road_class, band) -> tuple[int, np.ndarray]:
     return N, amplitude
 
 
-def _synthesise(N: int, dx: float, length: float, harmonics: np.ndarray):
-    """``x, z`` up to ``length`` of ``Σ |c_k| cos(2π n_k x + arg c_k)`` (inverse FFT)."""
-    z = np.fft.irfft(0.5 * N * harmonics, n=N)
+def _synthesise(N: int, dx: float, length: float, amplitude: np.ndarray, unit: np.ndarray):
+    """``x, z`` up to ``length`` of ``Σ A_k |u_k| cos(2π n_k x + arg u_k)`` (inverse FFT)."""
+    z = np.fft.irfft(0.5 * N * amplitude * unit, n=N)
     x = np.arange(N) * dx
     keep = x <= length + 1e-9 * length
     return x[keep], z[keep]
@@ -385,10 +385,10 @@ def iso8608_profiles(
     phase = np.random.default_rng(seed).uniform(0, 2 * np.pi, amplitude.size)
     other = np.random.default_rng([seed, 1]).uniform(0, 2 * np.pi, amplitude.size)
     rho = isotropic_coherence(np.arange(amplitude.size) / (N * dx), track)
-    left = amplitude * np.exp(1j * phase)
-    right = amplitude * (rho * np.exp(1j * phase) + np.sqrt(1 - rho**2) * np.exp(1j * other))
-    x, zl = _synthesise(N, dx, length, left)
-    _, zr = _synthesise(N, dx, length, right)
+    left = np.exp(1j * phase)
+    right = rho * left + np.sqrt(1 - rho**2) * np.exp(1j * other)
+    x, zl = _synthesise(N, dx, length, amplitude, left)
+    _, zr = _synthesise(N, dx, length, amplitude, right)
     return x, zl, zr
 
 

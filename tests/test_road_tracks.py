@@ -124,3 +124,26 @@ def test_transmissibility_is_the_delayed_sum_of_the_axles():
     assert tr.units["pitch_acc"] == "(rad/s²)/m" and tr.units["susp_travel_rear"] == "m/m"
     with pytest.raises(ValueError, match="speed is required"):
         qc.transmissibility(p, f)
+
+
+def test_the_right_track_is_the_documented_sum_of_harmonics():
+    """iso8608_profiles' right track against its formula summed directly (no
+    FFT): Σ A_k (ρ_k cos(2πn_k x + φ_k) + √(1-ρ_k²) cos(2πn_k x + ψ_k)), with
+    the period, the band and the phases as the docstrings state them."""
+    length, dx, track, seed = 20.0, 0.1, 1.5, 5
+    x, left, right = road.iso8608_profiles(length, dx, track, "B", seed)
+    N = int(np.ceil(max(length, 10 / 0.011) / dx)) + 1
+    N += N % 2
+    n = np.arange(N // 2 + 1) / (N * dx)
+    inside = (n >= 0.011) & (n <= 2.83) & (np.arange(n.size) < N // 2)
+    A = np.where(inside, np.sqrt(2 * road.iso8608_psd(np.maximum(n, 1e-9), "B") / (N * dx)), 0.0)
+    phi = np.random.default_rng(seed).uniform(0, 2 * np.pi, n.size)
+    psi = np.random.default_rng([seed, 1]).uniform(0, 2 * np.pi, n.size)
+    rho = road.isotropic_coherence(n, track)
+    arg = 2 * np.pi * np.outer(x, n)
+    expected_left = np.cos(arg + phi) @ A
+    expected_right = (rho * np.cos(arg + phi) + np.sqrt(1 - rho**2) * np.cos(arg + psi)) @ A
+    scale = np.max(np.abs(expected_left))
+    # thousands of terms summed two ways: rounding, 1e-12 of the amplitude
+    np.testing.assert_allclose(left, expected_left, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(right, expected_right, rtol=0, atol=1e-12 * scale)
