@@ -120,10 +120,11 @@ def _damping(cmp) -> list[str]:
     out = [text]
     for m, nm in cmp.numerical_modes.items():
         b = nm.loc[first.name]
+        label = first.name.replace(" ", "-")  # "body-bounce" on a quarter car
         worst = nm["freq error [%]"].abs().idxmax()
         sign = "adds" if b["zeta error"] > 0 else "removes"
         out.append(
-            f"{m} at h = {fmt(cmp.h)} s {sign} damping: {first.name} ζ {fmt(b['zeta'])} → "
+            f"{m} at h = {fmt(cmp.h)} s {sign} damping: {label} ζ {fmt(b['zeta'])} → "
             f"{fmt(b['zeta_h'])} (Δζ = {b['zeta error']:+.2g}); its largest frequency error is "
             f"{fmt(nm.loc[worst, 'freq error [%]'])}% ({worst})."
         )
