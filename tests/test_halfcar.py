@@ -337,6 +337,7 @@ def test_the_report_of_a_half_car_comparison(half_car_comparison, tmp_path):
     report = qc.write_report(half_car_comparison, tmp_path / "report", formats=("md",))
     text = (report / "report.md").read_text(encoding="utf-8")
     assert "pitch" in text and "susp_travel_front" in text and "lift" in text
+    assert "xu_rear; m/s, rad/s, m and rad)" in text  # the states' units
 
 
 def test_a_sweep_over_half_car_designs_matches_each_exact_response():

@@ -225,9 +225,17 @@ def _scenario_text(cmp) -> str:
         else f"forced response to the input(s) {', '.join(cmp.system.input_labels)}"
         + (f" ({cmp.input_description})" if getattr(cmp, "input_description", "") else "")
     )
+    model = getattr(cmp, "model", None)
+    # the states' units in order of first use: "m/s and m" on a quarter car
+    units = (
+        list(dict.fromkeys(model.unit(s) for s in cmp.system.state_labels))
+        if model is not None
+        else ["m/s", "m"]
+    )
+    unit_text = " and ".join([", ".join(units[:-1]), units[-1]] if len(units) > 1 else units)
     return (
         f"Scenario: {kind}, from X0 = [{x0}] (states {', '.join(cmp.system.state_labels)}; "
-        f"m/s and m), over {fmt(t0)}–{fmt(t1)} s with h = {fmt(cmp.h)} s "
+        f"{unit_text}), over {fmt(t0)}–{fmt(t1)} s with h = {fmt(cmp.h)} s "
         f"({cmp.table['steps'].iloc[0]} steps). SI units throughout."
     )
 
