@@ -12,6 +12,8 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import warnings
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import fields
 from importlib.metadata import version
@@ -24,7 +26,7 @@ from .modal import modal_analysis
 from .report import ReportError, check_target, write_report
 from .scenario import MODELS, ROADS, Scenario, ScenarioError, road_option, vehicle_keys
 
-__all__ = ["run", "build_parser", "scenario_from_args", "UsageError"]
+__all__ = ["run", "build_parser", "scenario_from_args", "summarise_warnings", "UsageError"]
 
 _PROG = "qc-control"
 #: The run's options of ``report``, as fields of `qc_control.Scenario`.
@@ -313,6 +315,43 @@ def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split())
 
 
+#: numpy's floating-point warnings ("overflow encountered in exp"), in words
+_FP_WORDS = {
+    "overflow": "overflowed",
+    "invalid value": "gave NaN",
+    "divide by zero": "divided by zero",
+    "underflow": "underflowed",
+}
+
+
+def summarise_warnings(caught) -> list[str]:
+    """The run's warnings, each distinct one once, in words, with its count.
+
+    numpy's floating-point warnings ("overflow encountered in square") are one
+    line together: they come from a response that grew past float range, which
+    the report already flags; a diverged run can raise dozens of them.
+    """
+    floating: Counter[str] = Counter()
+    other: Counter[str] = Counter()
+    for w in caught:
+        text = " ".join(str(w.message).split())
+        kind = text.split(" encountered in ")[0]
+        if w.category is RuntimeWarning and kind in _FP_WORDS:
+            floating[kind] += 1
+        else:
+            other[text] += 1
+    lines = [text + (f" ({n} times)" if n > 1 else "") for text, n in other.items()]
+    if floating:
+        n = sum(floating.values())
+        what = ", ".join(_FP_WORDS[k] for k in floating)
+        lines.append(
+            f"{n} floating-point operation{'s' if n > 1 else ''} {what}: a response "
+            "grew beyond the range of floating point (a step beyond a stability limit, or an "
+            "extreme design); the numbers it touched are inf or NaN"
+        )
+    return lines
+
+
 def run(argv: list[str]) -> int:
     """Run ``qc-control`` with the arguments ``argv``; returns the exit status.
 
@@ -323,7 +362,13 @@ def run(argv: list[str]) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
-        return args.run(args)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                return args.run(args)
+            finally:
+                for line in summarise_warnings(caught):
+                    print(f"{_PROG}: warning: {line}", file=sys.stderr)
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
     except (UsageError, ScenarioError) as exc:

@@ -215,6 +215,10 @@ def _observed_order(hs, errors) -> float:
     return float(np.polyfit(np.log(hs[ok]), np.log(errors[ok]), 1)[0])
 
 
+#: RHS evaluations beyond any run: a cost extrapolated past it is "unreached".
+_MAX_COST = 1e15
+
+
 def _cost_to_reach(conv: pd.DataFrame, method: ButcherTableau, span: float, h_max: float) -> dict:
     """RHS evaluations for max |xs error| = tol, for each tolerance.
 
@@ -238,13 +242,16 @@ def _cost_to_reach(conv: pd.DataFrame, method: ButcherTableau, span: float, h_ma
         lt = math.log(tol)
         if log_e[-1] <= lt <= log_e[0] and len(rows) > 1:
             # errors fall as nfev grows: interpolate on the reversed (increasing) arrays
-            n = math.exp(np.interp(lt, log_e[::-1], log_n[::-1]))
+            log_cost = float(np.interp(lt, log_e[::-1], log_n[::-1]))
             kind = "interpolated"
         else:
             i = 0 if lt > log_e[0] else -1
-            n = math.exp(log_n[i] + (log_e[i] - lt) / method.order)
+            log_cost = log_n[i] + (log_e[i] - lt) / method.order
             kind = "extrapolated"
-        result[tol] = (int(max(math.ceil(n), fewest)), kind)
+        if log_cost > math.log(_MAX_COST):  # e.g. errors of 1e300 from an x0 of 1e308
+            result[tol] = (math.nan, "unreached")
+            continue
+        result[tol] = (int(max(math.ceil(math.exp(log_cost)), fewest)), kind)
     return result
 
 
@@ -370,13 +377,14 @@ def error_table(responses: dict, reference: Reference, model: VehicleModel) -> p
     body = labels.index(model.body_disp)
     rows = {}
     for name, resp in responses.items():
-        with np.errstate(invalid="ignore"):
+        # a diverged run's errors are inf (or overflow to it): that is the answer
+        with np.errstate(invalid="ignore", over="ignore"):
             err = _outputs(resp, ref.shape[1]) - ref
-        row = {}
-        for i, label in enumerate(labels):
-            unit = model.unit(label)
-            row[f"max |{label} err| [{unit}]"] = float(np.max(np.abs(err[i])))
-            row[f"rms {label} err [{unit}]"] = float(np.sqrt(np.mean(err[i] ** 2)))
+            row = {}
+            for i, label in enumerate(labels):
+                unit = model.unit(label)
+                row[f"max |{label} err| [{unit}]"] = float(np.max(np.abs(err[i])))
+                row[f"rms {label} err [{unit}]"] = float(np.sqrt(np.mean(err[i] ** 2)))
         row[f"final |{model.body_disp} err| [{model.unit(model.body_disp)}]"] = float(
             abs(err[body, -1])
         )

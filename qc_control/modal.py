@@ -258,6 +258,8 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
     zeta_nominal = MinvC[0, 0] / (2.0 * math.sqrt(MinvK[0, 0])) if MinvK[0, 0] > 0 else math.nan
 
     eigvals, eigvecs = np.linalg.eig(A)
+    # a damping ratio below MARGINAL_RTOL is rounding: reported as 0, never < 0
+    eigvals = stability.settle_marginal(eigvals)
     groups = _pair_eigenvalues(eigvals, eigvecs)
     names = _classify([_shape(v) for _, v in groups])
 

@@ -387,6 +387,10 @@ def road_from_mapping(values: Mapping[str, Any]) -> Road:
 # ------------------------------------------------------------- scenario
 
 
+#: The largest |x0| entry: its square (RMS errors, energies) stays far inside float range.
+MAX_STATE = 1e150
+
+
 @dataclass(frozen=True)
 class ModelKind:
     """A vehicle a `Scenario` can run: its parameters and how to build it.
@@ -697,6 +701,15 @@ class Scenario:
             raise ScenarioError(
                 f"x0 must be {len(names)} comma-separated numbers, all finite: "
                 f"{', '.join(names)} [{', '.join(units[n] for n in names)}]; got {x0!r}",
+                "scenario",
+                "x0",
+            )
+        big = [v for v in values if abs(v) > MAX_STATE]
+        if big:
+            raise ScenarioError(
+                f"x0 = {big[0]!r} is beyond {MAX_STATE:.0e}: the comparison squares the "
+                "states (RMS errors, energies), and the square of such a value overflows "
+                "double precision; the car is linear, so a smaller x0 scales the response",
                 "scenario",
                 "x0",
             )

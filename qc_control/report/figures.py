@@ -190,6 +190,9 @@ def overlay_figure(cmp) -> Figure:
     return fig
 
 
+_ERROR_CEILING = 1e200  # [m] far beyond any physical error, far below float overflow
+
+
 def error_figure(cmp) -> Figure:
     """|xs error| against time on a log axis."""
     colors, rank = _colors(cmp.responses), _rank(cmp)
@@ -197,11 +200,26 @@ def error_figure(cmp) -> Figure:
     ax = fig.subplots()
     body = _body_wheel(cmp)[0]
     exact = output_signal(cmp.reference, body)
+    clipped = False
     for name, resp in cmp.responses.items():
         n = resp.time.size
-        err = np.abs(output_signal(resp, body) - exact[:n])
+        with np.errstate(invalid="ignore", over="ignore"):  # a diverged run: inf, shown clipped
+            err = np.abs(output_signal(resp, body) - exact[:n])
         err = np.where(err > 0, err, np.nan)  # exact zeros (t = 0) have no log
+        # the log axis pads its range by a factor; past ~1e300 that overflows
+        clipped |= bool(np.any(err > _ERROR_CEILING))
+        err = np.minimum(err, _ERROR_CEILING)
         ax.semilogy(resp.time, err, color=colors[name], lw=1, label=name, **_style(cmp, name, rank))
+    if clipped:
+        ax.axhline(_ERROR_CEILING, color="0.5", lw=0.8, ls="--")
+        ax.annotate(
+            f"diverged: errors above {_ERROR_CEILING:.0e} m drawn on this line",
+            (0.01, _ERROR_CEILING),
+            xycoords=("axes fraction", "data"),
+            va="top",
+            fontsize="small",
+            color="0.3",
+        )
     ax.set(
         xlabel="time [s]",
         ylabel=f"|{body} − {body} exact| [m]",

@@ -39,11 +39,17 @@ def _step_limits(cmp) -> list[str]:
     out = []
     if "euler" in t.index:
         row = t.loc["euler"]
-        out.append(
-            f"Euler's step limit is h = {fmt(row['h_max [s]'])} s, set by the "
-            f"{row['limited by']} mode (|1 + hλ| ≤ 1, i.e. h ≤ −2·Re λ/|λ|²); the chosen "
-            f"h = {fmt(cmp.h)} s is {fmt(100 * cmp.h / row['h_max [s]'])}% of it."
-        )
+        if row["h_max [s]"] > 0:
+            out.append(
+                f"Euler's step limit is h = {fmt(row['h_max [s]'])} s, set by the "
+                f"{row['limited by']} mode (|1 + hλ| ≤ 1, i.e. h ≤ −2·Re λ/|λ|²); the chosen "
+                f"h = {fmt(cmp.h)} s is {fmt(100 * cmp.h / row['h_max [s]'])}% of it."
+            )
+        else:  # Re λ = 0: the limit −2·Re λ/|λ|² is zero
+            out.append(
+                f"Euler has no stable step: the {row['limited by']} mode is undamped "
+                "(Re λ = 0), so |1 + hλ| > 1 for every h > 0 and its amplitude grows at any step."
+            )
     others = [f"{m} {fmt(r['h_max [s]'])} s" for m, r in t.iterrows() if m != "euler"]
     if others:
         out.append("The other limits: " + ", ".join(others) + ".")
