@@ -89,6 +89,14 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         skyhook,
     )
     from .damping import DampingOptimum, ParetoFront, optimal_damping, pareto_front
+    from .halfcar import (
+        FullCarParams,
+        HalfCarParams,
+        full_car,
+        full_car_model,
+        half_car,
+        half_car_model,
+    )
     from .integrate import DivergenceWarning, Solution
     from .methods import METHODS, ButcherTableau, get_method
     from .metrics import Metric, RideSignals
@@ -194,6 +202,12 @@ _LAZY: dict[str, str] = {
     "lyapunov_variances": "spectral",
     "white_velocity_variances": "spectral",
     "iso8608_intensity": "spectral",
+    "HalfCarParams": "halfcar",
+    "FullCarParams": "halfcar",
+    "half_car": "halfcar",
+    "half_car_model": "halfcar",
+    "full_car": "halfcar",
+    "full_car_model": "halfcar",
 }
 
 
@@ -283,4 +297,10 @@ __all__ = [
     "lqr_controller",
     "hinf_controller",
     "HinfDesign",
+    "HalfCarParams",
+    "FullCarParams",
+    "half_car",
+    "half_car_model",
+    "full_car",
+    "full_car_model",
 ]

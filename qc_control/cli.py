@@ -28,13 +28,13 @@ from .modal import modal_analysis
 from .model import QuarterCarParams
 from .report import ReportError, check_target, write_report
 from .report.control import write_control_report
-from .scenario import ROADS, Scenario, ScenarioError, road_option
+from .scenario import MODELS, ROADS, Scenario, ScenarioError, road_option, vehicle_keys
 
 __all__ = ["run", "build_parser", "scenario_from_args", "summarise_warnings", "UsageError"]
 
 _PROG = "qc-control"
 #: The run's options of ``report``, as fields of `qc_control.Scenario`.
-_RUN_OPTIONS = ("t_end", "h", "x0", "methods", "max_steps")
+_RUN_OPTIONS = ("model", "t_end", "h", "x0", "methods", "max_steps")
 
 
 class UsageError(Exception):
@@ -58,10 +58,24 @@ def _floats(text: str) -> list[float]:
 
 def _add_vehicle(parser: argparse.ArgumentParser) -> None:
 
-    group = parser.add_argument_group("vehicle (SI units; defaults: the seed's Table 1)")
-    for f in fields(QuarterCarParams):
+    group = parser.add_argument_group(
+        "vehicle (SI units; defaults: the seed's Table 1 for the quarter car)"
+    )
+    group.add_argument(
+        "--model",
+        choices=list(MODELS),
+        help="the vehicle: "
+        + ", ".join(f"{name} ({kind.description})" for name, kind in MODELS.items())
+        + "; default quarter",
+    )
+    users: dict[str, list[str]] = {}
+    for name, kind in MODELS.items():
+        for f in fields(kind.params):
+            users.setdefault(f.name, []).append(name)
+    for key in vehicle_keys():
+        which = "" if len(users[key]) == len(MODELS) else f" ({', '.join(users[key])} car)"
         group.add_argument(
-            f"--{f.name}", type=float, metavar="X", help=f"{f.name}, overrides the config file"
+            f"--{key}", type=float, metavar="X", help=f"{key}{which}, overrides the config file"
         )
     group.add_argument(
         "--config",
@@ -209,9 +223,7 @@ def build_parser() -> argparse.ArgumentParser:
 def scenario_from_args(args: argparse.Namespace):
     """The `qc_control.Scenario` of parsed arguments: ``--config``, then the options over it."""
     doc: dict = {
-        f.name: getattr(args, f.name)
-        for f in fields(QuarterCarParams)
-        if getattr(args, f.name, None) is not None
+        key: getattr(args, key) for key in vehicle_keys() if getattr(args, key, None) is not None
     }
     run = {k: getattr(args, k) for k in _RUN_OPTIONS if getattr(args, k, None) is not None}
     road = {"kind": args.road_kind} if getattr(args, "road_kind", None) is not None else {}

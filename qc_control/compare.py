@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 import scipy.signal
 
+from .halfcar import FullCarParams, HalfCarParams
 from .integrate import DivergenceWarning, check_time_grid, uniform_step
 from .limits import check_memory
 from .methods import ButcherTableau, get_method
@@ -140,16 +141,14 @@ class MethodComparison:
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""
-        cols = [
-            "order",
-            "RHS evals",
-            "wall time [ms]",
-            "max |xs err| [m]",
-            "max |xu err| [m]",
-            "observed order",
-            "h_max [s]",
-        ]
-        return self.table[cols]
+        model = self.model
+        errors = [f"max |{model.body_disp if model else 'xs'} err| [m]"]
+        if model is not None and len(model.corners) > 1:  # each corner's travel error
+            errors += [f"max |{c.susp_travel} err| [m]" for c in model.corners]
+        else:
+            errors.append("max |xu err| [m]")
+        cols = ["order", "RHS evals", "wall time [ms]", *errors, "observed order", "h_max [s]"]
+        return self.table[[c for c in cols if c in self.table.columns]]
 
 
 def best_time(fn: Callable[[], object], repeats: int, warmup: bool = False) -> float:
@@ -541,6 +540,9 @@ def _as_model(sys, U, params) -> tuple[control.StateSpace, VehicleModel | None, 
     """(system, model, params) from a system, parameters, a model, or None."""
     if isinstance(sys, VehicleModel):
         return sys.system, sys, sys.params
+    if isinstance(sys, (HalfCarParams, FullCarParams)):
+        model = sys.model(road=U is not None)
+        return model.system, model, model.params
     if sys is None or isinstance(sys, (QuarterCarParams, dict)):
         model = quarter_car_model(as_params(sys), road=U is not None)
         return model.system, model, model.params
@@ -586,9 +588,10 @@ def compare_methods(
 
     Parameters
     ----------
-    sys : control.StateSpace, VehicleModel or QuarterCarParams
-        The vehicle. Parameters build
-        ``quarter_car_model(params, road=U is not None)``.
+    sys : control.StateSpace, VehicleModel, QuarterCarParams, HalfCarParams or FullCarParams
+        The vehicle. Parameters build their model with the road inputs when
+        ``U`` is given (``quarter_car_model(params, road=U is not None)``);
+        a half or full car then needs ``X0`` of its 8 or 14 states.
     T : array_like, optional
         Uniform output grid [s]; default 0-10 s at 0.01 s.
     X0 : array_like, default ``(0, 0, 0.05, 0)``
@@ -701,9 +704,11 @@ def compare_methods(
 
     ride, ride_error, trans = None, None, None
     roads = model.road_inputs()
-    if U is not None and len(roads) == 1 and list(sys.input_labels) == roads:
+    if U is not None and roads and list(sys.input_labels) == roads:
         ride, ride_error = ride_comparison(reference, responses, model)
-        trans = transmissibility(sys) if params is not None else None
+        # one road input: the quarter car's transmissibility (a car on several axles
+        # needs the speed for its wheelbase delay: qc.transmissibility(model, speed=V))
+        trans = transmissibility(sys) if params is not None and len(roads) == 1 else None
     return MethodComparison(
         system=sys,
         params=params,

@@ -74,6 +74,12 @@ class ReportError(ValueError):
     """The report cannot be written where it was asked to go."""
 
 
+def _body(cmp) -> str:
+    """The label of the body displacement the errors are measured on (``xs``, ``z``)."""
+    model = getattr(cmp, "model", None)
+    return model.body_disp if model is not None else "xs"
+
+
 def _versions() -> dict[str, str]:
     """The installed versions behind the numbers, from the distributions' metadata."""
     names = {
@@ -153,7 +159,7 @@ def figure_specs(cmp) -> list[FigureSpec]:
             (
                 f"method_{_slug(name)}.png",
                 f"{name}: displacement of the suspension (sprung mass, red solid) and of "
-                f"the wheel (blue dashed) against the exact xs (dark grey) and xu (light "
+                f"the wheel (blue dashed) against the exact ones (dark grey, light "
                 f"grey, dashed), h = {cmp.h:g} s",
                 functools.partial(method_figure, cmp, name),
                 SEED_FIGURES.get(name),
@@ -168,13 +174,13 @@ def figure_specs(cmp) -> list[FigureSpec]:
         ),
         (
             "convergence.png",
-            "Max |xs error| against h, with slope guides of each order",
+            f"Max |{_body(cmp)} error| against h, with slope guides of each order",
             lambda: convergence_figure(cmp),
             None,
         ),
         (
             "work_precision.png",
-            "Max |xs error| against RHS evaluations (machine-independent) and against "
+            f"Max |{_body(cmp)} error| against RHS evaluations (machine-independent) and against "
             "wall time (measured on this machine)",
             lambda: work_precision_figure(cmp),
             None,
@@ -220,9 +226,17 @@ def _scenario_text(cmp) -> str:
         else f"forced response to the input(s) {', '.join(cmp.system.input_labels)}"
         + (f" ({cmp.input_description})" if getattr(cmp, "input_description", "") else "")
     )
+    model = getattr(cmp, "model", None)
+    # the states' units in order of first use: "m/s and m" on a quarter car
+    units = (
+        list(dict.fromkeys(model.unit(s) for s in cmp.system.state_labels))
+        if model is not None
+        else ["m/s", "m"]
+    )
+    unit_text = " and ".join([", ".join(units[:-1]), units[-1]] if len(units) > 1 else units)
     return (
         f"Scenario: {kind}, from X0 = [{x0}] (states {', '.join(cmp.system.state_labels)}; "
-        f"m/s and m), over {fmt(t0)}–{fmt(t1)} s with h = {fmt(cmp.h)} s "
+        f"{unit_text}), over {fmt(t0)}–{fmt(t1)} s with h = {fmt(cmp.h)} s "
         f"({cmp.table['steps'].iloc[0]} steps). SI units throughout."
     )
 
@@ -318,7 +332,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
     conv = cmp.convergence.pivot(index="h", columns="method", values="error")
     conv = conv.sort_index(ascending=False)[[t.name for t in cmp.methods]]
     conv.index.name = "h [s]"
-    blocks.append(Table(conv, "Max |xs error| [m] at h, h/2, …, h/32"))
+    blocks.append(Table(conv, f"Max |{_body(cmp)} error| [m] at h, h/2, …, h/32"))
     blocks.append(
         Table(
             table[["order", "observed order"]],
@@ -353,7 +367,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
     blocks.append(
         Table(
             reach,
-            "RHS evaluations to reach each max |xs error| "
+            f"RHS evaluations to reach each max |{_body(cmp)} error| "
             "(i: interpolated between refinements, e: extrapolated with "
             "e = C·h^p, never beyond h_max)",
         )
