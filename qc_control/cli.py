@@ -75,7 +75,11 @@ def _add_vehicle(parser: argparse.ArgumentParser) -> None:
     for key in vehicle_keys():
         which = "" if len(users[key]) == len(MODELS) else f" ({', '.join(users[key])} car)"
         group.add_argument(
-            f"--{key}", type=float, metavar="X", help=f"{key}{which}, overrides the config file"
+            "--" + key.replace("_", "-"),  # one spelling for options: --ks-front, as --t-end
+            dest=key,
+            type=float,
+            metavar="X",
+            help=f"{key}{which}, overrides the config file",
         )
     group.add_argument(
         "--config",
@@ -362,7 +366,7 @@ def _control_command(args, designs: list[str]) -> str:
         parts += ["--config", str(args.config)]
     for f in fields(QuarterCarParams):
         if getattr(args, f.name, None) is not None:
-            parts += [f"--{f.name}", repr(getattr(args, f.name))]
+            parts += ["--" + f.name.replace("_", "-"), repr(getattr(args, f.name))]
     parts += ["--designs", "'" + ",".join("hinf" if d == "H∞" else d for d in designs) + "'"]
     for option in ("road_class", "speed", "road_duration", "bump_duration", "method", "cmax"):
         parts += ["--" + option.replace("_", "-"), str(getattr(args, option))]
@@ -371,6 +375,11 @@ def _control_command(args, designs: list[str]) -> str:
 
 def _cmd_control_report(args) -> int:
     params = scenario_from_args(args).vehicle
+    if not isinstance(params, QuarterCarParams):
+        raise UsageError(
+            f"control-report compares controllers on the quarter car only, got --model "
+            f"{args.model}; the half and full car take the passive tools (report, modes)"
+        )
     designs = _designs(args.designs)
     out = _check_out(args.out)
     if not args.quiet:

@@ -925,7 +925,7 @@ class Scenario:
             if self.model != "quarter":
                 args += _option("--model", self.model)
             for name, value in self.vehicle.to_dict().items():
-                args += _option(f"--{name}", repr(value))
+                args += _option("--" + name.replace("_", "-"), repr(value))
             args += _option("--t-end", repr(self.t_end))
             args += _option("--h", repr(self.h))
             args += _option("--x0", ",".join(map(repr, self.x0)))

@@ -97,6 +97,8 @@ BAD = [
     (["report", "--x0", "1,a,0,0"], "--x0 must be 4 comma-separated numbers"),
     # found by tests/test_properties.py: an internal OverflowError in the cost study
     (["report", "--x0", "1e308,0,0,0"], "--x0 1e+308 is beyond 1e+150"),
+    (["control-report", "--model", "half"], "control-report compares controllers on the quarter"),
+    (["modes", "--model", "half", "--ks_front", "1"], "unrecognized arguments: --ks_front"),
     (["report", "--methods", "rk5"], "--methods: unknown method 'rk5'"),
     (["report", "--methods", ""], "--methods must name at least one method"),
     (["report", "--t-end", "-1"], "--t-end must be a finite number > 0 s, got -1.0"),

@@ -153,6 +153,10 @@ VEHICLE = {
     "--ku": (["29530", "3e5", "1e7"], BAD_NUMBERS),
     "--zeta": (["0.3", "1", "2", "0"], BAD_NUMBERS),
     "--cs": (["3000", "500", "0"], BAD_NUMBERS),
+    "--model": (["quarter", "half", "full"], ["bicycle", ""]),
+    "--a": (["1.2", "1.5"], BAD_NUMBERS),
+    "--ks-front": (["30000"], BAD_NUMBERS),
+    "--arb-rear": (["8000", "0"], BAD_NUMBERS),
 }
 REPORT = {
     "--h": (["0.01", "0.02", "0.05"], BAD_NUMBERS),

@@ -76,7 +76,7 @@ def test_toml_and_command_round_trip(model):
 
 
 def test_modes_command_prints_the_named_modes(capsys):
-    assert run(["modes", "--model", "full", "--arb_front", "20000"]) == 0
+    assert run(["modes", "--model", "full", "--arb-front", "20000"]) == 0
     out = capsys.readouterr().out
     for name in ("bounce", "pitch", "roll", "front axle tramp"):
         assert name in out
