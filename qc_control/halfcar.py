@@ -42,6 +42,9 @@ The default vehicle is the passenger car of Ikenaga, Lewis, Campos and Davis,
 "Active suspension control of ground vehicle based on a full-vehicle model",
 Proc. American Control Conference 2000, pp. 4019-4024 (Table 1); the half car
 is its bicycle half (half the body mass and pitch inertia, one corner per axle).
+Its spring, damper, unsprung-mass and tire values and Iy agree with the public
+parameter file ``half_car_parameter.m`` of github.com/junhyukch7/Semi-Active-Suspension;
+ms, Ix, a, b and the tracks are quoted from the paper's Table 1, not rechecked here.
 """
 
 from __future__ import annotations
