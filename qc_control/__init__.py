@@ -77,6 +77,26 @@ except PackageNotFoundError:  # pragma: no cover - a source tree that was never 
 if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from . import road, spectral
     from .compare import MethodComparison, compare_methods
+    from .control_study import ControlComparison, compare_controllers
+    from .controllers import (
+        HinfDesign,
+        add_damper,
+        closed_loop,
+        groundhook,
+        hinf_controller,
+        hybrid,
+        lqr_controller,
+        skyhook,
+    )
+    from .damping import DampingOptimum, ParetoFront, optimal_damping, pareto_front
+    from .halfcar import (
+        FullCarParams,
+        HalfCarParams,
+        full_car,
+        full_car_model,
+        half_car,
+        half_car_model,
+    )
     from .integrate import DivergenceWarning, Solution
     from .methods import METHODS, ButcherTableau, get_method
     from .metrics import Metric, RideSignals
@@ -124,6 +144,20 @@ _LAZY: dict[str, str] = {
     "road": "road",
     "MethodComparison": "compare",
     "compare_methods": "compare",
+    "compare_controllers": "control_study",
+    "ControlComparison": "control_study",
+    "optimal_damping": "damping",
+    "pareto_front": "damping",
+    "DampingOptimum": "damping",
+    "ParetoFront": "damping",
+    "closed_loop": "controllers",
+    "skyhook": "controllers",
+    "groundhook": "controllers",
+    "hybrid": "controllers",
+    "add_damper": "controllers",
+    "lqr_controller": "controllers",
+    "hinf_controller": "controllers",
+    "HinfDesign": "controllers",
     "DivergenceWarning": "integrate",
     "Solution": "integrate",
     "METHODS": "methods",
@@ -174,6 +208,12 @@ _LAZY: dict[str, str] = {
     "white_velocity_variances": "spectral",
     "iso8608_intensity": "spectral",
     "ISO8608Road": "spectral",
+    "HalfCarParams": "halfcar",
+    "FullCarParams": "halfcar",
+    "half_car": "halfcar",
+    "half_car_model": "halfcar",
+    "full_car": "halfcar",
+    "full_car_model": "halfcar",
 }
 
 
@@ -250,4 +290,24 @@ __all__ = [
     "white_velocity_variances",
     "iso8608_intensity",
     "ISO8608Road",
+    "compare_controllers",
+    "ControlComparison",
+    "optimal_damping",
+    "pareto_front",
+    "DampingOptimum",
+    "ParetoFront",
+    "closed_loop",
+    "skyhook",
+    "groundhook",
+    "hybrid",
+    "add_damper",
+    "lqr_controller",
+    "hinf_controller",
+    "HinfDesign",
+    "HalfCarParams",
+    "FullCarParams",
+    "half_car",
+    "half_car_model",
+    "full_car",
+    "full_car_model",
 ]

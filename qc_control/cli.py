@@ -12,6 +12,8 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import warnings
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import fields
 from importlib.metadata import version
@@ -20,16 +22,19 @@ from typing import Any
 
 import pandas as pd
 
+from .control_study import DESIGNS, compare_controllers
+from .controllers import HINF_AVAILABLE
 from .modal import modal_analysis
 from .model import QuarterCarParams
 from .report import ReportError, check_target, write_report
-from .scenario import ROADS, Scenario, ScenarioError, road_option
+from .report.control import write_control_report
+from .scenario import MODELS, ROADS, Scenario, ScenarioError, road_option, vehicle_keys
 
-__all__ = ["run", "build_parser", "scenario_from_args", "UsageError"]
+__all__ = ["run", "build_parser", "scenario_from_args", "summarise_warnings", "UsageError"]
 
 _PROG = "qc-control"
 #: The run's options of ``report``, as fields of `qc_control.Scenario`.
-_RUN_OPTIONS = ("t_end", "h", "x0", "methods", "max_steps")
+_RUN_OPTIONS = ("model", "t_end", "h", "x0", "methods", "max_steps")
 
 
 class UsageError(Exception):
@@ -53,10 +58,28 @@ def _floats(text: str) -> list[float]:
 
 def _add_vehicle(parser: argparse.ArgumentParser) -> None:
 
-    group = parser.add_argument_group("vehicle (SI units; defaults: the seed's Table 1)")
-    for f in fields(QuarterCarParams):
+    group = parser.add_argument_group(
+        "vehicle (SI units; defaults: the seed's Table 1 for the quarter car)"
+    )
+    group.add_argument(
+        "--model",
+        choices=list(MODELS),
+        help="the vehicle: "
+        + ", ".join(f"{name} ({kind.description})" for name, kind in MODELS.items())
+        + "; default quarter",
+    )
+    users: dict[str, list[str]] = {}
+    for name, kind in MODELS.items():
+        for f in fields(kind.params):
+            users.setdefault(f.name, []).append(name)
+    for key in vehicle_keys():
+        which = "" if len(users[key]) == len(MODELS) else f" ({', '.join(users[key])} car)"
         group.add_argument(
-            f"--{f.name}", type=float, metavar="X", help=f"{f.name}, overrides the config file"
+            "--" + key.replace("_", "-"),  # one spelling for options: --ks-front, as --t-end
+            dest=key,
+            type=float,
+            metavar="X",
+            help=f"{key}{which}, overrides the config file",
         )
     group.add_argument(
         "--config",
@@ -166,15 +189,45 @@ def build_parser() -> argparse.ArgumentParser:
         "-q", "--quiet", action="store_true", help="no progress lines on stderr, only the summary"
     )
     report.set_defaults(run=_cmd_report)
+
+    ctl = sub.add_parser(
+        "control-report",
+        help="compare passive, semi-active and active suspensions (skyhook ... H∞) and "
+        "write the report",
+        allow_abbrev=False,
+    )
+    _add_vehicle(ctl)
+    ctl.add_argument(
+        "--designs",
+        metavar="A,B,...",
+        help=f"designs to compare (default all: {', '.join(DESIGNS)}; 'hinf' for H∞)",
+    )
+    ctl.add_argument("--road-class", default="C", metavar="A-H", help="ISO 8608 class (default C)")
+    ctl.add_argument("--speed", type=float, default=20.0, metavar="M/S", help="default 20")
+    ctl.add_argument(
+        "--road-duration", type=float, default=10.0, metavar="S", help="road run [s] (default 10)"
+    )
+    ctl.add_argument(
+        "--bump-duration", type=float, default=15.0, metavar="S", help="bump run [s] (default 15)"
+    )
+    ctl.add_argument("--method", default="rk4", help="fixed-step method (default rk4)")
+    ctl.add_argument(
+        "--cmax",
+        type=float,
+        default=4000.0,
+        metavar="N·S/M",
+        help="semi-active damper's largest damping (default 4000)",
+    )
+    ctl.add_argument("--out", default="control-report", metavar="DIR", help="report directory")
+    ctl.add_argument("-q", "--quiet", action="store_true", help="no progress line on stderr")
+    ctl.set_defaults(run=_cmd_control_report)
     return parser
 
 
 def scenario_from_args(args: argparse.Namespace):
     """The `qc_control.Scenario` of parsed arguments: ``--config``, then the options over it."""
     doc: dict = {
-        f.name: getattr(args, f.name)
-        for f in fields(QuarterCarParams)
-        if getattr(args, f.name, None) is not None
+        key: getattr(args, key) for key in vehicle_keys() if getattr(args, key, None) is not None
     }
     run = {k: getattr(args, k) for k in _RUN_OPTIONS if getattr(args, k, None) is not None}
     road = {"kind": args.road_kind} if getattr(args, "road_kind", None) is not None else {}
@@ -294,12 +347,112 @@ def _cmd_report(args) -> int:
     return 0
 
 
+def _designs(text: str | None) -> list[str]:
+    if text is None:
+        return [d for d in DESIGNS if d != "H∞" or HINF_AVAILABLE]
+    names = [("H∞" if n.strip().lower() in ("hinf", "h∞") else n.strip()) for n in text.split(",")]
+    unknown = [n for n in names if n not in DESIGNS]
+    if unknown:
+        raise UsageError(f"--designs: unknown design {unknown[0]!r}; choose from {list(DESIGNS)}")
+    if "H∞" in names and not HINF_AVAILABLE:
+        raise UsageError("--designs: H∞ needs slycot: pip install 'qc-control[robust]'")
+    return names
+
+
+def _control_command(args, designs: list[str]) -> str:
+    """The command line that redoes this control report."""
+    parts = [_PROG, "control-report"]
+    if getattr(args, "config", None):
+        parts += ["--config", str(args.config)]
+    for f in fields(QuarterCarParams):
+        if getattr(args, f.name, None) is not None:
+            parts += ["--" + f.name.replace("_", "-"), repr(getattr(args, f.name))]
+    parts += ["--designs", "'" + ",".join("hinf" if d == "H∞" else d for d in designs) + "'"]
+    for option in ("road_class", "speed", "road_duration", "bump_duration", "method", "cmax"):
+        parts += ["--" + option.replace("_", "-"), str(getattr(args, option))]
+    return " ".join(parts + ["--out", str(args.out)])
+
+
+def _cmd_control_report(args) -> int:
+    params = scenario_from_args(args).vehicle
+    if not isinstance(params, QuarterCarParams):
+        raise UsageError(
+            f"control-report compares controllers on the quarter car only, got --model "
+            f"{args.model}; the half and full car take the passive tools (report, modes)"
+        )
+    designs = _designs(args.designs)
+    out = _check_out(args.out)
+    if not args.quiet:
+        _progress(f"qc-control control-report: {len(designs)} designs, bump and road runs")
+    try:
+        cmp = compare_controllers(
+            params,
+            designs=designs,
+            road_class=args.road_class,
+            speed=args.speed,
+            road_duration=args.road_duration,
+            bump_duration=args.bump_duration,
+            method=args.method,
+            cmax=args.cmax,
+        )
+    except ValueError as exc:  # the library names the bad value
+        raise UsageError(str(exc)) from None
+    command = _control_command(args, designs)
+    try:
+        path = write_control_report(cmp, out, command=command)
+    except ReportError as exc:
+        raise UsageError(str(exc)) from None
+    with pd.option_context(
+        "display.width", 200, "display.max_columns", 20, "display.float_format", "{:.4g}".format
+    ):
+        print(cmp.table)
+    print(f"\nwrote {path / 'report.html'}, report.pdf, report.md, the CSV tables and figures")
+    return 0
+
+
 def _progress(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
 
 
 def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split())
+
+
+#: numpy's floating-point warnings ("overflow encountered in exp"), in words
+_FP_WORDS = {
+    "overflow": "overflowed",
+    "invalid value": "gave NaN",
+    "divide by zero": "divided by zero",
+    "underflow": "underflowed",
+}
+
+
+def summarise_warnings(caught) -> list[str]:
+    """The run's warnings, each distinct one once, in words, with its count.
+
+    numpy's floating-point warnings ("overflow encountered in square") are one
+    line together: they come from a response that grew past float range, which
+    the report already flags; a diverged run can raise dozens of them.
+    """
+    floating: Counter[str] = Counter()
+    other: Counter[str] = Counter()
+    for w in caught:
+        text = " ".join(str(w.message).split())
+        kind = text.split(" encountered in ")[0]
+        if w.category is RuntimeWarning and kind in _FP_WORDS:
+            floating[kind] += 1
+        else:
+            other[text] += 1
+    lines = [text + (f" ({n} times)" if n > 1 else "") for text, n in other.items()]
+    if floating:
+        n = sum(floating.values())
+        what = ", ".join(_FP_WORDS[k] for k in floating)
+        lines.append(
+            f"{n} floating-point operation{'s' if n > 1 else ''} {what}: a response "
+            "grew beyond the range of floating point (a step beyond a stability limit, or an "
+            "extreme design); the numbers it touched are inf or NaN"
+        )
+    return lines
 
 
 def run(argv: list[str]) -> int:
@@ -312,7 +465,13 @@ def run(argv: list[str]) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
-        return args.run(args)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                return args.run(args)
+            finally:
+                for line in summarise_warnings(caught):
+                    print(f"{_PROG}: warning: {line}", file=sys.stderr)
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
     except (UsageError, ScenarioError) as exc:

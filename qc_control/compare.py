@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 import scipy.signal
 
+from .halfcar import FullCarParams, HalfCarParams
 from .integrate import DivergenceWarning, check_time_grid, uniform_step
 from .limits import check_memory
 from .methods import ButcherTableau, get_method
@@ -140,16 +141,14 @@ class MethodComparison:
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""
-        cols = [
-            "order",
-            "RHS evals",
-            "wall time [ms]",
-            "max |xs err| [m]",
-            "max |xu err| [m]",
-            "observed order",
-            "h_max [s]",
-        ]
-        return self.table[cols]
+        model = self.model
+        errors = [f"max |{model.body_disp if model else 'xs'} err| [m]"]
+        if model is not None and len(model.corners) > 1:  # each corner's travel error
+            errors += [f"max |{c.susp_travel} err| [m]" for c in model.corners]
+        else:
+            errors.append("max |xu err| [m]")
+        cols = ["order", "RHS evals", "wall time [ms]", *errors, "observed order", "h_max [s]"]
+        return self.table[[c for c in cols if c in self.table.columns]]
 
 
 def best_time(fn: Callable[[], object], repeats: int, warmup: bool = False) -> float:
@@ -216,6 +215,10 @@ def _observed_order(hs, errors) -> float:
     return float(np.polyfit(np.log(hs[ok]), np.log(errors[ok]), 1)[0])
 
 
+#: RHS evaluations beyond any run: a cost extrapolated past it is "unreached".
+_MAX_COST = 1e15
+
+
 def _cost_to_reach(conv: pd.DataFrame, method: ButcherTableau, span: float, h_max: float) -> dict:
     """RHS evaluations for max |xs error| = tol, for each tolerance.
 
@@ -239,13 +242,16 @@ def _cost_to_reach(conv: pd.DataFrame, method: ButcherTableau, span: float, h_ma
         lt = math.log(tol)
         if log_e[-1] <= lt <= log_e[0] and len(rows) > 1:
             # errors fall as nfev grows: interpolate on the reversed (increasing) arrays
-            n = math.exp(np.interp(lt, log_e[::-1], log_n[::-1]))
+            log_cost = float(np.interp(lt, log_e[::-1], log_n[::-1]))
             kind = "interpolated"
         else:
             i = 0 if lt > log_e[0] else -1
-            n = math.exp(log_n[i] + (log_e[i] - lt) / method.order)
+            log_cost = log_n[i] + (log_e[i] - lt) / method.order
             kind = "extrapolated"
-        result[tol] = (int(max(math.ceil(n), fewest)), kind)
+        if log_cost > math.log(_MAX_COST):  # e.g. errors of 1e300 from an x0 of 1e308
+            result[tol] = (math.nan, "unreached")
+            continue
+        result[tol] = (int(max(math.ceil(math.exp(log_cost)), fewest)), kind)
     return result
 
 
@@ -371,13 +377,14 @@ def error_table(responses: dict, reference: Reference, model: VehicleModel) -> p
     body = labels.index(model.body_disp)
     rows = {}
     for name, resp in responses.items():
-        with np.errstate(invalid="ignore"):
+        # a diverged run's errors are inf (or overflow to it): that is the answer
+        with np.errstate(invalid="ignore", over="ignore"):
             err = _outputs(resp, ref.shape[1]) - ref
-        row = {}
-        for i, label in enumerate(labels):
-            unit = model.unit(label)
-            row[f"max |{label} err| [{unit}]"] = float(np.max(np.abs(err[i])))
-            row[f"rms {label} err [{unit}]"] = float(np.sqrt(np.mean(err[i] ** 2)))
+            row = {}
+            for i, label in enumerate(labels):
+                unit = model.unit(label)
+                row[f"max |{label} err| [{unit}]"] = float(np.max(np.abs(err[i])))
+                row[f"rms {label} err [{unit}]"] = float(np.sqrt(np.mean(err[i] ** 2)))
         row[f"final |{model.body_disp} err| [{model.unit(model.body_disp)}]"] = float(
             abs(err[body, -1])
         )
@@ -533,6 +540,9 @@ def _as_model(sys, U, params) -> tuple[control.StateSpace, VehicleModel | None, 
     """(system, model, params) from a system, parameters, a model, or None."""
     if isinstance(sys, VehicleModel):
         return sys.system, sys, sys.params
+    if isinstance(sys, (HalfCarParams, FullCarParams)):
+        model = sys.model(road=U is not None)
+        return model.system, model, model.params
     if sys is None or isinstance(sys, (QuarterCarParams, dict)):
         model = quarter_car_model(as_params(sys), road=U is not None)
         return model.system, model, model.params
@@ -578,9 +588,10 @@ def compare_methods(
 
     Parameters
     ----------
-    sys : control.StateSpace, VehicleModel or QuarterCarParams
-        The vehicle. Parameters build
-        ``quarter_car_model(params, road=U is not None)``.
+    sys : control.StateSpace, VehicleModel, QuarterCarParams, HalfCarParams or FullCarParams
+        The vehicle. Parameters build their model with the road inputs when
+        ``U`` is given (``quarter_car_model(params, road=U is not None)``);
+        a half or full car then needs ``X0`` of its 8 or 14 states.
     T : array_like, optional
         Uniform output grid [s]; default 0-10 s at 0.01 s.
     X0 : array_like, default ``(0, 0, 0.05, 0)``
@@ -693,9 +704,11 @@ def compare_methods(
 
     ride, ride_error, trans = None, None, None
     roads = model.road_inputs()
-    if U is not None and len(roads) == 1 and list(sys.input_labels) == roads:
+    if U is not None and roads and list(sys.input_labels) == roads:
         ride, ride_error = ride_comparison(reference, responses, model)
-        trans = transmissibility(sys) if params is not None else None
+        # one road input: the quarter car's transmissibility (a car on several axles
+        # needs the speed for its wheelbase delay: qc.transmissibility(model, speed=V))
+        trans = transmissibility(sys) if params is not None and len(roads) == 1 else None
     return MethodComparison(
         system=sys,
         params=params,

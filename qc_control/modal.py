@@ -1,4 +1,10 @@
-"""Modal analysis of the quarter car: frequencies, damping and mode shapes."""
+"""Modal analysis of any vehicle: frequencies, damping, and modes named by shape.
+
+The quarter car's two modes are body bounce and wheel hop. A half or full car
+(`qc_control.halfcar`) has body modes (bounce, pitch, roll) and wheel modes
+(per axle: wheel hop, and on a full car axle tramp, the wheels against each
+other), named from their eigenvectors by `vehicle_modes`.
+"""
 
 from __future__ import annotations
 
@@ -8,11 +14,21 @@ from dataclasses import dataclass
 import control
 import numpy as np
 import pandas as pd
+import scipy.optimize
 
 from . import stability
+from .halfcar import FULL_CAR_CORNERS, HALF_CAR_CORNERS, FullCarParams, HalfCarParams
 from .model import QuarterCarParams, quarter_car
+from .vehicle import VehicleModel
 
-__all__ = ["Mode", "ModalAnalysis", "modal_analysis", "quarter_car_matrices", "numerical_modes"]
+__all__ = [
+    "Mode",
+    "ModalAnalysis",
+    "modal_analysis",
+    "vehicle_modes",
+    "quarter_car_matrices",
+    "numerical_modes",
+]
 
 BODY, WHEEL = "body bounce", "wheel hop"
 
@@ -24,7 +40,9 @@ class Mode:
     Attributes
     ----------
     name : str
-        ``'body bounce'`` or ``'wheel hop'``, from the mode shape.
+        From the mode shape: ``'body bounce'`` or ``'wheel hop'`` on a
+        quarter car; ``'bounce'``, ``'pitch'``, ``'roll'``, ``'front wheel
+        hop'``, ``'rear axle tramp'``... on other vehicles (`vehicle_modes`).
     eigenvalue : complex
         The eigenvalue with Im >= 0 (for an overdamped mode, the slower one).
     wn : float
@@ -37,9 +55,20 @@ class Mode:
     fn_undamped : float
         Undamped natural frequency [Hz] from K·φ = ω²·M·φ.
     shape_ratio, shape_phase : float
-        |xu/xs| and its phase [deg] in the eigenvector.
+        |xu/xs| and its phase [deg] in the eigenvector; on other vehicles the
+        same ratio over all corners, wheel motion against the body's motion
+        above the wheels, ``Σ u_i conj(b_i) / Σ |b_i|²`` (its modulus and phase).
     zeta_nominal : float
-        The nominal cs/(2√(ks·ms)), the same for both modes.
+        The nominal cs/(2√(ks·ms)), the same for both modes (quarter car;
+        NaN otherwise).
+    shape : tuple of (label, complex)
+        The displacement part of the eigenvector by state label, scaled so
+        that its largest entry is 1 (empty for the quarter car's table).
+    node_x : float
+        Where along the body (ahead of the CG [m]) its heave and pitch
+        motions cancel, ``-Re(z/theta)``, for the bounce and pitch modes of a
+        vehicle with a pitch state (``inf`` when it does not pitch); NaN
+        otherwise.
     """
 
     name: str
@@ -51,6 +80,8 @@ class Mode:
     shape_ratio: float
     shape_phase: float
     zeta_nominal: float
+    shape: tuple = ()
+    node_x: float = math.nan
 
     @property
     def fn(self) -> float:
@@ -71,15 +102,29 @@ _COLUMNS = {
 }
 
 
+_VEHICLE_COLUMNS = {
+    "eigenvalue": "eigenvalue [1/s]",
+    "wn": "wn [rad/s]",
+    "fn": "fn [Hz]",
+    "zeta": "zeta [-]",
+    "fd": "fd [Hz]",
+    "fn_undamped": "fn undamped [Hz]",
+    "shape_ratio": "|wheel/body| [-]",
+    "shape_phase": "phase(wheel/body) [deg]",
+    "node_x": "node x [m]",
+}
+
+
 @dataclass(frozen=True)
 class ModalAnalysis:
-    """The two modes of a quarter car, body bounce first.
+    """The modes of a vehicle: body modes first (a quarter car: body bounce first).
 
     ``str()`` gives the table and the note; `to_frame` gives a DataFrame.
     """
 
-    modes: tuple[Mode, Mode]
+    modes: tuple[Mode, ...]
     note: str
+    columns: tuple[tuple[str, str], ...] = tuple(_COLUMNS.items())
 
     def __getitem__(self, name: str) -> Mode:
         for mode in self.modes:
@@ -98,8 +143,7 @@ class ModalAnalysis:
     def to_frame(self) -> pd.DataFrame:
         """One row per mode, indexed by name, columns with units."""
         rows = {
-            m.name: {label: getattr(m, attr) for attr, label in _COLUMNS.items()}
-            for m in self.modes
+            m.name: {label: getattr(m, attr) for attr, label in self.columns} for m in self.modes
         }
         frame = pd.DataFrame.from_dict(rows, orient="index")
         frame.index.name = "mode"
@@ -161,15 +205,20 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
 
     Parameters
     ----------
-    sys_or_params : QuarterCarParams, dict, control.StateSpace or None
-        The vehicle; a system must have the states ``[vs, vu, xs, xu]``
-        (as `quarter_car` builds it). ``None`` is the seed's vehicle.
+    sys_or_params : vehicle parameters, dict, VehicleModel, control.StateSpace or None
+        `QuarterCarParams` (or a dict of its fields), `HalfCarParams`,
+        `FullCarParams`, a model or a system.
+        The vehicle; a 4-state system must have the states ``[vs, vu, xs,
+        xu]`` (as `quarter_car` builds it), a larger one the labels of a
+        half or full car (see `vehicle_modes`). ``None`` is the seed's
+        quarter car.
 
     Returns
     -------
     ModalAnalysis
-        Two `Mode` rows, body bounce first, and a one-line note when the
-        body mode's damping departs from the nominal ratio.
+        A quarter car: two `Mode` rows, body bounce first, and a one-line
+        note when the body mode's damping departs from the nominal ratio.
+        Another vehicle: one row per mode, named by `vehicle_modes`.
 
     Notes
     -----
@@ -194,6 +243,14 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
     >>> round(ma.body.fn, 3), round(ma.body.zeta, 4)
     (1.087, 0.0677)
     """
+    if isinstance(sys_or_params, (HalfCarParams, FullCarParams)):
+        return vehicle_modes(sys_or_params.model())
+    if isinstance(sys_or_params, VehicleModel):
+        if not isinstance(sys_or_params.params, QuarterCarParams):
+            return vehicle_modes(sys_or_params)
+        sys_or_params = sys_or_params.system
+    if isinstance(sys_or_params, control.StateSpace) and sys_or_params.nstates != 4:
+        return vehicle_modes(sys_or_params)
     if sys_or_params is None or isinstance(sys_or_params, (QuarterCarParams, dict)):
         sys_or_params = quarter_car(sys_or_params)
     MinvC, MinvK, A = quarter_car_matrices(sys_or_params)
@@ -201,6 +258,8 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
     zeta_nominal = MinvC[0, 0] / (2.0 * math.sqrt(MinvK[0, 0])) if MinvK[0, 0] > 0 else math.nan
 
     eigvals, eigvecs = np.linalg.eig(A)
+    # a damping ratio below MARGINAL_RTOL is rounding: reported as 0, never < 0
+    eigvals = stability.settle_marginal(eigvals)
     groups = _pair_eigenvalues(eigvals, eigvecs)
     names = _classify([_shape(v) for _, v in groups])
 
@@ -214,21 +273,15 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
 
     modes = []
     for name, (lams, v) in zip(names, groups):
-        if len(lams) == 1:  # a conjugate pair, represented by Im >= 0
-            lam = lams[0]
-            wn, zeta, fd = abs(lam), -lam.real / abs(lam), abs(lam.imag) / (2 * math.pi)
-        else:  # two real eigenvalues of one overdamped mode
-            l1, l2 = (float(x.real) for x in lams)
-            wn = math.sqrt(l1 * l2)
-            zeta, fd, lam = -(l1 + l2) / (2 * wn), 0.0, complex(max(l1, l2))
+        lam, wn, zeta, fd = _mode_numbers(lams)
         ratio = _shape(v)
         modes.append(
             Mode(
                 name,
-                complex(lam),
-                float(wn),
-                float(zeta),
-                float(fd),
+                lam,
+                wn,
+                zeta,
+                fd,
                 fn_undamped[name],
                 float(abs(ratio)),
                 float(np.degrees(np.angle(ratio))),
@@ -237,6 +290,20 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
         )
     modes.sort(key=lambda m: m.name != BODY)
     return ModalAnalysis((modes[0], modes[1]), _damping_note(modes[0], MinvK))
+
+
+def _mode_numbers(lams) -> tuple[complex, float, float, float]:
+    """``(eigenvalue, wn, zeta, fd)`` of a mode: a conjugate pair (given by its
+    Im > 0 member), two real eigenvalues of an overdamped mode (the slower one
+    stands for it, ``wn = √(λ₁λ₂)``, ``ζ = -(λ₁+λ₂)/(2 wn) >= 1``), or one real."""
+    if len(lams) == 2:
+        l1, l2 = (float(x.real) for x in lams)
+        wn = math.sqrt(l1 * l2)
+        return complex(max(l1, l2)), wn, -(l1 + l2) / (2 * wn), 0.0
+    lam = complex(lams[0])
+    if lam.imag > 0:
+        return lam, abs(lam), -lam.real / abs(lam), lam.imag / (2 * math.pi)
+    return lam, abs(lam), 1.0, 0.0
 
 
 def _shape(v: np.ndarray) -> complex:
@@ -307,3 +374,248 @@ def numerical_modes(method, h: float, vehicle=None) -> pd.DataFrame:
     except (TypeError, ValueError):  # not a quarter car: general rows
         return stability.numerical_modes(method, h, vehicle)
     return stability.numerical_modes(method, h, named)
+
+
+#: Body degrees of freedom by displacement-state label, and the mode each names.
+BODY_MODES = {"xs": "bounce", "z": "bounce", "theta": "pitch", "phi": "roll"}
+
+
+def _corner_labels(
+    sys: control.StateSpace, model: VehicleModel | None
+) -> list[tuple[str, str, str]]:
+    """``(name, travel label, tire label)`` per corner: the model's roles, or
+    for a bare system the outputs ``susp_travel_<s>`` / ``tire_defl_<s>``."""
+    if model is not None:
+        return [(c.name, c.susp_travel, c.tire_defl) for c in model.corners]
+    names = dict(HALF_CAR_CORNERS + FULL_CAR_CORNERS)
+    out = list(sys.output_labels)
+    return [
+        (names.get(label[12:], label[12:]), label, "tire_defl_" + label[12:])
+        for label in out
+        if label.startswith("susp_travel_") and "tire_defl_" + label[12:] in out
+    ]
+
+
+def _assign(scores: np.ndarray) -> list[int | None]:
+    """For each row (a mode), the column (a name) of the best one-to-one match
+    (largest product of scores); None for rows left over."""
+    rows, cols = scipy.optimize.linear_sum_assignment(-np.log(np.maximum(scores, 1e-300)))
+    out: list[int | None] = [None] * scores.shape[0]
+    for r, c in zip(rows, cols):
+        out[r] = int(c)
+    return out
+
+
+class _Shapes:
+    """What naming needs of a vehicle: its wheels, its body points over them and its templates."""
+
+    def __init__(self, sys: control.StateSpace, model: VehicleModel | None):
+        A = np.asarray(sys.A, dtype=float)
+        N = A.shape[0]
+        n = N // 2
+        if N % 2 or not np.array_equal(A[n:], np.hstack([np.eye(n), np.zeros((n, n))])):
+            raise ValueError(
+                f"system {sys.name!r} is not in vehicle form: the states must be the "
+                "velocities then the displacements, A = [[-M⁻¹C, -M⁻¹K], [I, 0]]"
+            )
+        corners = _corner_labels(sys, model)
+        if not corners:
+            raise ValueError(
+                f"system {sys.name!r} names no corners: pass a VehicleModel, or a system with "
+                "outputs 'susp_travel_<corner>' and 'tire_defl_<corner>'"
+            )
+        out, C = list(sys.output_labels), np.asarray(sys.C, dtype=float)
+        self.n, self.A = n, A
+        self.labels = list(sys.state_labels)[n:]
+        self.wheels = [int(np.argmax(np.abs(C[out.index(t), n:]))) for _, _, t in corners]
+        eye = np.eye(n)
+        # the body point above each wheel: travel + wheel
+        self.body = np.array(
+            [C[out.index(s), n:] + eye[w] for (_, s, _), w in zip(corners, self.wheels)]
+        )
+        self.dofs = [j for j in range(n) if j not in self.wheels]
+        self.body_names = [
+            BODY_MODES.get(self.labels[j], f"{self.labels[j]} mode") for j in self.dofs
+        ]
+        # how far each body coordinate moves the body points over the wheels (rms)
+        self.lever = np.sqrt(np.mean(self.body[:, self.dofs] ** 2, axis=0))
+        axles: dict[str, list[tuple[int, str]]] = {}
+        for i, (name, _, _) in enumerate(corners):
+            words = name.split()
+            axles.setdefault(words[0] if words else "", []).append(
+                (i, words[1] if len(words) > 1 else "")
+            )
+        self.templates, self.wheel_names = [], []
+        for axle, members in axles.items():
+            hop = np.zeros(len(corners))
+            hop[[i for i, _ in members]] = 1.0
+            self.templates.append(hop)
+            self.wheel_names.append(f"{axle} wheel hop".strip())
+            sides = dict((side, i) for i, side in members)
+            if "left" in sides and "right" in sides:
+                tramp = np.zeros(len(corners))
+                tramp[sides["left"]], tramp[sides["right"]] = 1.0, -1.0
+                self.templates.append(tramp)
+                self.wheel_names.append(f"{axle} axle tramp".strip())
+
+    def motions(self, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(wheel motions u, body motions b above the wheels) of a displacement shape."""
+        return phi[self.wheels], self.body @ phi
+
+    def names(self, shapes: list[np.ndarray]) -> list[str]:
+        """Names of displacement shapes: the body modes are those whose wheels follow
+        the body most closely; each gets the body coordinate that moves the body
+        most, and each wheel mode the axle pattern it resembles most, one-to-one."""
+        stroke = []
+        for phi in shapes:
+            u, b = self.motions(phi)
+            stroke.append(np.sum(np.abs(u - b) ** 2) / np.sum(np.abs(u) ** 2 + np.abs(b) ** 2))
+        order = list(np.argsort(stroke, kind="stable"))
+        body, wheel = order[: len(self.dofs)], order[len(self.dofs) :]
+        names = [f"mode {i + 1}" for i in range(len(shapes))]
+        if body:
+            share = np.array([np.abs(shapes[i][self.dofs]) * self.lever for i in body])
+            share /= np.maximum(share.sum(axis=1, keepdims=True), 1e-300)
+            for i, k in zip(body, _assign(share)):
+                if k is not None:
+                    names[i] = self.body_names[k]
+        if wheel:
+            score = []
+            for i in wheel:
+                u = self.motions(shapes[i])[0]
+                score.append(
+                    [
+                        abs(np.vdot(t, u)) ** 2 / (t @ t * max(np.vdot(u, u).real, 1e-300))
+                        for t in self.templates
+                    ]
+                )
+            for i, k in zip(wheel, _assign(np.array(score))):
+                if k is not None:
+                    names[i] = self.wheel_names[k]
+        return names
+
+    def node_x(self, phi: np.ndarray) -> float:
+        """``-Re(z/theta)``: where along the body heave and pitch cancel."""
+        if "theta" not in self.labels:
+            return math.nan
+        z = next((phi[self.labels.index(k)] for k in ("z", "xs") if k in self.labels), 0.0)
+        theta = phi[self.labels.index("theta")]
+        return -float(np.real(z / theta)) if abs(theta) > 0 else math.inf
+
+    def ratio(self, phi: np.ndarray) -> complex:
+        u, b = self.motions(phi)
+        body = float(np.sum(np.abs(b) ** 2))
+        return complex(np.vdot(b, u) / body) if body > 0 else complex(math.inf)
+
+
+def vehicle_modes(vehicle) -> ModalAnalysis:
+    """The modes of a half car, a full car or any vehicle, named by their shapes.
+
+    Parameters
+    ----------
+    vehicle : VehicleModel or control.StateSpace
+        A continuous-time model whose state is the velocities then the
+        displacements (``A = [[-M⁻¹C, -M⁻¹K], [I, 0]]``) with the corners
+        in its roles (or, for a bare system, outputs ``susp_travel_<s>`` and
+        ``tire_defl_<s>``), as `qc_control.half_car` and
+        `qc_control.full_car` build them.
+
+    Returns
+    -------
+    ModalAnalysis
+        One `Mode` per degree of freedom: the body modes first, then the
+        wheel modes.
+
+    Notes
+    -----
+    Each eigenvalue pair ``λ`` (Im > 0) gives ``ωn = |λ|``, ``ζ = -Re λ/|λ|``
+    and ``fd = Im λ/2π`` (python-control's `damp` convention); the undamped
+    frequencies are the square roots of the eigenvalues of ``M⁻¹K``. A mode
+    is named from the displacement part ``φ`` of its eigenvector:
+
+    - the wheels' motion ``u`` and the body's motion ``b`` above them (read
+      from the travel outputs: travel = body point - wheel) give the
+      relative stroke ``Σ|u - b|² / Σ(|u|² + |b|²)``, near 0 when the
+      wheels ride with the body and near or above 1 when they move against
+      it. The modes with the smallest strokes, as many as the body has
+      coordinates, are body modes;
+    - each body mode is named after the body coordinate (``z`` bounce,
+      ``theta`` pitch, ``phi`` roll) whose motion moves the body points
+      over the wheels most, one name per mode (an assignment maximising
+      the product of the shares);
+    - each wheel mode is named after the axle pattern its wheel motions
+      match best (normalised ``|tᵀu|²``): both wheels of an axle together
+      (``front wheel hop``) or against each other (``front axle tramp``).
+
+    A bounce mode is the one whose node (``node x``: where heave and pitch
+    cancel) lies far from the CG, the pitch mode's lies near it (Gillespie,
+    *Fundamentals of Vehicle Dynamics*, SAE 1992, ch. 5). Under Olley's
+    condition ``Iy = ms·a·b`` the nodes are at the axles: each mode moves
+    one axle only.
+
+    Examples
+    --------
+    >>> from qc_control.halfcar import half_car_model
+    >>> [m.name for m in vehicle_modes(half_car_model()).modes]
+    ['bounce', 'pitch', 'front wheel hop', 'rear wheel hop']
+    """
+    model = vehicle if isinstance(vehicle, VehicleModel) else None
+    sys = vehicle.system if model is not None else vehicle
+    if not isinstance(sys, control.StateSpace):
+        raise TypeError(f"expected a VehicleModel or control.StateSpace, got {type(sys).__name__}")
+    if not control.isctime(sys, strict=True):
+        raise ValueError(f"system {sys.name!r} must be continuous-time, got dt={sys.dt!r}")
+    geo = _Shapes(sys, model)
+    n = geo.n
+    eigvals, eigvecs = np.linalg.eig(geo.A)
+    groups = _group(eigvals, eigvecs[n:])
+    names = geo.names([v for _, v in groups])
+
+    w2, phi = np.linalg.eig(-geo.A[:n, n:])  # M⁻¹K
+    w2, phi = w2.real, phi.real
+    undamped = dict(zip(geo.names(list(phi.T)), np.sqrt(np.maximum(w2, 0.0)) / (2 * math.pi)))
+
+    modes = []
+    for name, (lams, v) in zip(names, groups):
+        lam, wn, zeta, fd = _mode_numbers(lams)
+        v = v / v[np.argmax(np.abs(v))]
+        ratio = geo.ratio(v)
+        modes.append(
+            Mode(
+                name,
+                lam,
+                wn,
+                zeta,
+                fd,
+                float(undamped.get(name, math.nan)),
+                float(abs(ratio)),
+                float(np.degrees(np.angle(ratio))),
+                math.nan,
+                tuple(zip(geo.labels, (complex(x) for x in v))),
+                geo.node_x(v) if name in ("bounce", "pitch") else math.nan,
+            )
+        )
+    rank = {name: i for i, name in enumerate(geo.body_names + geo.wheel_names)}
+    modes.sort(key=lambda m: (rank.get(m.name, len(rank)), m.wn))
+    return ModalAnalysis(tuple(modes), "", tuple(_VEHICLE_COLUMNS.items()))
+
+
+def _group(eigvals: np.ndarray, shapes: np.ndarray) -> list[tuple[tuple[complex, ...], np.ndarray]]:
+    """Eigenvalues grouped into modes with their displacement shapes: a conjugate
+    pair is one mode; real eigenvalues (overdamped) pair up by the most similar
+    shapes, the slower one's shape standing for the pair."""
+    groups: list[tuple[tuple[complex, ...], np.ndarray]] = [
+        ((complex(eigvals[i]),), shapes[:, i]) for i in range(eigvals.size) if eigvals[i].imag > 0
+    ]
+    real = [i for i in range(eigvals.size) if eigvals[i].imag == 0]
+    unit = {i: shapes[:, i] / max(np.linalg.norm(shapes[:, i]), 1e-300) for i in real}
+    while real:
+        i = real.pop(0)
+        if not real:
+            groups.append(((complex(eigvals[i]),), shapes[:, i]))
+            break
+        j = max(real, key=lambda k: abs(np.vdot(unit[i], unit[k])))
+        real.remove(j)
+        slow = i if eigvals[i].real > eigvals[j].real else j
+        groups.append(((complex(eigvals[i]), complex(eigvals[j])), shapes[:, slow]))
+    return groups

@@ -8,18 +8,19 @@ and road holding (dynamic tire load against the static wheel load).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import control
 import numpy as np
 import pandas as pd
 
+from .halfcar import FullCarParams, HalfCarParams
 from .integrate import uniform_step
 from .iso2631 import wk_filter, wk_weighted
 from .metrics import METRICS, RIDE_METRICS, RideSignals, evaluate
 from .model import as_params, quarter_car, quarter_car_model
-from .road import ISO8608_BAND, ISO8608_N0, band_limits, road_class_psd
+from .road import ISO8608_BAND, ISO8608_N0, band_limits, positive, road_class_psd
 from .spectral import (
     SPECTRAL_CAPABLE,
     iso8608_intensity,
@@ -57,30 +58,61 @@ def _road_system(sys_or_params):
 
 @dataclass(frozen=True, eq=False)
 class Transmissibility:
-    """Frequency responses from the road height zr to the ride signals.
+    """Frequency responses from the road height to the ride signals.
 
     Attributes
     ----------
     freqs_hz : ndarray
     response : dict[str, ndarray]
-        Complex ``H(j2πf)`` for ``xs``, ``body_acc``, ``susp_travel``,
-        ``tire_defl``.
+        Complex ``H(j2πf)`` per output label: ``xs``, ``body_acc``,
+        ``susp_travel``, ``tire_defl`` for a quarter car; for a vehicle on
+        several wheels the body's displacement and acceleration, its pitch
+        (and roll) acceleration and every corner's travel and tire deflection.
     invariant_hz : float
-        ``√(ku/mu)/2π``: there ``|body_acc/zr| = ku/ms`` whatever the damping.
+        ``√(ku/mu)/2π``: there ``|body_acc/zr| = ku/ms`` whatever the damping
+        (quarter car; NaN otherwise).
     invariant_gain : float
-        ``ku/ms`` [1/s²].
+        ``ku/ms`` [1/s²] (quarter car; NaN otherwise).
+    units : dict[str, str]
+        The unit of each gain, e.g. ``'(m/s²)/m'``.
+    delay_s : float
+        The wheelbase delay ``(a + b)/V`` [s] of the rear wheels (0 for one wheel).
     """
 
     freqs_hz: np.ndarray
     response: dict
     invariant_hz: float
     invariant_gain: float
+    units: dict = field(default_factory=lambda: dict(_UNITS))
+    delay_s: float = 0.0
+
+    def wheelbase_notches(self, signal: str = "pitch") -> np.ndarray:
+        """The wheelbase-filtering frequencies in the band [Hz].
+
+        One road under both axles, the rear ``τ`` later, excites the body
+        through ``H_f + e^{-jωτ} H_r``. On a car symmetric about its CG the
+        axles' heave contributions are equal and their pitch contributions
+        opposite, so pitch vanishes where ``e^{-jωτ} = 1`` and heave where
+        ``e^{-jωτ} = -1``:
+
+        .. math:: f_{pitch} = \\frac{k V}{a + b}, \\qquad
+                  f_{heave} = \\frac{(k + ½) V}{a + b}, \\quad k = 1, 2, \\dots
+
+        (Gillespie, *Fundamentals of Vehicle Dynamics*, 1992, ch. 5, wheelbase
+        filtering); on other cars the dips lie near these frequencies.
+        """
+        if self.delay_s <= 0:
+            return np.array([])
+        offset = {"pitch": 0.0, "heave": 0.5}[signal]
+        top = self.freqs_hz.max() * self.delay_s
+        k = np.arange(1 if offset == 0 else 0, int(np.floor(top - offset)) + 1) + offset
+        return k[k / self.delay_s >= self.freqs_hz.min()] / self.delay_s
 
     def to_frame(self) -> pd.DataFrame:
         """|H| and phase [deg] per signal, indexed by frequency [Hz]."""
         cols = {}
         for name, h in self.response.items():
-            cols[f"|{name}/zr| [{_UNITS[name]}]"] = np.abs(h)
+            cols[f"|{name}/zr| [{self.units[name]}]"] = np.abs(h)
             cols[f"phase {name} [deg]"] = np.degrees(np.angle(h))
         frame = pd.DataFrame(cols, index=pd.Index(self.freqs_hz, name="f [Hz]"))
         return frame
@@ -89,41 +121,59 @@ class Transmissibility:
         """Bode-style plot: magnitude (log-log) and phase of each signal."""
         from matplotlib.figure import Figure  # heavy and optional: only when plotting
 
-        fig = Figure(figsize=(9, 6.5), layout="constrained")
-        axes = fig.subplots(2, 2, sharex=True).ravel()
+        rows = math.ceil(len(self.response) / 2)
+        fig = Figure(figsize=(9, 3.25 * rows), layout="constrained")
+        axes = fig.subplots(rows, 2, sharex=True, squeeze=False).ravel()
         for ax, (name, h) in zip(axes, self.response.items()):
             ax.loglog(self.freqs_hz, np.abs(h), color="tab:blue")
-            ax.set(title=f"{name} / zr", ylabel=f"|H| [{_UNITS[name]}]")
+            ax.set(title=f"{name} / zr", ylabel=f"|H| [{self.units[name]}]")
             ax.grid(alpha=0.3, which="both")
             twin = ax.twinx()
             twin.semilogx(
                 self.freqs_hz, np.degrees(np.unwrap(np.angle(h))), color="tab:orange", lw=0.8
             )
             twin.set_ylabel("phase [deg]", color="tab:orange")
-        axes[1].plot(
-            [self.invariant_hz],
-            [self.invariant_gain],
-            "ko",
-            mfc="none",
-            label=f"invariant point: {self.invariant_hz:.2f} Hz, ku/ms",
-        )
-        axes[1].legend(fontsize="small", loc="lower left")
-        for ax in axes[2:]:
+        if math.isfinite(self.invariant_hz):
+            axes[1].plot(
+                [self.invariant_hz],
+                [self.invariant_gain],
+                "ko",
+                mfc="none",
+                label=f"invariant point: {self.invariant_hz:.2f} Hz, ku/ms",
+            )
+            axes[1].legend(fontsize="small", loc="lower left")
+        for ax in axes[len(self.response) :]:
+            ax.set_visible(False)
+        for ax in axes[-2:]:
             ax.set_xlabel("frequency [Hz]")
         return fig
 
 
-def transmissibility(sys_or_params=None, freqs_hz=None) -> Transmissibility:
-    """Transmissibility from the road to xs, body_acc, susp_travel and tire_defl.
+def transmissibility(sys_or_params=None, freqs_hz=None, *, speed=None) -> Transmissibility:
+    """Transmissibility from the road to the ride signals.
 
-    Computed with ``control.frequency_response`` of ``quarter_car(road=True)``.
+    Computed with ``control.frequency_response``: of ``quarter_car(road=True)``
+    to xs, body_acc, susp_travel and tire_defl; of a vehicle on several wheels
+    (a half or full car) from one road under every wheel, the rear wheels
+    meeting it ``τ = (a + b)/V`` later, to the body's displacement and
+    accelerations and every corner's travel and tire deflection:
+
+    .. math:: H_y(j\\omega) = \\sum_{front} H_{y,i}(j\\omega)
+              + e^{-j\\omega\\tau} \\sum_{rear} H_{y,i}(j\\omega)
+
+    The delay is exact (``e^{-jωτ}``, no Padé approximation); the same road
+    under the left and right wheels (a fully correlated road, the worst case
+    for heave and pitch: it excites no roll).
 
     Parameters
     ----------
-    sys_or_params : QuarterCarParams, dict, control.StateSpace or None
-        A vehicle, or a system with the road input ``'zr'``.
+    sys_or_params : vehicle parameters, dict, VehicleModel, control.StateSpace or None
+        A vehicle (`QuarterCarParams`, `HalfCarParams`, `FullCarParams`), a
+        model of one, or a quarter-car system with the road input ``'zr'``.
     freqs_hz : array_like, optional
         Frequencies [Hz] > 0; default 200 points from 0.1 to 100 Hz.
+    speed : float, optional
+        Vehicle speed [m/s]; required for a vehicle on several axles.
 
     Notes
     -----
@@ -133,10 +183,16 @@ def transmissibility(sys_or_params=None, freqs_hz=None) -> Transmissibility:
     body-acceleration transmissibility, the same for every damper
     (Hedrick & Butsuen, 1990).
     """
-    sys = _road_system(sys_or_params)
     f = np.logspace(-1, 2, 200) if freqs_hz is None else np.asarray(freqs_hz, dtype=float)
     if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("freqs_hz must be a 1-D array of finite frequencies > 0 Hz")
+    if isinstance(sys_or_params, (HalfCarParams, FullCarParams)):
+        sys_or_params = sys_or_params.model(road=True)
+    if isinstance(sys_or_params, VehicleModel) and len(sys_or_params.corners) > 1:
+        return _axle_transmissibility(sys_or_params, f, speed)
+    if isinstance(sys_or_params, VehicleModel):
+        sys_or_params = sys_or_params.system
+    sys = _road_system(sys_or_params)
     fr = control.frequency_response(sys, 2 * np.pi * f)
     j = sys.input_labels.index("zr")
     H = np.asarray(fr.complex)
@@ -149,9 +205,47 @@ def transmissibility(sys_or_params=None, freqs_hz=None) -> Transmissibility:
     return Transmissibility(f, response, math.sqrt(ku_over_mu) / (2 * math.pi), ku_over_ms)
 
 
+def _axle_transmissibility(model: VehicleModel, f: np.ndarray, speed) -> Transmissibility:
+    """`transmissibility` of a vehicle on several axles: one road, the rear later."""
+    if speed is None:
+        raise ValueError(
+            f"speed is required for the transmissibility of {model.name!r}: its rear wheels "
+            "meet the road (a + b)/speed after the front ones"
+        )
+    speed = positive("speed", speed, "m/s")
+    roads = model.road_inputs()
+    if len(roads) != len(model.corners):
+        raise ValueError(
+            f"model {model.name!r} has no road input under every wheel; build it with road=True"
+        )
+    wheelbase = float(model.params.a + model.params.b)
+    tau = wheelbase / speed
+    sys = model.system
+    H = np.asarray(control.frequency_response(sys, 2 * np.pi * f).complex)
+    H = H.reshape(sys.noutputs, sys.ninputs, f.size)
+    late = np.exp(-2j * np.pi * f * tau)
+    weights = [late if c.name.startswith("rear") else np.ones_like(late) for c in model.corners]
+    columns = [sys.input_labels.index(c.road) for c in model.corners]
+    combined = sum(w * H[:, j] for w, j in zip(weights, columns))
+    outputs = list(sys.output_labels)
+    wanted = [model.body_disp, model.body_acc]
+    wanted += [label for label in ("heave_acc", "pitch_acc", "roll_acc") if label in outputs]
+    wanted += [c.susp_travel for c in model.corners] + [c.tire_defl for c in model.corners]
+    wanted = list(dict.fromkeys(wanted))
+    response = {label: combined[outputs.index(label)] for label in wanted}
+    units = {label: _gain_unit(model.unit(label)) for label in wanted}
+    return Transmissibility(f, response, math.nan, math.nan, units, tau)
+
+
+def _gain_unit(unit: str) -> str:
+    return f"({unit})/m" if "/" in unit else f"{unit}/m"
+
+
 def _road_model(params) -> VehicleModel:
     if isinstance(params, VehicleModel):
         return params
+    if isinstance(params, (HalfCarParams, FullCarParams)):
+        return params.model(road=True)
     return quarter_car_model(as_params(params), road=True)
 
 
@@ -163,9 +257,10 @@ def ride_metrics(response, params=None, metrics=RIDE_METRICS) -> pd.Series:
     response : control.TimeResponseData
         A response of the vehicle on a road, from qc_control or
         python-control, on a uniform time grid, with the model's outputs.
-    params : QuarterCarParams, dict or VehicleModel, optional
+    params : vehicle parameters, dict or VehicleModel, optional
         The vehicle (tire stiffness, static wheel load, which output is
-        which); the seed's quarter car by default.
+        which); the seed's quarter car by default. Wheel metrics are given
+        per corner (``peak_susp_travel front [m]`` on a half car).
     metrics : sequence of str, default `qc_control.metrics.RIDE_METRICS`
         Names from `qc_control.metrics.METRICS`.
 

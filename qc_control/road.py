@@ -1,4 +1,10 @@
-"""Road inputs for ``quarter_car(road=True)``: samples of the road height zr [m].
+"""Road inputs: samples of the road height zr [m] under one wheel or under several.
+
+One track (``quarter_car(road=True)``): `step`, `bump`, `sine`, `iso8608`.
+Several wheels (`qc_control.half_car`, `qc_control.full_car`): the rear wheels
+meet the front wheels' road a wheelbase later (`delay`, `axle_inputs`,
+`corner_inputs`), and the left and right tracks of a random road are partly
+correlated (`isotropic_coherence`, `iso8608_tracks`).
 
 Every function returns ``zr`` on a given time grid ``T`` [s]; the random
 road is deterministic for a given seed. A road is an input linear between
@@ -11,6 +17,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import scipy.special
 
 from .integrate import check_time_grid, uniform_step
 from .limits import check_memory
@@ -30,6 +37,12 @@ __all__ = [
     "finite",
     "road_class_psd",
     "band_limits",
+    "delay",
+    "axle_inputs",
+    "corner_inputs",
+    "isotropic_coherence",
+    "iso8608_profiles",
+    "iso8608_tracks",
 ]
 
 #: Reference spatial frequency n0 [cycles/m] of ISO 8608.
@@ -170,6 +183,20 @@ def iso8608_profile(
     Interaction*, ch. 3) and zero outside it. The period is at least ten
     of the longest wavelengths, so the band's low end holds ten harmonics.
     """
+    N, amplitude = _harmonics(length, dx, road_class, band)
+    phase = np.random.default_rng(_seed(seed)).uniform(0, 2 * np.pi, amplitude.size)
+    return _synthesise(N, dx, length, amplitude, np.exp(1j * phase))
+
+
+def _seed(seed) -> int:
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+    return int(seed)
+
+
+def _harmonics(length, dx, road_class, band) -> tuple[int, np.ndarray]:
+    """The period ``N`` samples and the harmonics' amplitudes ``sqrt(2 Gd(n_k) Δn)``
+    (zero outside the band) of `iso8608_profile`, at ``n_k = k/(N dx)``."""
     length, dx = positive("length", length, "m"), positive("dx", dx, "m")
     lo, hi = band_limits(band)
     g0 = road_class_psd(road_class)
@@ -178,8 +205,6 @@ def iso8608_profile(
             f"dx = {dx!r} m is too coarse for the band up to {hi!r} cycles/m: "
             f"it must be <= 1/(2 n_max) = {1 / (2 * hi):.4g} m"
         )
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
     N = int(math.ceil(max(length, 10.0 / lo) / dx)) + 1  # (N - 1) dx >= length
     N += N % 2
     dn = 1.0 / (N * dx)
@@ -188,8 +213,12 @@ def iso8608_profile(
     inside = (n >= lo) & (n <= hi) & (np.arange(n.size) < N // 2)
     amplitude = np.zeros_like(n)
     amplitude[inside] = np.sqrt(2 * g0 * (n[inside] / ISO8608_N0) ** -2.0 * dn)
-    phase = np.random.default_rng(seed).uniform(0, 2 * np.pi, n.size)
-    z = np.fft.irfft(0.5 * N * amplitude * np.exp(1j * phase), n=N)
+    return N, amplitude
+
+
+def _synthesise(N: int, dx: float, length: float, amplitude: np.ndarray, unit: np.ndarray):
+    """``x, z`` up to ``length`` of ``Σ A_k |u_k| cos(2π n_k x + arg u_k)`` (inverse FFT)."""
+    z = np.fft.irfft(0.5 * N * amplitude * unit, n=N)
     x = np.arange(N) * dx
     keep = x <= length + 1e-9 * length
     return x[keep], z[keep]
@@ -214,6 +243,14 @@ def iso8608(
     ((2001,), True)
     """
     T = _grid(T)
+    x, dx, lo, hi = _distance_grid(T, speed, band)
+    xp, zp = iso8608_profile(max(x[-1], dx), dx, road_class, seed, (lo, hi))
+    return np.interp(x, xp, zp)
+
+
+def _distance_grid(T: np.ndarray, speed, band) -> tuple[np.ndarray, float, float, float]:
+    """``x = v (t - T[0])``, the profile spacing ``dx`` and the band, once the grid
+    is checked to resolve the band at ``speed`` (`iso8608`, `iso8608_tracks`)."""
     speed = positive("speed", speed, "m/s")
     lo, hi = band_limits(band)
     dt = float(np.max(np.diff(T)))
@@ -238,5 +275,138 @@ def iso8608(
         f"an ISO 8608 profile of {samples:.3g} samples",
         "use a shorter or coarser time grid",
     )
-    xp, zp = iso8608_profile(max(x[-1], dx), dx, road_class, seed, (lo, hi))
-    return np.interp(x, xp, zp)
+    return x, dx, lo, hi
+
+
+def delay(T, zr, tau: float) -> np.ndarray:
+    """The input ``zr`` delayed by ``tau`` [s] on the grid ``T``: ``zr(t - tau)``.
+
+    The rear wheel of a car at speed ``V`` meets the front wheel's road
+    ``tau = (a + b)/V`` later. When ``tau`` is a whole number of steps of a
+    uniform grid the samples are shifted exactly; otherwise ``zr`` is read
+    between its samples by linear interpolation, the meaning python-control
+    gives an input (linear between samples). Before ``T[0] + tau`` the road
+    keeps its first value (a level road before the start).
+
+    Examples
+    --------
+    >>> T = np.arange(6) * 0.1
+    >>> delay(T, np.arange(6.0), 0.2).tolist()
+    [0.0, 0.0, 0.0, 1.0, 2.0, 3.0]
+    >>> delay(T, np.arange(6.0), 0.25).round(12).tolist()
+    [0.0, 0.0, 0.0, 0.5, 1.5, 2.5]
+    """
+    T = _grid(T)
+    zr = np.asarray(zr, dtype=float)
+    if zr.shape != T.shape or not np.all(np.isfinite(zr)):
+        raise ValueError(f"zr must be {T.size} finite samples on T, got shape {zr.shape}")
+    tau = finite("tau", tau, "s")
+    if tau < 0:
+        raise ValueError(f"tau must be >= 0 s (a delay), got {tau!r}")
+    h = uniform_step(T)
+    if h is not None:
+        m = round(tau / h)
+        if abs(m * h - tau) <= 1e-9 * h:  # a whole number of steps: shift the samples
+            out = np.full_like(zr, zr[0])
+            if m < zr.size:
+                out[m:] = zr[: zr.size - m]
+            return out
+    return np.interp(T - tau, T, zr, left=zr[0])
+
+
+def axle_inputs(T, zr, wheelbase: float, speed: float) -> np.ndarray:
+    """``(2, N)``: the road ``zr`` under the front wheel and, ``wheelbase/speed``
+    later, under the rear one (`delay`); the inputs ``[zr_front, zr_rear]``
+    of ``half_car(road=True)``."""
+    tau = positive("wheelbase", wheelbase, "m") / positive("speed", speed, "m/s")
+    return np.vstack([np.asarray(zr, dtype=float), delay(T, zr, tau)])
+
+
+def corner_inputs(T, left, right, wheelbase: float, speed: float) -> np.ndarray:
+    """``(4, N)``: the left and right tracks under the front wheels and, delayed
+    by ``wheelbase/speed``, under the rear ones; the inputs ``[zr_fl, zr_fr,
+    zr_rl, zr_rr]`` of ``full_car(road=True)``."""
+    front_left, rear_left = axle_inputs(T, left, wheelbase, speed)
+    front_right, rear_right = axle_inputs(T, right, wheelbase, speed)
+    return np.vstack([front_left, front_right, rear_left, rear_right])
+
+
+def isotropic_coherence(n, track: float) -> np.ndarray:
+    """Cross-spectrum over spectrum of two parallel tracks ``track`` [m] apart.
+
+    For an isotropic road surface whose single-track PSD is ISO 8608's
+    ``Gd(n) ∝ n⁻²`` (waviness 2), the two tracks' cross-spectral density is
+    real and
+
+    .. math:: \\frac{G_{lr}(n)}{G_d(n)} = 2\\pi n B\\, K_1(2\\pi n B)
+
+    (``K_1`` the modified Bessel function of the second kind; Dodds and
+    Robson, "The description of road surface roughness", *J. Sound Vib.*
+    31(2), 1973; Cebon, *Handbook of Vehicle-Road Interaction*, 1999,
+    ch. 3). It is 1 at ``n = 0`` (long waves lift both wheels together) and
+    falls to 0.5 near ``n ≈ 0.3/B``. The coherence is its square.
+
+    Notes
+    -----
+    An isotropic surface whose 2-D spectrum is ``S(k) = (C/2) k⁻³`` has the
+    track spectrum ``∫ S(√(n²+m²)) dm = C n⁻²`` and the cross-spectrum
+    ``∫ S(√(n²+m²)) cos(2πmB) dm = C (2πB/n) K_1(2πnB)``.
+    """
+    n = np.asarray(n, dtype=float)
+    if np.any(n < 0) or not np.all(np.isfinite(n)):
+        raise ValueError("n must be finite spatial frequencies >= 0 cycles/m")
+    x = 2 * np.pi * n * positive("track", track, "m")
+    with np.errstate(invalid="ignore"):
+        return np.where(x > 0, x * scipy.special.k1(np.maximum(x, 1e-300)), 1.0)
+
+
+def iso8608_profiles(
+    length: float,
+    dx: float,
+    track: float,
+    road_class: str = "C",
+    seed: int = 0,
+    band=ISO8608_BAND,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Left and right tracks ``track`` [m] apart of one isotropic ISO 8608 road.
+
+    Returns ``x, left, right``. The left track is `iso8608_profile` with the
+    same arguments (the same seed gives the same left track); each harmonic
+    of the right one is ``ρ(n)`` times the left's plus ``√(1-ρ²)`` times an
+    independent one of the same amplitude,
+
+    .. math:: c^R_k = A_k\\big(ρ(n_k) e^{iφ_k} + \\sqrt{1-ρ(n_k)^2}\\, e^{iψ_k}\\big)
+
+    so both tracks have the PSD ``Gd`` and their cross-spectrum is
+    ``ρ(n)·Gd(n)`` with ``ρ`` the `isotropic_coherence`.
+    """
+    N, amplitude = _harmonics(length, dx, road_class, band)
+    seed = _seed(seed)
+    phase = np.random.default_rng(seed).uniform(0, 2 * np.pi, amplitude.size)
+    other = np.random.default_rng([seed, 1]).uniform(0, 2 * np.pi, amplitude.size)
+    rho = isotropic_coherence(np.arange(amplitude.size) / (N * dx), track)
+    left = np.exp(1j * phase)
+    right = rho * left + np.sqrt(1 - rho**2) * np.exp(1j * other)
+    x, zl = _synthesise(N, dx, length, amplitude, left)
+    _, zr = _synthesise(N, dx, length, amplitude, right)
+    return x, zl, zr
+
+
+def iso8608_tracks(
+    T,
+    road_class: str = "C",
+    speed: float = 20.0,
+    track: float = 1.5,
+    seed: int = 0,
+    band=ISO8608_BAND,
+) -> np.ndarray:
+    """``(2, N)``: the left and right tracks of a random ISO 8608 road at ``speed``.
+
+    `iso8608_profiles` driven at ``speed`` [m/s] and sampled at ``T`` as
+    `iso8608` samples one track (the left track is `iso8608`'s road). Give
+    them to `corner_inputs` for a full car's four wheels.
+    """
+    T = _grid(T)
+    x, dx, lo, hi = _distance_grid(T, speed, band)
+    xp, zl, zr = iso8608_profiles(max(x[-1], dx), dx, track, road_class, seed, (lo, hi))
+    return np.vstack([np.interp(x, xp, zl), np.interp(x, xp, zr)])

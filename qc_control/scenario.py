@@ -13,6 +13,8 @@ The TOML layout (every key optional)::
     zeta = 0.25           # ms, mu, ks, ku and zeta or cs (QuarterCarParams)
 
     [scenario]
+    model = "quarter"     # or "half", "full" (qc_control.scenario.MODELS); the
+                          # top-level keys are then HalfCarParams' or FullCarParams'
     t_end = 10.0          # end time [s]
     h = 0.01              # step [s]
     x0 = [0.0, 0.0, 0.05, 0.0]          # [vs, vu, xs, xu] in m/s, m/s, m, m
@@ -53,8 +55,10 @@ from .compare import (
     MethodComparison,
     compare_methods,
 )
+from .halfcar import FullCarParams, HalfCarParams, full_car_model, half_car_model
 from .methods import METHODS, get_method
-from .model import STATES, QuarterCarParams
+from .model import QuarterCarParams, quarter_car_model
+from .vehicle import VehicleModel
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -75,6 +79,8 @@ __all__ = [
     "ROADS",
     "MAX_STEPS",
     "road_from_mapping",
+    "MODELS",
+    "ModelKind",
 ]
 
 #: The default limit on ``t_end / h``, the steps each method takes at h. The
@@ -381,42 +387,107 @@ def road_from_mapping(values: Mapping[str, Any]) -> Road:
 # ------------------------------------------------------------- scenario
 
 
-#: Vehicle parameter types and their state names (the order of ``x0``).
-_STATES = {QuarterCarParams: STATES}
-_X0_UNITS = {QuarterCarParams: "m/s, m/s, m, m"}
-_VEHICLE_KEYS = tuple(f.name for f in fields(QuarterCarParams))
-_RUN_KEYS = ("t_end", "h", "x0", "methods", "max_steps")
+#: The largest |x0| entry: its square (RMS errors, energies) stays far inside float range.
+MAX_STATE = 1e150
+
+
+@dataclass(frozen=True)
+class ModelKind:
+    """A vehicle a `Scenario` can run: its parameters and how to build it.
+
+    Attributes
+    ----------
+    params : type
+        The parameter dataclass (``from_mapping``, ``to_dict``), e.g.
+        `QuarterCarParams`; its fields are the top-level keys of the TOML.
+    build : callable ``(params, *, road: bool) -> VehicleModel``
+    description : str
+        One line for ``--help``.
+    """
+
+    params: Any  # a parameter dataclass
+    build: Callable[..., VehicleModel]
+    description: str
+
+    def states(self, vehicle) -> list[str]:
+        """The state labels, in the order of ``x0``."""
+        return list(self.build(vehicle, road=False).system.state_labels)
+
+
+#: The vehicles a `Scenario` runs, by its ``model`` name. A new vehicle is one
+#: entry here (its parameters become TOML keys and command-line options).
+MODELS: dict[str, ModelKind] = {
+    "quarter": ModelKind(QuarterCarParams, quarter_car_model, "the seed's quarter car"),
+    "half": ModelKind(HalfCarParams, half_car_model, "the bounce-pitch half car"),
+    "full": ModelKind(FullCarParams, full_car_model, "the heave-pitch-roll full car"),
+}
+
+
+def vehicle_keys() -> tuple[str, ...]:
+    """Every parameter name of every model in `MODELS`, each once, in order."""
+    return tuple(dict.fromkeys(f.name for kind in MODELS.values() for f in fields(kind.params)))
+
+
+_RUN_KEYS = ("t_end", "h", "x0", "methods", "max_steps", "model")
 #: The flat road keys of the ``[scenario]`` table of earlier versions.
 _LEGACY_ROAD_KEYS = ("road", "road_class", "speed", "seed")
 
 
-def _vehicle(values) -> QuarterCarParams:
-    """The vehicle from its parameters, with a ScenarioError naming the one at fault."""
-    if isinstance(values, QuarterCarParams):
-        vehicle = values
-    elif isinstance(values, Mapping):
-        try:
-            vehicle = QuarterCarParams.from_mapping(values)
-        except ValueError as exc:
-            raise ScenarioError(str(exc), None, _culprit(values)) from None
-    else:
+def _model_name(model, vehicle) -> str:
+    """The model's name: given, or read from the vehicle's type, else ``'quarter'``."""
+    if model is None:
+        kind = next((k for k, m in MODELS.items() if isinstance(vehicle, m.params)), "quarter")
+        return kind
+    if not isinstance(model, str) or model not in MODELS:
         raise ScenarioError(
-            f"vehicle must be a QuarterCarParams or a mapping of its parameters, "
-            f"got {type(values).__name__}",
+            f"model must be one of {', '.join(map(repr, MODELS))}, got {model!r}",
             "scenario",
-            "vehicle",
+            "model",
         )
-    return vehicle
+    return model
 
 
-def _culprit(values: Mapping) -> str | None:
+def _vehicle(values, model: str):
+    """The vehicle from its parameters, with a ScenarioError naming the one at fault."""
+    cls = MODELS[model].params
+    if values is None:
+        return cls()
+    if isinstance(values, cls):
+        return values
+    if isinstance(values, Mapping):
+        names = {f.name for f in fields(cls)}
+        for key in values:
+            others = [k for k, m in MODELS.items() if key in {f.name for f in fields(m.params)}]
+            if key not in names and others:
+                raise ScenarioError(
+                    f"{key} is a parameter of the {' and '.join(others)} car, not of the "
+                    f"{model} car: choose the model (model = {others[0]!r} in [scenario], "
+                    f"--model {others[0]})",
+                    None,
+                    key,
+                )
+        try:
+            return cls.from_mapping(values)
+        except ValueError as exc:
+            raise ScenarioError(str(exc), None, _culprit(values, cls)) from None
+    raise ScenarioError(
+        f"vehicle must be a {cls.__name__} or a mapping of its parameters (model {model!r}), "
+        f"got {type(values).__name__}",
+        "scenario",
+        "vehicle",
+    )
+
+
+def _culprit(values: Mapping, cls: type) -> str | None:
     """The first parameter that is bad on its own, if one is."""
-    for key in _VEHICLE_KEYS:
-        if key in values:
-            try:
-                QuarterCarParams(**{key: values[key]})
-            except (TypeError, ValueError):
-                return key
+    names = [f.name for f in fields(cls)]
+    for key in values:
+        if key not in names:
+            return key
+        try:
+            cls(**{key: values[key]})
+        except (TypeError, ValueError):
+            return key
     return None
 
 
@@ -451,16 +522,18 @@ class Scenario:
 
     Parameters
     ----------
-    vehicle : QuarterCarParams or mapping, default the seed's vehicle
-        The vehicle's parameters (other vehicle types will plug in here).
+    vehicle : parameters or mapping, default the model's default vehicle
+        The vehicle's parameters: `QuarterCarParams` (the seed's Table 1 by
+        default), `HalfCarParams` or `FullCarParams`, as ``model`` says.
     road : Road or mapping, default `NoRoad`
         The road input, with all its parameters: `StepRoad`, `BumpRoad`,
         `SineRoad` or `ISO8608Road`; a mapping ``{'kind': 'bump', ...}``
         is read by `road_from_mapping`.
     x0 : sequence of float, optional
-        Initial state ``[vs, vu, xs, xu]`` [m/s, m/s, m, m]. Default: the car
-        at rest under a road, else `qc_control.compare.DEFAULT_X0` (the body
-        released from 5 cm).
+        Initial state in the model's state order (the quarter car's
+        ``[vs, vu, xs, xu]`` [m/s, m/s, m, m]). Default: the car at rest
+        under a road, else the body released from 5 cm (the quarter car's
+        `qc_control.compare.DEFAULT_X0`).
     t_end : float, default `qc_control.compare.DEFAULT_T_END`
         End time [s]; a whole number (at least 2) of steps ``h``.
     h : float, optional
@@ -475,6 +548,14 @@ class Scenario:
     max_steps : int, default `MAX_STEPS`
         The largest ``t_end / h`` accepted: a run beyond it is refused
         before anything is allocated.
+    model : str, optional
+        A name in `MODELS`: ``'quarter'`` (default), ``'half'`` or
+        ``'full'``; by default read from the type of ``vehicle``. On a half
+        or full car the road is under every wheel, the rear wheels meeting
+        it ``(a + b)/speed`` later (`qc_control.road.axle_inputs`), so the
+        road must have a speed (a bump or an ISO 8608 road); a full car's
+        ISO 8608 road has correlated left and right tracks
+        (`qc_control.road.iso8608_tracks`, ``track_front`` apart).
 
     Examples
     --------
@@ -487,7 +568,7 @@ class Scenario:
     True
     """
 
-    vehicle: QuarterCarParams = field(default_factory=QuarterCarParams)
+    vehicle: Any = None
     road: Road = field(default_factory=NoRoad)
     # None resolves to the default in __post_init__: the attribute is always set
     x0: tuple[float, ...] = None  # type: ignore[assignment]
@@ -495,10 +576,12 @@ class Scenario:
     h: float = None  # type: ignore[assignment]
     methods: tuple[str, ...] = DEFAULT_METHODS
     max_steps: int = MAX_STEPS
+    model: str = None  # type: ignore[assignment]
 
     def __post_init__(self):
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
-        put("vehicle", _vehicle(self.vehicle))
+        put("model", _model_name(self.model, self.vehicle))
+        put("vehicle", _vehicle(self.vehicle, self.model))
         road: Any = self.road
         if road is None or isinstance(road, str):
             road = {"kind": road or "none"}
@@ -535,6 +618,18 @@ class Scenario:
                 "h",
             )
         put("x0", self._x0(self.x0))
+        if self.model != "quarter" and not isinstance(road, NoRoad):
+            self._check_speed()
+
+    def _check_speed(self) -> None:
+        if getattr(self.road, "speed", None) is None:
+            raise ScenarioError(
+                f"a {self.road.kind} road has no speed, but the {self.model} car's rear wheels "
+                f"meet the road (a + b)/speed after the front ones: use a bump or an iso8608 "
+                f"road",
+                _ROAD_SECTION,
+                "kind",
+            )
 
     def _methods(self, methods) -> tuple[str, ...]:
         names = _sequence(methods)
@@ -581,13 +676,16 @@ class Scenario:
             )
 
     def _x0(self, x0) -> tuple[float, ...]:
-        names = _STATES[type(self.vehicle)]
+        kind = MODELS[self.model]
+        names = kind.states(self.vehicle)
         if x0 is None:
-            return (
-                tuple(float(v) for v in DEFAULT_X0)
-                if isinstance(self.road, NoRoad)
-                else ((0.0,) * len(names))
-            )
+            if not isinstance(self.road, NoRoad):
+                return (0.0,) * len(names)
+            if self.model == "quarter":
+                return tuple(float(v) for v in DEFAULT_X0)
+            # the body released from 5 cm, as the quarter car's DEFAULT_X0
+            body = kind.build(self.vehicle, road=False).body_disp
+            return tuple(0.05 if name == body else 0.0 for name in names)
         values = _sequence(x0)
         if values is not None and all(isinstance(v, str) for v in values):
             try:
@@ -599,9 +697,19 @@ class Scenario:
             or len(values) != len(names)
             or not all(_is_number(v) and math.isfinite(v) for v in values)
         ):
+            units = kind.build(self.vehicle, road=False).units
             raise ScenarioError(
                 f"x0 must be {len(names)} comma-separated numbers, all finite: "
-                f"{', '.join(names)} [{_X0_UNITS[type(self.vehicle)]}]; got {x0!r}",
+                f"{', '.join(names)} [{', '.join(units[n] for n in names)}]; got {x0!r}",
+                "scenario",
+                "x0",
+            )
+        big = [v for v in values if abs(v) > MAX_STATE]
+        if big:
+            raise ScenarioError(
+                f"x0 = {big[0]!r} is beyond {MAX_STATE:.0e}: the comparison squares the "
+                "states (RMS errors, energies), and the square of such a value overflows "
+                "double precision; the car is linear, so a smaller x0 scales the response",
                 "scenario",
                 "x0",
             )
@@ -619,13 +727,36 @@ class Scenario:
         return np.linspace(0.0, self.t_end, self.steps + 1)
 
     def road_input(self, T=None) -> tuple[np.ndarray | None, str]:
-        """``(zr samples on T, description)``; ``(None, '')`` without a road.
+        """``(road samples on T, description)``; ``(None, '')`` without a road.
 
-        The description is written from the road's actual parameters.
-        ``T`` defaults to `time_grid`.
+        On a quarter car the samples are ``zr``; on a half car
+        ``[zr_front, zr_rear]`` and on a full car ``[zr_fl, zr_fr, zr_rl,
+        zr_rr]``, the rear wheels a wheelbase later. The description is
+        written from the road's actual parameters. ``T`` defaults to
+        `time_grid`.
         """
         T = self.time_grid() if T is None else T
-        return self.road.samples(T), self.road.describe()
+        zr, description = self.road.samples(T), self.road.describe()
+        if zr is None or self.model == "quarter":
+            return zr, description
+        v, speed = self.vehicle, float(cast(Any, self.road).speed)
+        wheelbase = v.a + v.b
+        late = f"; the rear wheels {wheelbase / speed:.4g} s later ((a + b)/speed)"
+        if self.model == "half":
+            return roads.axle_inputs(T, zr, wheelbase, speed), description + late
+        if isinstance(self.road, ISO8608Road):
+            r = self.road
+            left, right = roads.iso8608_tracks(
+                T, r.road_class, speed, v.track_front, r.seed, r.band
+            )
+            description += f", left and right tracks {v.track_front:g} m apart (isotropic road)"
+        else:
+            left = right = zr
+        return roads.corner_inputs(T, left, right, wheelbase, speed), description + late
+
+    def vehicle_model(self, *, road: bool = False) -> VehicleModel:
+        """The `VehicleModel` this scenario runs."""
+        return MODELS[self.model].build(self.vehicle, road=road)
 
     def run(self, progress: Callable[[str], None] | None = None) -> MethodComparison:
         """Run the comparison: `qc_control.compare_methods` on this scenario.
@@ -635,8 +766,11 @@ class Scenario:
         """
         T = self.time_grid()
         U, description = self.road_input(T)
+        vehicle = (
+            self.vehicle if self.model == "quarter" else self.vehicle_model(road=U is not None)
+        )
         cmp = compare_methods(
-            self.vehicle,
+            vehicle,
             T,
             np.asarray(self.x0),
             U=U,
@@ -757,6 +891,7 @@ class Scenario:
             *(f"{k} = {_toml_value(v)}" for k, v in self.vehicle.to_dict().items()),
             "",
             "[scenario]",
+            *([f"model = {_toml_value(self.model)}"] if self.model != "quarter" else []),
             f"t_end = {_toml_value(self.t_end)}",
             f"h = {_toml_value(self.h)}",
             f"x0 = {_toml_value(self.x0)}",
@@ -787,8 +922,10 @@ class Scenario:
         if config is not None:
             args += ["--config", str(config)]
         else:
+            if self.model != "quarter":
+                args += _option("--model", self.model)
             for name, value in self.vehicle.to_dict().items():
-                args += _option(f"--{name}", repr(value))
+                args += _option("--" + name.replace("_", "-"), repr(value))
             args += _option("--t-end", repr(self.t_end))
             args += _option("--h", repr(self.h))
             args += _option("--x0", ",".join(map(repr, self.x0)))
@@ -837,8 +974,9 @@ def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
     if not isinstance(doc, Mapping):
         raise ScenarioError(f"a scenario must be a table (a mapping), got {doc!r}")
     vehicle, table = {}, {}
+    keys = vehicle_keys()
     for key, value in doc.items():
-        if key in _VEHICLE_KEYS:
+        if key in keys:
             vehicle[key] = value
         elif key == "scenario":
             if not isinstance(value, Mapping):
@@ -848,7 +986,7 @@ def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
             hint = " (put the road in a [scenario.road] table)" if key == "road" else ""
             raise ScenarioError(
                 f"unknown key {key!r}{hint}; expected the vehicle's parameters "
-                f"{', '.join(_VEHICLE_KEYS)} and a [scenario] table",
+                f"{', '.join(keys)} and a [scenario] table",
                 None,
                 key,
             )

@@ -43,6 +43,7 @@ __all__ = [
     "max_stable_step",
     "numerical_modes",
     "eigenvalues_of",
+    "settle_marginal",
     "MARGINAL_RTOL",
     "AMPLIFICATION_MARGIN",
 ]
@@ -165,8 +166,13 @@ def _batch_eigenvalues(system_or_eigenvalues) -> np.ndarray:
     return lam
 
 
-def _settle(lam: np.ndarray) -> np.ndarray:
-    """Marginal eigenvalues moved onto the imaginary axis, tiny ones to 0 (module notes)."""
+def settle_marginal(lam: np.ndarray) -> np.ndarray:
+    """Marginal eigenvalues moved onto the imaginary axis, tiny ones to 0 (module notes).
+
+    ``eig`` returns an undamped mode's eigenvalues with a real part of the size
+    of its rounding, of either sign; read as damping, that is a damping ratio
+    of ±1e-14 where the truth is 0 (or below what double precision resolves).
+    """
     lam = np.array(lam, dtype=complex)
     size = np.abs(lam)
     rho = size.max(axis=-1, keepdims=True) if lam.size else size
@@ -222,7 +228,7 @@ def step_is_stable(method, h: float, eigenvalues):
     if not (isinstance(h, (int, float, np.number)) and not isinstance(h, bool)) or not h >= 0:
         raise ValueError(f"h must be a step >= 0 s, got {show(h)}")
     coef = stability_coefficients(method)
-    lam = _settle(_batch_eigenvalues(eigenvalues))
+    lam = settle_marginal(_batch_eigenvalues(eigenvalues))
     radius = np.abs(np.polynomial.polynomial.polyval(h * lam, coef))
     ok = (radius <= 1 + AMPLIFICATION_MARGIN) | (lam.real > 0)
     ok = np.all(ok, axis=-1)
@@ -315,7 +321,7 @@ def max_stable_step(method, sys_or_eigenvalues) -> float:
     """
     _check_order_of_arguments("max_stable_step", method, sys_or_eigenvalues)
     coef = stability_coefficients(method)
-    lam = _settle(eigenvalues_of(sys_or_eigenvalues))
+    lam = settle_marginal(eigenvalues_of(sys_or_eigenvalues))
     lam = np.unique(np.where(lam.imag < 0, lam.conj(), lam))  # a conjugate has the same limit
     return min((_step_limit(coef, complex(x)) for x in lam), default=math.inf)
 

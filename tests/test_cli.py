@@ -95,6 +95,10 @@ BAD = [
     (["report", "--ms", "1e200", "--ks", "1e200"], "time scales span more than"),
     (["report", "--x0", "1,2"], "--x0 must be 4 comma-separated numbers, all finite: vs, vu"),
     (["report", "--x0", "1,a,0,0"], "--x0 must be 4 comma-separated numbers"),
+    # found by tests/test_properties.py: an internal OverflowError in the cost study
+    (["report", "--x0", "1e308,0,0,0"], "--x0 1e+308 is beyond 1e+150"),
+    (["control-report", "--model", "half"], "control-report compares controllers on the quarter"),
+    (["modes", "--model", "half", "--ks_front", "1"], "unrecognized arguments: --ks_front"),
     (["report", "--methods", "rk5"], "--methods: unknown method 'rk5'"),
     (["report", "--methods", ""], "--methods must name at least one method"),
     (["report", "--t-end", "-1"], "--t-end must be a finite number > 0 s, got -1.0"),
@@ -257,3 +261,74 @@ def test_report_reproduces_from_its_own_command_and_scenario_toml(files, capsys)
         )
         assert reproduce_line(files / again) == command
     assert re.search(r"--road bump --road-height 0\.1 .*--speed 15\.0", command)
+
+
+# --- issue 14 item 20: warnings are summarised once, in words -----------------
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        # tiny masses: every method diverges at h = 10 ms (44 RuntimeWarnings on 95cf135)
+        ["--ms", "1e-6", "--mu", "1e-6", "--t-end", "1"],
+        # undamped: Euler has no stable step ("∞% of it" and a divide-by-zero warning)
+        ["--zeta", "0", "--t-end", "1"],
+    ],
+)
+def test_degenerate_designs_report_without_a_warning_flood(tmp_path, args):
+    # a real process: pytest would otherwise capture the warnings before stderr
+    done = run("report", *args, "--quiet", "--out", str(tmp_path / "R"))
+    assert done.returncode == 0, done.stderr
+    err = done.stderr
+    # --quiet: no progress; the root causes are fixed, so no warning is left at all
+    assert err == "", err
+    text = (tmp_path / "R" / "report.md").read_text()
+    assert "∞%" not in text and "inf%" not in text  # (∞ as an error of a diverged run is right)
+    assert "beyond the stability limit" in text  # the finding says what happened, in words
+
+
+def test_undamped_car_has_no_stable_euler_step_in_words(tmp_path):
+    assert main(["report", "--zeta", "0", "--t-end", "1", "--quiet", "--out", str(tmp_path)]) == 0
+    assert "Euler has no stable step" in (tmp_path / "report.md").read_text()
+
+
+def test_warning_summary_counts_each_distinct_warning_once():
+    import warnings
+
+    from qc_control.integrate import DivergenceWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for _ in range(44):
+            warnings.warn("overflow encountered in square", RuntimeWarning, stacklevel=2)
+        warnings.warn("divide by zero encountered in scalar divide", RuntimeWarning, stacklevel=2)
+        for _ in range(3):
+            warnings.warn("rk4 diverged at t = 0.2 s", DivergenceWarning, stacklevel=2)
+    lines = cli.summarise_warnings(caught)
+    assert lines[0] == "rk4 diverged at t = 0.2 s (3 times)"
+    assert len(lines) == 2  # 45 floating-point warnings become one line
+    assert lines[1].startswith("45 floating-point operations overflowed, divided by zero:")
+
+
+def test_cli_prints_a_warning_summary_not_a_flood(monkeypatch, capsys, tmp_path):
+    """Whatever still warns inside a command reaches stderr once, prefixed, in words."""
+    import warnings
+
+    def noisy(args):
+        for _ in range(44):
+            warnings.warn("overflow encountered in exp", RuntimeWarning, stacklevel=2)
+        return 0
+
+    parser = build_parser()
+    real = parser.parse_args
+    monkeypatch.setattr(cli, "build_parser", lambda: parser)
+
+    def parse(argv):
+        args = real(argv)
+        args.run = noisy
+        return args
+
+    monkeypatch.setattr(parser, "parse_args", parse)
+    assert cli.run(["modes"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith("qc-control: warning: 44 floating-point")

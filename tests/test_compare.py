@@ -164,3 +164,17 @@ def test_steps_compose_and_timing_is_optional():
     pd.testing.assert_series_equal(errors["max |xs err| [m]"], plain.table["max |xs err| [m]"])
     # every output is measured, by label, in its own unit
     assert {"max |tire_defl err| [m]", "max |body_acc err| [m/s²]"} <= set(errors.columns)
+
+
+def test_a_cost_beyond_any_run_is_unreached_not_a_number():
+    """Euler from x0 = 1e150 m errs by ~1e143 m; reaching 1e-9 m at order 1 would take
+    ~1e152 RHS evaluations (e ∝ h, so n ∝ e0/tol): reported 'unreached', as for a
+    method that never converges, not as an integer or an overflow (found by
+    tests/test_properties.py at x0 = 1e308)."""
+    T = np.arange(51) * 0.01
+    cmp = qc.compare_methods(
+        qc.QuarterCarParams(), T, [1e150, 0, 0, 0], methods=["euler"], timing=False
+    )
+    kinds = cmp.cost_kind.loc[:, "euler"]
+    assert (kinds == "unreached").all(), kinds
+    assert cmp.cost.loc[:, "euler"].isna().all()

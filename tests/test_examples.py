@@ -70,6 +70,8 @@ def test_there_are_the_documented_examples():
         "modal_analysis",
         "design_sweep",
         "road_comfort",
+        "half_car_pitch",
+        "full_car_roll",
     }
 
 
@@ -193,6 +195,64 @@ def test_design_sweep(tmp_path):
     assert png_size(out / "design_sweep.png") == (880, 495)  # 8 × 4.5 in at 110 dpi
 
 
+def test_half_car_pitch(tmp_path):
+    """The printed peaks against python-control's exact response of the same bump,
+    and the wheelbase-filtering frequencies from the wheelbase and the speed."""
+    import control
+
+    import qc_control as qc
+
+    out = tmp_path / "h" / "p"
+    stdout = run("half_car_pitch", out)
+    car = qc.HalfCarParams(seat_x=0.3)
+    L = car.a + car.b
+    T = np.linspace(0.0, 3.0, 3001)
+    sys_ = qc.half_car(car, road=True)
+    for speed in (5.0, 20.0):
+        U = qc.road.axle_inputs(T, qc.road.bump(T, 0.05, 1.0, speed, 0.2), L, speed)
+        y = control.forced_response(sys_, T, U, 0.0).outputs
+        pitch = np.degrees(np.max(np.abs(y[sys_.output_labels.index("theta")])))
+        line = re.search(rf"at\s+{speed:.1f} m/s .*peak pitch (\S+) deg", stdout)
+        # printed to 3 decimals; RK4 at 1 ms is 1e-9 rad off
+        assert float(line.group(1)) == pytest.approx(pitch, abs=6e-4)
+    dips = re.findall(
+        r"\|pitch_acc/zr\| dips to \S+ at \S+ Hz \(wheelbase filtering: (\S+) Hz", stdout
+    )
+    assert [float(d) for d in dips] == pytest.approx([15.0 / L, 30.0 / L], abs=6e-4)
+    assert png_size(out / "half_car_bump.png") == (880, 550)  # 8 × 5 in at 110 dpi
+    assert png_size(out / "half_car_wheelbase_filtering.png") == (880, 495)
+
+
+def test_full_car_roll(tmp_path):
+    """The roll frequencies against the eigenvalues of A, and the peak roll
+    against python-control's exact response."""
+    import dataclasses
+
+    import control
+
+    import qc_control as qc
+
+    out = tmp_path / "f" / "r"
+    stdout = run("full_car_roll", out)
+    plain = qc.FullCarParams()
+    barred = dataclasses.replace(plain, arb_front=20e3, arb_rear=8e3)
+    T = np.linspace(0.0, 3.0, 3001)
+    left = qc.road.bump(T, 0.05, 1.0, 10.0, 0.2)
+    U = qc.road.corner_inputs(T, left, np.zeros_like(T), plain.a + plain.b, 10.0)
+    peaks = {}
+    for name, car in (("no anti-roll bars", plain), ("anti-roll bars", barred)):
+        sys_ = qc.full_car(car, road=True)
+        phi = control.forced_response(sys_, T, U, 0.0).outputs[sys_.output_labels.index("phi")]
+        peaks[name] = np.degrees(np.max(np.abs(phi)))
+        line = re.search(rf"^{name}: roll mode (\S+) Hz.*peak roll (\S+) deg", stdout, re.M)
+        assert float(line.group(2)) == pytest.approx(peaks[name], abs=6e-4)  # 3 decimals
+        # the roll frequency is one of |λ|/2π of A's eigenvalues
+        lam = np.linalg.eigvals(np.asarray(sys_.A))
+        assert np.min(np.abs(np.abs(lam) / (2 * np.pi) - float(line.group(1)))) < 6e-4
+    assert peaks["anti-roll bars"] > peaks["no anti-roll bars"]
+    assert png_size(out / "full_car_roll.png") == (880, 550)
+
+
 def test_no_example_or_library_figure_calls_show():
     files = list(EXAMPLES.values()) + [
         *(ROOT / "qc_control" / "report").glob("*.py"),
@@ -202,3 +262,24 @@ def test_no_example_or_library_figure_calls_show():
         text = path.read_text(encoding="utf-8")
         assert ".show(" not in text, path
         assert "import matplotlib.pyplot" not in text, path
+
+
+def test_active_suspension(tmp_path):
+    out = tmp_path / "a" / "s"
+    stdout = run("active_suspension", out)
+    p = qc_params()
+    printed = float(re.search(r"cs = (\S+) N·s/m", stdout).group(1))
+    assert printed == pytest.approx(p.ks * np.sqrt((p.ms + p.mu) / p.ku), abs=0.05)  # closed form
+    with open(out / "control_table.csv", newline="", encoding="utf-8") as fh:
+        rows = {r["design"]: r for r in csv.DictReader(fh)}
+    acc = "road: rms_body_acc [m/s²]"
+    assert float(rows["skyhook"][acc]) < float(rows["passive (seed)"][acc])
+    for name in ("transmissibility_body_acc", "transmissibility_tire_defl"):
+        assert png_size(out / f"{name}.png") == (800, 500)  # 8 × 5 in at 100 dpi
+    assert png_size(out / "pareto.png") == (800, 600)
+
+
+def qc_params():
+    from qc_control import QuarterCarParams
+
+    return QuarterCarParams()

@@ -50,6 +50,7 @@ if TYPE_CHECKING:
 __all__ = [
     "check_target",
     "write_report",
+    "write_document",
     "build_blocks",
     "figure_specs",
     "FigureSpec",
@@ -71,6 +72,12 @@ DPI = 150
 
 class ReportError(ValueError):
     """The report cannot be written where it was asked to go."""
+
+
+def _body(cmp) -> str:
+    """The label of the body displacement the errors are measured on (``xs``, ``z``)."""
+    model = getattr(cmp, "model", None)
+    return model.body_disp if model is not None else "xs"
 
 
 def _versions() -> dict[str, str]:
@@ -152,7 +159,7 @@ def figure_specs(cmp) -> list[FigureSpec]:
             (
                 f"method_{_slug(name)}.png",
                 f"{name}: displacement of the suspension (sprung mass, red solid) and of "
-                f"the wheel (blue dashed) against the exact xs (dark grey) and xu (light "
+                f"the wheel (blue dashed) against the exact ones (dark grey, light "
                 f"grey, dashed), h = {cmp.h:g} s",
                 functools.partial(method_figure, cmp, name),
                 SEED_FIGURES.get(name),
@@ -167,13 +174,13 @@ def figure_specs(cmp) -> list[FigureSpec]:
         ),
         (
             "convergence.png",
-            "Max |xs error| against h, with slope guides of each order",
+            f"Max |{_body(cmp)} error| against h, with slope guides of each order",
             lambda: convergence_figure(cmp),
             None,
         ),
         (
             "work_precision.png",
-            "Max |xs error| against RHS evaluations (machine-independent) and against "
+            f"Max |{_body(cmp)} error| against RHS evaluations (machine-independent) and against "
             "wall time (measured on this machine)",
             lambda: work_precision_figure(cmp),
             None,
@@ -219,9 +226,17 @@ def _scenario_text(cmp) -> str:
         else f"forced response to the input(s) {', '.join(cmp.system.input_labels)}"
         + (f" ({cmp.input_description})" if getattr(cmp, "input_description", "") else "")
     )
+    model = getattr(cmp, "model", None)
+    # the states' units in order of first use: "m/s and m" on a quarter car
+    units = (
+        list(dict.fromkeys(model.unit(s) for s in cmp.system.state_labels))
+        if model is not None
+        else ["m/s", "m"]
+    )
+    unit_text = " and ".join([", ".join(units[:-1]), units[-1]] if len(units) > 1 else units)
     return (
         f"Scenario: {kind}, from X0 = [{x0}] (states {', '.join(cmp.system.state_labels)}; "
-        f"m/s and m), over {fmt(t0)}–{fmt(t1)} s with h = {fmt(cmp.h)} s "
+        f"{unit_text}), over {fmt(t0)}–{fmt(t1)} s with h = {fmt(cmp.h)} s "
         f"({cmp.table['steps'].iloc[0]} steps). SI units throughout."
     )
 
@@ -317,7 +332,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
     conv = cmp.convergence.pivot(index="h", columns="method", values="error")
     conv = conv.sort_index(ascending=False)[[t.name for t in cmp.methods]]
     conv.index.name = "h [s]"
-    blocks.append(Table(conv, "Max |xs error| [m] at h, h/2, …, h/32"))
+    blocks.append(Table(conv, f"Max |{_body(cmp)} error| [m] at h, h/2, …, h/32"))
     blocks.append(
         Table(
             table[["order", "observed order"]],
@@ -352,7 +367,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
     blocks.append(
         Table(
             reach,
-            "RHS evaluations to reach each max |xs error| "
+            f"RHS evaluations to reach each max |{_body(cmp)} error| "
             "(i: interpolated between refinements, e: extrapolated with "
             "e = C·h^p, never beyond h_max)",
         )
@@ -528,6 +543,41 @@ def write_report(
     ValueError
         For an unknown format.
     """
+    scenario = getattr(cmp, "scenario", None)
+    return write_document(
+        out_dir,
+        TITLE,
+        lambda: build_blocks(cmp, command),
+        figure_specs(cmp),
+        lambda: _csv_tables(cmp),
+        formats,
+        extra={"scenario.toml": scenario.to_toml()} if scenario is not None else None,
+        command=command,
+        overwrite=overwrite,
+    )
+
+
+def write_document(
+    out_dir,
+    title: str,
+    blocks: Callable[[], list],
+    figures=(),
+    tables: Callable[[], dict[str, pd.DataFrame]] | None = None,
+    formats=FORMATS,
+    *,
+    extra: dict[str, str] | None = None,
+    command: str | None = None,
+    overwrite: bool = True,
+) -> Path:
+    """Write a report's files into ``out_dir``, atomically (what `write_report` does).
+
+    ``figures`` are `FigureSpec` (drawn first, as PNG), ``blocks()`` the
+    document (Markdown, HTML, PDF per ``formats``), ``tables()`` the CSV
+    files by name, ``extra`` more text files by name. The directory is built
+    beside the target and swapped in under a lock; an existing directory is
+    replaced only if it is an earlier report holding nothing foreign
+    (`check_target`).
+    """
     formats = tuple(formats)
     bad = [f for f in formats if f not in FORMATS]
     if bad or not formats:
@@ -540,30 +590,29 @@ def write_report(
     with _exclusive(out.parent, out):
         _recover(out)
         check_target(out, overwrite)  # again: recovery may have put a report back
-        return _write(cmp, out, formats, command)
+        return _write(out, title, blocks, figures, tables, formats, extra, command)
 
 
-def _write(cmp, out: Path, formats: tuple, command: str | None) -> Path:
-    """Build the report in a working copy and swap it in (see `write_report`)."""
+def _write(out: Path, title, blocks_of, figures, tables_of, formats, extra, command) -> Path:
+    """Build the report in a working copy and swap it in (see `write_document`)."""
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
     os.chmod(tmp, 0o777 & ~_umask())  # a directory as the user's umask makes it, not 0700
     moved: Path | None = None
     try:
-        for spec in figure_specs(cmp):
+        for spec in figures:
             spec.make().savefig(tmp / spec.name, dpi=DPI)
-        blocks = build_blocks(cmp, command)
+        blocks = blocks_of()
         if "md" in formats:
-            (tmp / "report.md").write_text(to_markdown(TITLE, blocks), encoding="utf-8")
+            (tmp / "report.md").write_text(to_markdown(title, blocks), encoding="utf-8")
         if "html" in formats:
-            (tmp / "report.html").write_text(to_html(TITLE, blocks, tmp), encoding="utf-8")
+            (tmp / "report.html").write_text(to_html(title, blocks, tmp), encoding="utf-8")
         if "pdf" in formats:
-            to_pdf(TITLE, blocks, tmp, tmp / "report.pdf")
-        if "csv" in formats:
-            for name, frame in _csv_tables(cmp).items():
+            to_pdf(title, blocks, tmp, tmp / "report.pdf")
+        if "csv" in formats and tables_of is not None:
+            for name, frame in tables_of().items():
                 frame.to_csv(tmp / name)
-        scenario = getattr(cmp, "scenario", None)
-        if scenario is not None:
-            (tmp / "scenario.toml").write_text(scenario.to_toml(), encoding="utf-8")
+        for name, text in (extra or {}).items():
+            (tmp / name).write_text(text, encoding="utf-8")
         written = sorted(p.name for p in tmp.iterdir())
         (tmp / MARKER).write_text(
             f"qc-control report\n{command or ''}\nfiles:\n" + "\n".join(written) + "\n",

@@ -100,16 +100,32 @@ def _legend(fig, note: str = "", **kw):
     return fig.legend(**kw)
 
 
+def _body_wheel(cmp) -> tuple[str, str, str | None]:
+    """(body displacement, first wheel's displacement, first road input) labels:
+    ``xs``, ``xu``, ``zr`` on a quarter car, ``z``, ``xu_front``, ``zr_front``
+    on a half car."""
+    model = getattr(cmp, "model", None)
+    outputs = list(cmp.system.output_labels)
+    body = model.body_disp if model is not None else "xs"
+    wheel = "xu" if "xu" in outputs else next(o for o in outputs if o.startswith("xu_"))
+    roads = model.road_inputs() if model is not None else ["zr"]
+    road = next((r for r in roads if r in cmp.system.input_labels), None)
+    return body, wheel, road
+
+
 def reference_figure(cmp) -> Figure:
     """The exact response the methods are measured against (and the road, if any)."""
     ref = cmp.reference
+    body, wheel, road = _body_wheel(cmp)
     fig = Figure(figsize=(8, 3.4), layout="constrained")
     ax = fig.subplots()
-    if cmp.U is not None and "zr" in cmp.system.input_labels:
-        zr = np.asarray(cmp.U)[list(cmp.system.input_labels).index("zr")]
-        ax.plot(cmp.T, zr * _MM, color="tab:brown", lw=0.9, label="road zr")
-    ax.plot(ref.time, output_signal(ref, "xs") * _MM, "r-", lw=1.3, label="body xs (exact)")
-    ax.plot(ref.time, output_signal(ref, "xu") * _MM, "b--", lw=1.1, label="wheel xu (exact)")
+    if cmp.U is not None and road is not None:
+        zr = np.asarray(cmp.U)[list(cmp.system.input_labels).index(road)]
+        ax.plot(cmp.T, zr * _MM, color="tab:brown", lw=0.9, label=f"road {road}")
+    ax.plot(ref.time, output_signal(ref, body) * _MM, "r-", lw=1.3, label=f"body {body} (exact)")
+    ax.plot(
+        ref.time, output_signal(ref, wheel) * _MM, "b--", lw=1.1, label=f"wheel {wheel} (exact)"
+    )
     ax.set(
         xlabel="time [s]",
         ylabel="displacement [mm]",
@@ -128,13 +144,14 @@ def method_figure(cmp, method: str) -> Figure:
     drawn wide underneath.
     """
     resp, ref = cmp.responses[method], cmp.reference
+    body, wheel, _ = _body_wheel(cmp)
     fig = Figure(figsize=(8, 3.4), layout="constrained")
     ax = fig.subplots()
-    for name in ("xs", "xu"):
-        ax.plot(ref.time, output_signal(ref, name) * _MM, label=f"exact {name}", **_EXACT[name])
-    xs, xu = output_signal(resp, "xs"), output_signal(resp, "xu")
-    ax.plot(resp.time, xs * _MM, "r-", lw=1.2, label="suspension (sprung mass) xs")
-    ax.plot(resp.time, xu * _MM, "b--", lw=1.2, label="wheel xu")
+    for name, style in ((body, "xs"), (wheel, "xu")):
+        ax.plot(ref.time, output_signal(ref, name) * _MM, label=f"exact {name}", **_EXACT[style])
+    xs, xu = output_signal(resp, body), output_signal(resp, wheel)
+    ax.plot(resp.time, xs * _MM, "r-", lw=1.2, label=f"suspension (sprung mass) {body}")
+    ax.plot(resp.time, xu * _MM, "b--", lw=1.2, label=f"wheel {wheel}")
     title = f"{method}, h = {cmp.h:g} s"
     same = [g for g in coincidence_groups(cmp) if method in g]
     if same:
@@ -152,11 +169,12 @@ def overlay_figure(cmp) -> Figure:
     fig = Figure(figsize=(8, 3.6), layout="constrained")
     ax = fig.subplots()
     ref = cmp.reference
-    ax.plot(ref.time, output_signal(ref, "xs") * _MM, color="k", lw=4, alpha=0.25, label="exact")
+    body = _body_wheel(cmp)[0]
+    ax.plot(ref.time, output_signal(ref, body) * _MM, color="k", lw=4, alpha=0.25, label="exact")
     for name, resp in cmp.responses.items():
         ax.plot(
             resp.time,
-            output_signal(resp, "xs") * _MM,
+            output_signal(resp, body) * _MM,
             color=colors[name],
             lw=1.2,
             label=name,
@@ -164,7 +182,7 @@ def overlay_figure(cmp) -> Figure:
         )
     ax.set(
         xlabel="time [s]",
-        ylabel="body displacement xs [mm]",
+        ylabel=f"body displacement {body} [mm]",
         title=f"All methods against the exact response, h = {cmp.h:g} s",
     )
     ax.grid(alpha=0.3)
@@ -172,20 +190,39 @@ def overlay_figure(cmp) -> Figure:
     return fig
 
 
+_ERROR_CEILING = 1e200  # [m] far beyond any physical error, far below float overflow
+
+
 def error_figure(cmp) -> Figure:
     """|xs error| against time on a log axis."""
     colors, rank = _colors(cmp.responses), _rank(cmp)
     fig = Figure(figsize=(8, 3.6), layout="constrained")
     ax = fig.subplots()
-    exact = output_signal(cmp.reference, "xs")
+    body = _body_wheel(cmp)[0]
+    exact = output_signal(cmp.reference, body)
+    clipped = False
     for name, resp in cmp.responses.items():
         n = resp.time.size
-        err = np.abs(output_signal(resp, "xs") - exact[:n])
+        with np.errstate(invalid="ignore", over="ignore"):  # a diverged run: inf, shown clipped
+            err = np.abs(output_signal(resp, body) - exact[:n])
         err = np.where(err > 0, err, np.nan)  # exact zeros (t = 0) have no log
+        # the log axis pads its range by a factor; past ~1e300 that overflows
+        clipped |= bool(np.any(err > _ERROR_CEILING))
+        err = np.minimum(err, _ERROR_CEILING)
         ax.semilogy(resp.time, err, color=colors[name], lw=1, label=name, **_style(cmp, name, rank))
+    if clipped:
+        ax.axhline(_ERROR_CEILING, color="0.5", lw=0.8, ls="--")
+        ax.annotate(
+            f"diverged: errors above {_ERROR_CEILING:.0e} m drawn on this line",
+            (0.01, _ERROR_CEILING),
+            xycoords=("axes fraction", "data"),
+            va="top",
+            fontsize="small",
+            color="0.3",
+        )
     ax.set(
         xlabel="time [s]",
-        ylabel="|xs − xs exact| [m]",
+        ylabel=f"|{body} − {body} exact| [m]",
         title=f"Error against time, h = {cmp.h:g} s",
     )
     ax.grid(alpha=0.3, which="both")
@@ -244,7 +281,7 @@ def convergence_figure(cmp) -> Figure:
     ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set(
         xlabel="step h [s]",
-        ylabel="max |xs error| [m]",
+        ylabel=f"max |{_body_wheel(cmp)[0]} error| [m]",
         title="Convergence (dotted: slope of the method's order)",
     )
     ax.grid(alpha=0.3, which="both")
@@ -279,7 +316,7 @@ def work_precision_figure(cmp) -> Figure:
         right.loglog(rows["time"] * 1e3, rows["error"], **{**style, "ls": "none"})
     left.set(
         xlabel="right-hand-side evaluations",
-        ylabel="max |xs error| [m]",
+        ylabel=f"max |{_body_wheel(cmp)[0]} error| [m]",
         title="Against work",
     )
     right.set(

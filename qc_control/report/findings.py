@@ -39,11 +39,17 @@ def _step_limits(cmp) -> list[str]:
     out = []
     if "euler" in t.index:
         row = t.loc["euler"]
-        out.append(
-            f"Euler's step limit is h = {fmt(row['h_max [s]'])} s, set by the "
-            f"{row['limited by']} mode (|1 + hλ| ≤ 1, i.e. h ≤ −2·Re λ/|λ|²); the chosen "
-            f"h = {fmt(cmp.h)} s is {fmt(100 * cmp.h / row['h_max [s]'])}% of it."
-        )
+        if row["h_max [s]"] > 0:
+            out.append(
+                f"Euler's step limit is h = {fmt(row['h_max [s]'])} s, set by the "
+                f"{row['limited by']} mode (|1 + hλ| ≤ 1, i.e. h ≤ −2·Re λ/|λ|²); the chosen "
+                f"h = {fmt(cmp.h)} s is {fmt(100 * cmp.h / row['h_max [s]'])}% of it."
+            )
+        else:  # Re λ = 0: the limit −2·Re λ/|λ|² is zero
+            out.append(
+                f"Euler has no stable step: the {row['limited by']} mode is undamped "
+                "(Re λ = 0), so |1 + hλ| > 1 for every h > 0 and its amplitude grows at any step."
+            )
     others = [f"{m} {fmt(r['h_max [s]'])} s" for m, r in t.iterrows() if m != "euler"]
     if others:
         out.append("The other limits: " + ", ".join(others) + ".")
@@ -103,19 +109,28 @@ def _coincidence(cmp) -> list[str]:
 
 
 def _damping(cmp) -> list[str]:
-    body, wheel = cmp.modes.body, cmp.modes.wheel
-    text = (
-        f"Nominal against modal damping: the nominal ratio cs/(2·√(ks·ms)) = "
-        f"{fmt(body.zeta_nominal)}, but the modes have ζ = {fmt(body.zeta)} (body bounce, "
-        f"{fmt(body.fn)} Hz) and ζ = {fmt(wheel.zeta)} (wheel hop, {fmt(wheel.fn)} Hz)."
-    )
+    first = cmp.modes.modes[0]  # body bounce, or a car's lowest body mode
+    if math.isfinite(first.zeta_nominal):  # the quarter car
+        body, wheel = cmp.modes.body, cmp.modes.wheel
+        text = (
+            f"Nominal against modal damping: the nominal ratio cs/(2·√(ks·ms)) = "
+            f"{fmt(body.zeta_nominal)}, but the modes have ζ = {fmt(body.zeta)} (body bounce, "
+            f"{fmt(body.fn)} Hz) and ζ = {fmt(wheel.zeta)} (wheel hop, {fmt(wheel.fn)} Hz)."
+        )
+    else:
+        text = (
+            "Modal damping: "
+            + ", ".join(f"ζ = {fmt(m.zeta)} ({m.name}, {fmt(m.fn)} Hz)" for m in cmp.modes.modes)
+            + "."
+        )
     out = [text]
     for m, nm in cmp.numerical_modes.items():
-        b = nm.loc["body bounce"]
+        b = nm.loc[first.name]
+        label = first.name.replace(" ", "-")  # "body-bounce" on a quarter car
         worst = nm["freq error [%]"].abs().idxmax()
         sign = "adds" if b["zeta error"] > 0 else "removes"
         out.append(
-            f"{m} at h = {fmt(cmp.h)} s {sign} damping: body-bounce ζ {fmt(b['zeta'])} → "
+            f"{m} at h = {fmt(cmp.h)} s {sign} damping: {label} ζ {fmt(b['zeta'])} → "
             f"{fmt(b['zeta_h'])} (Δζ = {b['zeta error']:+.2g}); its largest frequency error is "
             f"{fmt(nm.loc[worst, 'freq error [%]'])}% ({worst})."
         )
@@ -148,19 +163,29 @@ def _ride(cmp) -> list[str]:
     ref = float(ride.loc["reference", key])
     off = cmp.ride_error["rms_body_acc_wk [% off]"]
     parts = [f"{m} {v:+.2g}%" for m, v in off.items()]
-    lift = bool(ride.loc["reference", "lift_off"])
-    tire = "rms_tire_load / static [-]"
+    # one column per wheel: "lift_off" on a quarter car, "lift_off front" on a half car
+    wheels = [
+        c[len("lift_off") :] for c in ride.columns if c.startswith("lift_off") and "[" not in c
+    ]
+    lifted = [
+        w.strip() or "the wheel" for w in wheels if bool(ride.loc["reference", f"lift_off{w}"])
+    ]
+    tire = [
+        f"{fmt(float(ride.loc['reference', f'rms_tire_load / static{w} [-]']))}" for w in wheels
+    ]
     return [
         f"On this road the exact Wk-weighted body acceleration is {fmt(ref)} m/s² RMS "
         f"(ISO 2631-1); at h = {fmt(cmp.h)} s the methods give it "
         + ", ".join(parts)
         + ". "
         + (
-            "The dynamic tire load exceeds the static wheel load: the wheel would "
-            "lift off, which this linear model does not represent."
-            if lift
-            else f"The RMS dynamic tire load is {fmt(float(ride.loc['reference', tire]))} "
-            "of the static wheel load, and the wheel never lifts off."
+            "The dynamic tire load exceeds the static wheel load"
+            + ("" if len(wheels) == 1 else f" ({', '.join(lifted)})")
+            + ": the wheel would lift off, which this linear model does not represent."
+            if lifted
+            else f"The RMS dynamic tire load is {' and '.join(tire)} of the static wheel load"
+            + ("" if len(wheels) == 1 else f" ({', '.join(w.strip() for w in wheels)})")
+            + ", and the wheel never lifts off."
         )
     ]
 

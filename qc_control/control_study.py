@@ -1,0 +1,330 @@
+"""Passive, semi-active and active suspensions compared on one car.
+
+`compare_controllers` builds each design on the same quarter car, runs it
+over a bump and an ISO 8608 road with a fixed-step method (linear loops
+through the LTI engine, semi-active ones through
+`qc_control.input_output_response`), and computes:
+
+- on the bump: peak body acceleration, peak suspension travel, the 2 %
+  settling time of the body displacement (`qc_control.metrics`);
+- on the road: RMS and ISO 2631-1 Wk-weighted RMS body acceleration, RMS
+  travel, RMS dynamic tire load over the static load, RMS actuator force
+  and the mean actuator power ``⟨fa·(vs - vu)⟩`` (positive: the actuator
+  delivers energy; a semi-active damper only dissipates, so its power is
+  <= 0);
+- the transmissibility from the road to the body acceleration and to the
+  tire deflection of every linear design (``control.frequency_response``;
+  a semi-active loop has none).
+
+Every number is here; `qc_control.report.control` formats them.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import control
+import numpy as np
+import pandas as pd
+
+from . import road
+from .controllers import (
+    add_damper,
+    closed_loop,
+    groundhook,
+    hinf_controller,
+    hybrid,
+    lqr_controller,
+    skyhook,
+)
+from .damping import ParetoFront, optimal_damping, pareto_front, spectral_ride
+from .integrate import check_time_grid
+from .metrics import mean_square
+from .model import QuarterCarParams, as_params, quarter_car_model
+from .response import auto_step, forced_response, input_output_response
+from .ride import ride_metrics
+from .road import positive
+from .vehicle import VehicleModel
+
+__all__ = ["ControlComparison", "compare_controllers", "DESIGNS", "BUMP_METRICS", "ROAD_METRICS"]
+
+#: The designs compared by default, in order.
+DESIGNS = (
+    "passive (seed)",
+    "passive optimum",
+    "skyhook",
+    "skyhook semi-active",
+    "groundhook",
+    "groundhook semi-active",
+    "hybrid",
+    "hybrid semi-active",
+    "ADD",
+    "LQR",
+    "H∞",
+)
+#: Metrics of the bump run (names of `qc_control.metrics`).
+BUMP_METRICS = ("peak_body_acc", "peak_susp_travel", "settling_time")
+#: Metrics of the road run.
+ROAD_METRICS = ("rms_body_acc", "rms_body_acc_wk", "rms_susp_travel", "rms_tire_load / static")
+
+
+@dataclass(frozen=True, eq=False)
+class ControlComparison:
+    """Every number of the controller comparison.
+
+    Attributes
+    ----------
+    params : QuarterCarParams
+        The car.
+    designs : dict[str, str]
+        Design name -> what it is (law, gains, device range).
+    table : pandas.DataFrame
+        One row per design: the bump metrics (``bump: ...``) and the road
+        metrics (``road: ...``), with units in the column names.
+    freqs_hz : ndarray
+    transmissibility : dict[str, dict[str, ndarray]]
+        Linear design -> ``{'body_acc': |H|, 'tire_defl': |H|}`` from the
+        road height.
+    bump : dict
+        ``height`` [m], ``length`` [m], ``speed`` [m/s], ``duration`` [s].
+    road : dict
+        ``road_class``, ``speed`` [m/s], ``duration`` [s], ``seed``.
+    method : str
+    dt : dict
+        The time step [s] of the bump and road runs.
+    exact : pandas.DataFrame
+        Linear design -> its exact stationary RMS metrics on the road's
+        white road velocity (`qc_control.damping.spectral_ride`: Lyapunov,
+        unbounded band), free of the finite run's sampling spread.
+    pareto : ParetoFront or None
+        The passive comfort / road-holding front (cs x ks around the car)
+        with the linear controllers marked.
+    notes : list[str]
+    """
+
+    params: QuarterCarParams
+    designs: dict
+    table: pd.DataFrame
+    freqs_hz: np.ndarray
+    transmissibility: dict
+    bump: dict
+    road: dict
+    method: str
+    dt: dict
+    exact: pd.DataFrame = field(default_factory=pd.DataFrame)
+    pareto: ParetoFront | None = None
+    notes: list = field(default_factory=list)
+
+
+def _design_set(p: QuarterCarParams, road_class, speed, cmax, which, hinf_beta):
+    """name -> (VehicleModel, description): every design on the same car."""
+    car = quarter_car_model(p, road=True, actuator=True)
+    c_sky, c_gnd = 3000.0, 1000.0
+    semi = {"semi_active": "on-off", "cmin": 0.0, "cmax": cmax}
+    device = f"on-off damper 0-{cmax:.0f} N·s/m in parallel with cs"
+    makers = {
+        "passive (seed)": lambda: (quarter_car_model(p, road=True), f"cs = {p.cs:.0f} N·s/m"),
+        "passive optimum": lambda: _passive_optimum(p, road_class, speed),
+        "skyhook": lambda: (closed_loop(car, skyhook(c_sky)), f"ideal, c_sky = {c_sky:.0f}"),
+        "skyhook semi-active": lambda: (
+            closed_loop(car, skyhook(c_sky, **semi)),
+            f"c_sky = {c_sky:.0f}, {device}",
+        ),
+        "groundhook": lambda: (
+            closed_loop(car, groundhook(c_gnd)),
+            f"ideal, c_gnd = {c_gnd:.0f} (unstable beyond ~1.2e3 on the seed car)",
+        ),
+        "groundhook semi-active": lambda: (
+            closed_loop(car, groundhook(c_sky, **semi)),
+            f"c_gnd = {c_sky:.0f}, {device}",
+        ),
+        "hybrid": lambda: (
+            closed_loop(car, hybrid(c_sky, 0.5)),
+            f"ideal, c = {c_sky:.0f}, α = 0.5",
+        ),
+        "hybrid semi-active": lambda: (
+            closed_loop(car, hybrid(c_sky, 0.5, **semi)),
+            f"c = {c_sky:.0f}, α = 0.5, {device}",
+        ),
+        "ADD": lambda: (
+            closed_loop(car, add_damper(0.0, cmax)),
+            f"acceleration-driven damper, {device}, 50 Hz accelerometer",
+        ),
+        "LQR": lambda: (
+            closed_loop(car, lqr_controller(car)),
+            "full state, default weights (1 m/s², 5 cm, 5 mm, 1 kN)",
+        ),
+        "H∞": lambda: _hinf(car, hinf_beta),
+    }
+    unknown = [w for w in which if w not in makers]
+    if unknown:
+        raise ValueError(f"unknown design {unknown[0]!r}; choose from {list(makers)}")
+    return {name: makers[name]() for name in which}
+
+
+def _passive_optimum(p, road_class, speed):
+    opt = optimal_damping(p, "comfort", road=(road_class, speed))
+    model = quarter_car_model(opt.params, road=True)
+    return model, f"comfort optimum (closed form), cs = {opt.cs:.0f} N·s/m, ζ = {opt.zeta:.2f}"
+
+
+def _hinf(car, beta):
+    design = hinf_controller(car, beta)
+    what = (
+        f"MATLAB active-suspension weights, β = {beta:g}, γ = {design.gamma:.4f} "
+        f"(closed-loop ‖·‖∞ {design.norm:.4f})"
+    )
+    return closed_loop(car, design.controller), what
+
+
+def _run(model: VehicleModel, T, U, method: str):
+    """A fixed-step run; a linear loop is substepped to `auto_step`'s accuracy rule.
+
+    (An H∞ loop has poles near -700 1/s, beyond RK4's stability at 5 ms.)
+    A semi-active loop steps at the grid's spacing: its fastest mode is the
+    car's wheel hop under ``cs + cmax`` (about -60 1/s) or the ADD's sensor
+    (-314 1/s), within RK4's stability limit at 5 ms.
+    """
+    if isinstance(model.system, control.StateSpace):
+        h, _ = auto_step(method, model.system.poles())
+        substeps = max(1, math.ceil(float(T[1] - T[0]) / h * (1 - 1e-12)))
+        return forced_response(model.system, T, U, method=method, substeps=substeps)
+    return input_output_response(model.system, T, U, method=method)
+
+
+def _actuator(resp) -> tuple[float, float]:
+    """RMS actuator force [N] and mean power [W] (0, 0 for a passive car)."""
+    labels = list(resp.output_labels)
+    if "fa" not in labels:
+        return 0.0, 0.0
+    fa = np.asarray(resp.outputs)[labels.index("fa")]
+    states = list(resp.state_labels)
+    x = np.asarray(resp.states)
+    vrel = x[states.index("vs")] - x[states.index("vu")]
+    power = fa * vrel
+    mean_power = float(np.trapezoid(power, resp.time) / (resp.time[-1] - resp.time[0]))
+    return float(math.sqrt(mean_square(fa))), mean_power
+
+
+def compare_controllers(
+    params=None,
+    *,
+    designs: Sequence[str] = DESIGNS,
+    road_class: str = "C",
+    speed: float = 20.0,
+    road_duration: float = 10.0,
+    road_seed: int = 0,
+    bump_height: float = 0.05,
+    bump_duration: float = 15.0,
+    method: str = "rk4",
+    cmax: float = 4000.0,
+    hinf_beta: float = 0.5,
+    freqs_hz=None,
+) -> ControlComparison:
+    """Run every design over a bump and an ISO 8608 road, and tabulate.
+
+    Parameters
+    ----------
+    params : QuarterCarParams, dict or None
+        The car; the seed's by default.
+    designs : sequence of str
+        A subset of `DESIGNS` (``'H∞'`` needs slycot).
+    road_class, speed, road_duration, road_seed
+        The ISO 8608 road [-, m/s, s, -], sampled at 5 ms (within
+        `qc_control.road.largest_step` up to 35 m/s).
+    bump_height, bump_duration
+        The 1 m long 1 - cos bump met at 10 m/s [m, s], sampled at 2 ms;
+        the run must be long enough for the body to settle (the seed car's
+        body mode needs about 9 s to reach 2 %).
+    method : str
+        The fixed-step method of both runs.
+    cmax : float
+        The semi-active damper's largest damping [N·s/m].
+    hinf_beta : float
+        The H∞ design's travel/comfort weight (MATLAB's β).
+    freqs_hz : array_like, optional
+        Transmissibility frequencies; default 200 from 0.1 to 30 Hz.
+
+    Returns
+    -------
+    ControlComparison
+    """
+    p = as_params(params)
+    speed = positive("speed", speed, "m/s")
+    road_duration = positive("road_duration", road_duration, "s")
+    bump_duration = positive("bump_duration", bump_duration, "s")
+    positive("cmax", cmax, "N·s/m")
+    built = _design_set(p, road_class, speed, float(cmax), list(designs), hinf_beta)
+    dt_road, dt_bump = 0.005, 0.002
+    T_road = check_time_grid(np.arange(0.0, road_duration + dt_road / 2, dt_road), "T")
+    T_bump = check_time_grid(np.arange(0.0, bump_duration + dt_bump / 2, dt_bump), "T")
+    zr_road = road.iso8608(T_road, road_class, speed=speed, seed=road_seed)
+    zr_bump = road.bump(T_bump, height=bump_height)
+    f = np.geomspace(0.1, 30.0, 200) if freqs_hz is None else np.asarray(freqs_hz, float)
+    rows, trans, notes = {}, {}, []
+    for name, (model, _) in built.items():
+        bump_resp = _run(model, T_bump, zr_bump, method)
+        road_resp = _run(model, T_road, zr_road, method)
+        row = {f"bump: {k}": v for k, v in ride_metrics(bump_resp, model, BUMP_METRICS).items()}
+        row.update(
+            {f"road: {k}": v for k, v in ride_metrics(road_resp, model, ROAD_METRICS).items()}
+        )
+        force, power = _actuator(road_resp)
+        row["road: rms actuator force [N]"] = force
+        row["road: mean actuator power [W]"] = power
+        rows[name] = row
+        if not (bump_resp.success and road_resp.success):
+            notes.append(f"{name}: the fixed-step run did not succeed ({road_resp.message})")
+        if isinstance(model.system, control.StateSpace):
+            j = model.system.input_labels.index("zr")
+            H = np.asarray(control.frequency_response(model.system, 2 * np.pi * f).complex)
+            trans[name] = {s: np.abs(H[model.output(s), j]) for s in ("body_acc", "tire_defl")}
+    linear = {
+        name: model
+        for name, (model, _) in built.items()
+        if isinstance(model.system, control.StateSpace)
+    }
+    exact = pd.concat(
+        [spectral_ride(m, (road_class, speed)).set_axis([n]) for n, m in linear.items()]
+    )
+    exact.index.name = "design"
+    critical = 2 * math.sqrt(p.ks * p.ms)
+    front = pareto_front(
+        p,
+        {
+            "cs": list(np.geomspace(0.1, 3.0, 40) * critical),
+            "ks": [k * p.ks for k in (0.5, 0.75, 1.0, 1.5, 2.0)],
+        },
+        road=(road_class, speed),
+        controllers={n: m for n, m in linear.items() if not n.startswith("passive")},
+    )
+    table = pd.DataFrame.from_dict(rows, orient="index").astype(float)
+    table.index.name = "design"
+    semi = [n for n, (m, _) in built.items() if not isinstance(m.system, control.StateSpace)]
+    if semi:
+        notes.append(
+            "semi-active designs are nonlinear and have no transmissibility: "
+            + ", ".join(semi)
+            + " appear in the table only"
+        )
+    return ControlComparison(
+        params=p,
+        designs={name: what for name, (_, what) in built.items()},
+        table=table,
+        freqs_hz=f,
+        transmissibility=trans,
+        bump={"height": bump_height, "length": 1.0, "speed": 10.0, "duration": bump_duration},
+        road={
+            "road_class": road_class,
+            "speed": speed,
+            "duration": road_duration,
+            "seed": road_seed,
+        },
+        method=method,
+        dt={"bump": dt_bump, "road": dt_road},
+        exact=exact,
+        pareto=front,
+        notes=notes,
+    )

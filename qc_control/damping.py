@@ -1,0 +1,487 @@
+"""Passive damper optimisation on exact spectral metrics, and the Pareto front.
+
+On white road velocity of intensity ``q`` (an ISO 8608 road of waviness 2
+at a constant speed, `qc_control.spectral.iso8608_intensity`), the quarter
+car's stationary variances are exact closed forms (Gobbi & Mastinu,
+"Analytical description and optimization of the dynamic behaviour of
+passively suspended road vehicles", J. Sound Vib. 245(3), 2001; Dahlberg,
+"An optimized speed-controlled suspension of a 2-DOF vehicle travelling
+on a randomly profiled road", J. Sound Vib. 58(2), 1978), each of the form
+``a·cs + b/cs``:
+
+.. math::
+
+    σ^2_{\\ddot x_s} = q\\,\\frac{c_s^2 k_t + k_s^2 (m_s + m_u)}{2 c_s m_s^2},
+    \\qquad σ^2_{travel} = q\\,\\frac{m_s + m_u}{2 c_s},
+
+    σ^2_{tire} = q\\,\\frac{c_s^2 k_t M^2 + k_s^2 M^3
+        - 2 k_s k_t m_s m_u M + k_t^2 m_s^2 m_u}{2 c_s k_t^2 m_s^2},
+    \\quad M = m_s + m_u
+
+(``kt`` is the tire stiffness ``ku``; the tire-deflection form is this
+module's solution of the same Lyapunov equation, checked against it in the
+tests). A weighted sum ``Σ w_i σ²_i = A·cs + B/cs`` is least at
+``cs = √(B/A)``: comfort alone gives ``cs = ks·√((ms + mu)/kt)``, road
+holding alone ``cs = √(ks² M³ - 2 ks kt ms mu M + kt² ms² mu)/(√kt · M)``.
+Travel alone falls as ``1/cs`` and has no finite optimum; as a constraint
+(RMS or 3σ travel within a rattle-space limit) it bounds ``cs`` from
+below, and the objective being convex in ``cs``, the constrained optimum
+is the larger of the two.
+
+Objectives without a closed form (the ISO 2631-1 Wk-weighted comfort, or a
+vehicle other than the quarter car) are minimised by
+``scipy.optimize.minimize_scalar`` on the exact Lyapunov metric
+(`qc_control.spectral`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pandas as pd
+import scipy.optimize
+
+from .model import QuarterCarParams, as_params, quarter_car_model
+from .road import positive
+from .spectral import iso8608_intensity, white_velocity_variances, white_velocity_wk_variance
+from .sweeps import design_grid
+from .vehicle import STANDARD_GRAVITY, VehicleModel
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+__all__ = [
+    "OBJECTIVES",
+    "DampingOptimum",
+    "ParetoFront",
+    "spectral_ride",
+    "closed_form_terms",
+    "optimal_damping",
+    "pareto_front",
+]
+
+#: Objective name -> (metric column, what it is). Variances of these are minimised.
+OBJECTIVES = {
+    "comfort": ("rms_body_acc [m/s²]", "RMS body acceleration"),
+    "comfort_wk": ("rms_body_acc_wk [m/s²]", "ISO 2631-1 Wk-weighted RMS body acceleration"),
+    "road_holding": ("rms_tire_load / static [-]", "RMS dynamic tire load over the static load"),
+    "travel": ("rms_susp_travel [m]", "RMS suspension travel"),
+}
+
+
+def _intensity(road) -> float:
+    """White road-velocity intensity [m²/s] from ``road``."""
+    if road is None:
+        return 1.0
+    if isinstance(road, tuple) and len(road) == 2:
+        return iso8608_intensity(road[0], road[1])
+    return positive("road (white road-velocity intensity)", road, "m²/s")
+
+
+def spectral_ride(model: VehicleModel, road=None, *, batch=None, wk: bool = False) -> pd.DataFrame:
+    """Exact RMS ride metrics of linear designs on white road velocity.
+
+    Parameters
+    ----------
+    model : VehicleModel
+        A linear vehicle with a road input (one corner is read: the first).
+    road : None, float or (road_class, speed)
+        Unit intensity (None), an intensity [m²/s], or an ISO 8608 road
+        (class letter, speed [m/s]).
+    batch : BatchedModel, optional
+        Many designs of ``model`` at once.
+    wk : bool
+        Also the Wk-weighted comfort (one more Lyapunov solve of 4 more states).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per design: the columns of `OBJECTIVES` (Wk only with ``wk``).
+    """
+    q = _intensity(road)
+    corner = model.corners[0]
+    var = white_velocity_variances(
+        model,
+        intensity=q,
+        outputs=[model.body_acc, corner.susp_travel, corner.tire_defl],
+        batch=batch,
+    )
+    kt = corner.tire_stiffness if batch is None else batch.tire_stiffness[0]
+    load = corner.static_load if batch is None else batch.static_load[0]
+    cols = {
+        OBJECTIVES["comfort"][0]: np.sqrt(var[model.body_acc]),
+        OBJECTIVES["road_holding"][0]: kt * np.sqrt(var[corner.tire_defl]) / load,
+        OBJECTIVES["travel"][0]: np.sqrt(var[corner.susp_travel]),
+    }
+    if wk:
+        cols[OBJECTIVES["comfort_wk"][0]] = np.sqrt(
+            white_velocity_wk_variance(model, intensity=q, batch=batch)
+        )
+    return pd.DataFrame({k: np.atleast_1d(v) for k, v in cols.items()})
+
+
+def closed_form_terms(p: QuarterCarParams, objective: str) -> tuple[float, float]:
+    """``(a, b)`` with ``σ² = a·cs + b/cs`` at unit intensity (module formulas)."""
+    ms, mu, ks, kt = p.ms, p.mu, p.ks, p.ku
+    M = ms + mu
+    if objective == "comfort":
+        return kt / (2 * ms**2), ks**2 * M / (2 * ms**2)
+    if objective == "travel":
+        return 0.0, M / 2
+    if objective == "road_holding":
+        tire = kt / (M * STANDARD_GRAVITY)  # tire load / static per metre of deflection
+        a = M**2 / (2 * kt * ms**2)
+        b = (ks**2 * M**3 - 2 * ks * kt * ms * mu * M + kt**2 * ms**2 * mu) / (2 * kt**2 * ms**2)
+        return tire**2 * a, tire**2 * b
+    raise KeyError(objective)
+
+
+@dataclass(frozen=True)
+class DampingOptimum:
+    """The damping that minimises an objective.
+
+    Attributes
+    ----------
+    cs : float
+        Optimal damping [N·s/m].
+    zeta : float
+        ``cs / (2√(ks·ms))`` [-].
+    params : QuarterCarParams or object
+        The vehicle with that damping.
+    value : float
+        The objective at the optimum: the weighted sum of variances
+        ``Σ wᵢ σᵢ²`` of the `OBJECTIVES` metrics at intensity ``q``.
+    metrics : pandas.Series
+        The RMS metrics (`OBJECTIVES` columns) at the optimum.
+    method : str
+        ``'closed form'``, ``'closed form, travel limit'`` (the travel
+        constraint is active) or ``'scipy.optimize'``.
+    """
+
+    cs: float
+    zeta: float
+    params: Any
+    value: float
+    metrics: pd.Series
+    method: str
+
+
+def _weights(objective) -> dict[str, float]:
+    if isinstance(objective, str):
+        if objective not in OBJECTIVES:
+            raise ValueError(
+                f"objective must be one of {sorted(OBJECTIVES)} or a mapping of weights, "
+                f"got {objective!r}"
+            )
+        return {objective: 1.0}
+    if not isinstance(objective, Mapping) or not objective:
+        raise TypeError(
+            f"objective must be a name from {sorted(OBJECTIVES)} or a non-empty mapping "
+            f"name -> weight, got {objective!r}"
+        )
+    out = {}
+    for k, v in objective.items():
+        if k not in OBJECTIVES:
+            raise ValueError(
+                f"unknown objective {k!r} in the weights; expected {sorted(OBJECTIVES)}"
+            )
+        out[k] = positive(f"weight of {k!r}", v, "") if v != 0 else 0.0
+    if not any(out.values()):
+        raise ValueError(f"the weights {dict(objective)!r} are all zero")
+    return out
+
+
+def _with_cs(params, cs: float):
+    if isinstance(params, QuarterCarParams):
+        return QuarterCarParams.from_mapping({**params.to_dict(changing=["cs"]), "cs": cs})
+    values = params.to_dict(changing=["cs"])
+    return type(params).from_mapping({**values, "cs": cs})
+
+
+def _travel_floor(p: QuarterCarParams, q: float, travel_limit, sigmas: float) -> float:
+    """The least cs whose RMS travel ``√(q M/(2 cs))`` is within ``travel_limit/sigmas``."""
+    if travel_limit is None:
+        return 0.0
+    limit = positive("travel_limit", travel_limit, "m") / sigmas
+    return q * (p.ms + p.mu) / (2 * limit**2)
+
+
+def optimal_damping(
+    params=None,
+    objective="comfort",
+    *,
+    road=None,
+    travel_limit: float | None = None,
+    sigmas: float = 1.0,
+    method: str = "auto",
+    bounds: tuple[float, float] | None = None,
+) -> DampingOptimum:
+    """The passive damping ``cs`` that minimises a ride objective on a random road.
+
+    Parameters
+    ----------
+    params : QuarterCarParams, dict, VehicleModel or None
+        The vehicle (its ``cs`` is what changes); the seed's by default. A
+        `VehicleModel` (with a road input) is optimised numerically through
+        its ``rebuild``.
+    objective : str or mapping
+        ``'comfort'``, ``'comfort_wk'``, ``'road_holding'``, or weights
+        ``{'comfort': 1, 'road_holding': 50, 'travel': 0}`` of the summed
+        variances (``'travel'`` alone has no finite optimum: ValueError).
+    road : None, float or (road_class, speed)
+        See `spectral_ride`; it scales every variance by ``q`` and so moves
+        the optimum only through ``travel_limit``.
+    travel_limit : float, optional
+        Rattle space [m]: ``sigmas`` times the RMS travel must stay within it.
+    sigmas : float, default 1
+        1 for an RMS limit, 3 for a 3σ limit.
+    method : 'auto', 'closed form' or 'numerical'
+        ``'auto'`` uses the closed form where one exists (the quarter car,
+        any weights without ``comfort_wk``).
+    bounds : (float, float), optional
+        The numerical search's ``cs`` interval [N·s/m]; default 0.01 to 100
+        times the critical damping ``2√(ks·ms)``.
+
+    Returns
+    -------
+    DampingOptimum
+
+    Examples
+    --------
+    >>> round(optimal_damping().cs, 1)   # ks·√((ms + mu)/kt), seed car
+    3496.8
+    """
+    weights = _weights(objective)
+    if set(weights) == {"travel"} or not any(w for k, w in weights.items() if k != "travel"):
+        raise ValueError(
+            "travel alone falls monotonically with cs ((ms + mu)/(2 cs)): it has no finite "
+            "optimum; weigh it with comfort or road_holding, or give it as travel_limit"
+        )
+    if method not in ("auto", "closed form", "numerical"):
+        raise ValueError(f"method must be 'auto', 'closed form' or 'numerical', got {method!r}")
+    sigmas = positive("sigmas", sigmas, "")
+    q = _intensity(road)
+    model = (
+        params
+        if isinstance(params, VehicleModel)
+        else quarter_car_model(as_params(params), road=True)
+    )
+    p = model.params
+    closed = isinstance(p, QuarterCarParams) and "comfort_wk" not in weights
+    closed = closed and not isinstance(params, VehicleModel)
+    if method == "closed form" and not closed:
+        raise ValueError(
+            "no closed form for this objective or vehicle (Wk weighting, or not a quarter "
+            "car): use method='numerical' or 'auto'"
+        )
+    use_closed = closed and method != "numerical"
+    wk = "comfort_wk" in weights
+
+    def objective_value(m: VehicleModel) -> tuple[float, pd.Series]:
+        row = spectral_ride(m, q, wk=wk).iloc[0]
+        return sum(w * row[OBJECTIVES[k][0]] ** 2 for k, w in weights.items()), row
+
+    if use_closed:
+        a = b = 0.0
+        for k, w in weights.items():
+            ak, bk = closed_form_terms(p, k)
+            a, b = a + w * ak, b + w * bk
+        cs = math.sqrt(b / a)
+        how = "closed form"
+    else:
+        critical = 2 * math.sqrt(p.ks * p.ms)
+        lo, hi = bounds if bounds is not None else (0.01 * critical, 100 * critical)
+        lo, hi = positive("bounds[0]", lo, "N·s/m"), positive("bounds[1]", hi, "N·s/m")
+        if hi <= lo:
+            raise ValueError(f"bounds must be increasing, got {bounds!r}")
+
+        def f(log_cs: float) -> float:
+            return objective_value(model.rebuild(_with_cs(p, math.exp(log_cs))))[0]
+
+        res = scipy.optimize.minimize_scalar(
+            f, bounds=(math.log(lo), math.log(hi)), method="bounded", options={"xatol": 1e-9}
+        )
+        cs = math.exp(float(res.x))
+        how = "scipy.optimize"
+    if travel_limit is not None:
+        floor = _travel_floor(p, q, travel_limit, sigmas)
+        if cs < floor:
+            cs, how = floor, f"{how}, travel limit"
+    best = model.rebuild(_with_cs(p, cs))
+    value, row = objective_value(best)
+    zeta = cs / (2 * math.sqrt(p.ks * p.ms))
+    return DampingOptimum(cs, zeta, best.params, float(value), row, how)
+
+
+# ---------------------------------------------------------------- the Pareto front
+
+
+def _non_dominated(values: np.ndarray) -> np.ndarray:
+    """Mask of the rows of ``values (m, k)`` that no other row dominates (all minimised)."""
+    order = np.lexsort(values.T[::-1])
+    keep = np.zeros(len(values), dtype=bool)
+    front: list[np.ndarray] = []
+    for i in order:
+        v = values[i]
+        if not any(np.all(f <= v) and np.any(f < v) for f in front):
+            keep[i] = True
+            front = [f for f in front if not (np.all(v <= f) and np.any(v < f))] + [v]
+    return keep
+
+
+@dataclass(frozen=True, eq=False)
+class ParetoFront:
+    """Non-dominated passive designs, and the figure.
+
+    Attributes
+    ----------
+    designs : pandas.DataFrame
+        The non-dominated, feasible designs: their varied parameters and
+        `OBJECTIVES` metrics, sorted by the first objective.
+    all_designs : pandas.DataFrame
+        Every design, with ``feasible`` (travel limit) and ``pareto`` flags.
+    markers : pandas.DataFrame
+        The marked points (passive optimum, the seed, controllers) and
+        their metrics.
+    figure : matplotlib.figure.Figure
+    """
+
+    designs: pd.DataFrame
+    all_designs: pd.DataFrame
+    markers: pd.DataFrame
+    figure: Figure
+
+
+def pareto_front(
+    params=None,
+    vary: Mapping[str, Sequence[float]] | None = None,
+    objectives: Sequence[str] = ("comfort", "road_holding"),
+    *,
+    road=("C", 20.0),
+    travel_limit: float | None = None,
+    sigmas: float = 3.0,
+    controllers: Mapping[str, Any] | None = None,
+) -> ParetoFront:
+    """The comfort / road-holding Pareto front of passive designs.
+
+    Every design of the grid ``vary`` (e.g. ``{'cs': [...], 'ks': [...]}``,
+    `qc_control.design_grid`) is evaluated exactly (`spectral_ride`, one
+    batched Lyapunov solve); designs whose ``sigmas``·RMS travel exceeds
+    ``travel_limit`` are infeasible; the front is the feasible designs no
+    other feasible design beats in every objective.
+
+    Parameters
+    ----------
+    params : QuarterCarParams, dict or None
+        The base vehicle.
+    vary : mapping
+        Parameter name -> values; default ``cs`` from 0.05 to 4 times
+        critical damping (60 values).
+    objectives : sequence of str
+        Two or more of `OBJECTIVES`; the figure plots the first two.
+    road : None, float or (road_class, speed)
+        Default ISO 8608 class C at 20 m/s.
+    travel_limit : float, optional
+        Rattle space [m].
+    sigmas : float, default 3
+        The travel limit holds ``sigmas`` standard deviations.
+    controllers : mapping, optional
+        Name -> a linear closed loop (`VehicleModel`, evaluated exactly) or
+        a mapping of `OBJECTIVES` columns to values (e.g. from a simulation),
+        marked on the figure.
+
+    Returns
+    -------
+    ParetoFront
+    """
+    p = as_params(params)
+    objectives = list(objectives)
+    if len(objectives) < 2 or any(o not in OBJECTIVES for o in objectives):
+        raise ValueError(
+            f"objectives must be two or more of {sorted(OBJECTIVES)}, got {objectives!r}"
+        )
+    if vary is None:
+        critical = 2 * math.sqrt(p.ks * p.ms)
+        vary = {"cs": list(np.geomspace(0.05, 4.0, 60) * critical)}
+    designs = design_grid(vary, p)
+    model = quarter_car_model(p, road=True)
+    batch = model.batch([QuarterCarParams.from_mapping(d) for d in designs])
+    wk = "comfort_wk" in objectives
+    table = spectral_ride(model, road, batch=batch, wk=wk)
+    frame = pd.concat([pd.DataFrame(designs)[list(vary)], table], axis=1)
+    travel = frame[OBJECTIVES["travel"][0]].to_numpy()
+    feasible = np.ones(len(frame), dtype=bool)
+    if travel_limit is not None:
+        feasible = positive("sigmas", sigmas, "") * travel <= positive(
+            "travel_limit", travel_limit, "m"
+        )
+    cols = [OBJECTIVES[o][0] for o in objectives]
+    pareto = np.zeros(len(frame), dtype=bool)
+    if feasible.any():
+        pareto[np.flatnonzero(feasible)[_non_dominated(frame.loc[feasible, cols].to_numpy())]] = (
+            True
+        )
+    frame["feasible"], frame["pareto"] = feasible, pareto
+    front = frame[pareto].sort_values(cols[0]).reset_index(drop=True)
+
+    marks: dict[str, Mapping] = {}
+    seed_row = spectral_ride(model, road, wk=wk).iloc[0]
+    marks["passive (this car)"] = seed_row
+    for goal in ("comfort", "road_holding"):
+        opt = optimal_damping(p, goal, road=road, travel_limit=travel_limit, sigmas=sigmas)
+        marks[f"passive optimum: {goal} (cs={opt.cs:.0f})"] = spectral_ride(
+            quarter_car_model(opt.params, road=True), road, wk=wk
+        ).iloc[0]
+    for name, ctrl in (controllers or {}).items():
+        if isinstance(ctrl, VehicleModel):
+            marks[name] = spectral_ride(ctrl, road, wk=wk).iloc[0]
+        else:
+            marks[name] = pd.Series(dict(ctrl))
+    markers = pd.DataFrame(marks).T
+    fig = _pareto_figure(frame, front, markers, cols, travel_limit, sigmas)
+    return ParetoFront(front, frame, markers, fig)
+
+
+def _pareto_figure(frame, front, markers, cols, travel_limit, sigmas) -> Figure:
+    from matplotlib.figure import Figure  # heavy and optional: only when plotting
+
+    fig = Figure(figsize=(8, 6), layout="constrained")
+    ax = fig.subplots()
+    x, y = cols[0], cols[1]
+    tcol = OBJECTIVES["travel"][0]
+    ax.scatter(frame[x], frame[y], s=8, color="0.8", label="all designs")
+    if (~frame["feasible"]).any():
+        bad = frame[~frame["feasible"]]
+        ax.scatter(bad[x], bad[y], s=10, marker="x", color="0.6", label="travel limit exceeded")
+    sc = ax.scatter(front[x], front[y], c=front[tcol], cmap="viridis", s=28, zorder=3)
+    ax.plot(front[x], front[y], color="0.3", lw=0.8, zorder=2, label="Pareto front")
+    fig.colorbar(sc, ax=ax, label=tcol.replace("rms_susp_travel", "RMS suspension travel"))
+    markers_cycle = ["*", "D", "s", "^", "v", "P", "X", "o", "<", ">", "h"]
+    for i, (name, row) in enumerate(markers.iterrows()):
+        if x in row and y in row and pd.notna(row[x]) and pd.notna(row[y]):
+            ax.scatter(
+                [row[x]],
+                [row[y]],
+                marker=markers_cycle[i % len(markers_cycle)],
+                s=90,
+                edgecolor="k",
+                zorder=4,
+                label=name,
+            )
+    ax.set_xlabel(f"{OBJECTIVES[_name_of(x)][1]} [{x.split('[')[-1]}")
+    ax.set_ylabel(f"{OBJECTIVES[_name_of(y)][1]} [{y.split('[')[-1]}")
+    title = "Passive designs: comfort against road holding"
+    if travel_limit is not None:
+        title += f" ({sigmas:g}σ travel <= {1e3 * travel_limit:g} mm)"
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small", loc="best")
+    return fig
+
+
+def _name_of(column: str) -> str:
+    return next(k for k, (c, _) in OBJECTIVES.items() if c == column)

@@ -1,0 +1,181 @@
+"""The controller comparison report (``qc-control control-report``).
+
+Presentation only: every number comes from the
+`qc_control.control_study.ControlComparison`. One table (bump and road
+metrics per design) and two transmissibility figures, one per signal (body
+acceleration and tire deflection against frequency), every linear design
+on each.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import TYPE_CHECKING
+
+import pandas as pd
+
+from . import FORMATS, FigureSpec, write_document
+from .document import Code, Heading, Image, Paragraph, Table
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+__all__ = ["write_control_report", "control_blocks", "control_figures", "TITLE"]
+
+TITLE = "Quarter car: passive, semi-active and active suspensions compared"
+
+_SIGNALS = {
+    "body_acc": ("body acceleration", "|body_acc / zr| [(m/s²)/m]"),
+    "tire_defl": ("tire deflection", "|tire_defl / zr| [m/m]"),
+}
+
+
+def transmissibility_chart(cmp, signal: str) -> Figure:
+    """One signal's |H(f)| from the road height, every linear design on one chart."""
+    from matplotlib.figure import Figure  # heavy and optional: only when plotting
+
+    what, ylabel = _SIGNALS[signal]
+    fig = Figure(figsize=(8, 5), layout="constrained")
+    ax = fig.subplots()
+    styles = ["-", "--", "-.", ":"]
+    for i, (name, mags) in enumerate(cmp.transmissibility.items()):
+        ax.loglog(cmp.freqs_hz, mags[signal], ls=styles[i // 10 % 4], lw=1.4, label=name)
+    ax.set(
+        xlabel="frequency [Hz]",
+        ylabel=ylabel,
+        title=f"Transmissibility from the road to the {what}",
+    )
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def control_figures(cmp) -> list[FigureSpec]:
+    """The report's figures: one transmissibility chart per signal."""
+    specs = []
+    for i, signal in enumerate(_SIGNALS, start=1):
+        what = _SIGNALS[signal][0]
+        specs.append(
+            FigureSpec(
+                f"transmissibility_{signal}.png",
+                f"Figure {i}",
+                f"|{signal}/zr| of every linear design against frequency: the {what} "
+                "per metre of road height (control.frequency_response).",
+                functools.partial(transmissibility_chart, cmp, signal),
+            )
+        )
+    if cmp.pareto is not None:
+        specs.append(
+            FigureSpec(
+                "pareto.png",
+                "Figure 3",
+                "Passive designs (cs × ks around the car) by exact RMS body acceleration and "
+                "tire load on the road's white road velocity, the non-dominated ones coloured by "
+                "RMS travel; the passive optima and the linear controllers marked.",
+                lambda: cmp.pareto.figure,
+            )
+        )
+    return specs
+
+
+def _design_table(cmp) -> pd.DataFrame:
+    return pd.DataFrame(
+        {"what": list(cmp.designs.values())}, index=pd.Index(list(cmp.designs), name="design")
+    )
+
+
+def control_blocks(cmp, command: str | None = None) -> list:
+    """The report as document blocks (see `qc_control.report.document`)."""
+    p, bump, road = cmp.params, cmp.bump, cmp.road
+    table = cmp.table.copy()
+    bump_cols = [c for c in table.columns if c.startswith("bump: ")]
+    road_cols = [c for c in table.columns if c.startswith("road: ")]
+    blocks: list = [
+        Paragraph(
+            f"One quarter car (ms = {p.ms:g} kg, mu = {p.mu:g} kg, ks = {p.ks:g} N/m, "
+            f"ku = {p.ku:g} N/m, cs = {p.cs:.0f} N·s/m) with each suspension design, "
+            f"run by {cmp.method} at a fixed step: over a {bump['height'] * 100:g} cm, "
+            f"{bump['length']:g} m 1 − cos bump at {bump['speed']:g} m/s for "
+            f"{bump['duration']:g} s (h = {cmp.dt['bump'] * 1e3:g} ms) and over an ISO 8608 "
+            f"class {road['road_class']} road at {road['speed']:g} m/s for "
+            f"{road['duration']:g} s (h = {cmp.dt['road'] * 1e3:g} ms, seed {road['seed']}). "
+            "Linear loops are substepped to the accuracy rule of qc_control.auto_step."
+        ),
+        Heading("Designs"),
+        Table(_design_table(cmp), "What each design is.", "Table 1"),
+        Heading("Bump"),
+        Table(
+            table[bump_cols].rename(columns=lambda c: c[len("bump: ") :]),
+            "Peak body acceleration, peak suspension travel and the 2 % settling time of the "
+            f"body displacement (a settling time near {bump['duration']:g} s: not settled "
+            "within the run).",
+            "Table 2",
+        ),
+        Heading("ISO 8608 road"),
+        Table(
+            table[road_cols].rename(columns=lambda c: c[len("road: ") :]),
+            "RMS and ISO 2631-1 Wk-weighted RMS body acceleration, RMS travel, RMS dynamic "
+            "tire load over the static load, RMS actuator force and mean actuator power "
+            "⟨fa·(vs − vu)⟩ (positive: the actuator supplies energy; a semi-active damper "
+            "only dissipates).",
+            "Table 3",
+        ),
+        Heading("Transmissibility"),
+    ]
+    specs = control_figures(cmp)
+    for spec in specs[:2]:
+        blocks.append(Image(spec.name, spec.caption, spec.label))
+    if not cmp.exact.empty:
+        blocks += [
+            Heading("Exact stationary metrics"),
+            Table(
+                cmp.exact,
+                "Linear designs on the road's white road velocity (ISO 8608 of waviness 2 at "
+                "constant speed): stationary RMS from a Lyapunov equation over the unbounded "
+                "band, no simulation. Semi-active designs are nonlinear: Table 3 only.",
+                "Table 4",
+            ),
+        ]
+    for spec in specs[2:]:
+        blocks.append(Image(spec.name, spec.caption, spec.label))
+    if cmp.notes:
+        blocks.append(Heading("Notes"))
+        blocks += [Paragraph(note) for note in cmp.notes]
+    if command:
+        blocks += [Heading("Reproduce"), Code(command)]
+    return blocks
+
+
+def write_control_report(
+    cmp, out_dir, formats=FORMATS, *, command: str | None = None, overwrite: bool = True
+):
+    """Write the controller comparison into ``out_dir`` (as `qc_control.write_report` does).
+
+    Files: ``report.md``/``.html``/``.pdf`` per ``formats``, the two
+    transmissibility PNGs, and with ``'csv'`` ``control_table.csv`` (every
+    number of Tables 2 and 3) and ``transmissibility.csv``.
+    """
+
+    def tables() -> dict[str, pd.DataFrame]:
+        cols = {
+            f"|{sig}/zr| {name}": mags[sig]
+            for sig in _SIGNALS
+            for name, mags in cmp.transmissibility.items()
+        }
+        trans = pd.DataFrame(cols, index=pd.Index(cmp.freqs_hz, name="f [Hz]"))
+        return {
+            "control_table.csv": cmp.table,
+            "transmissibility.csv": trans,
+            "exact_metrics.csv": cmp.exact,
+        }
+
+    return write_document(
+        out_dir,
+        TITLE,
+        lambda: control_blocks(cmp, command),
+        control_figures(cmp),
+        tables,
+        formats,
+        command=command,
+        overwrite=overwrite,
+    )
