@@ -88,6 +88,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         quarter_car,
         quarter_car_model,
     )
+    from .nonlinear import BumpStop, PiecewiseDamper, nonlinear_quarter_car
     from .plotting import plot_outputs
     from .report import write_report
     from .response import (
@@ -163,6 +164,10 @@ _LAZY: dict[str, str] = {
     "SweepResult": "sweeps",
     "design_grid": "sweeps",
     "sweep": "sweeps",
+    # nonlinear quarter car (issue 11)
+    "nonlinear_quarter_car": "nonlinear",
+    "BumpStop": "nonlinear",
+    "PiecewiseDamper": "nonlinear",
 }
 
 
@@ -234,4 +239,7 @@ __all__ = [
     "ride_metrics_spectral",
     "wk_filter",
     "wk_weighted",
+    "nonlinear_quarter_car",
+    "BumpStop",
+    "PiecewiseDamper",
 ]
