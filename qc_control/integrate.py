@@ -19,6 +19,7 @@ __all__ = [
     "check_time_grid",
     "check_substeps",
     "uniform_step",
+    "stage_times",
     "UNIFORM_RTOL",
 ]
 
@@ -265,6 +266,30 @@ def _run(f, tab, tt, x, out, start, stop, substeps, dt):
     x = _steps(f, ts, rows, x, buf, structure)
     out[start + 1 : stop + 1] = buf[substeps::substeps]
     return x
+
+
+def stage_times(t, method="rk4", *, substeps: int = 1) -> np.ndarray:
+    """Every time at which `integrate` evaluates ``f`` on the grid ``t`` (no events).
+
+    Shape ``(steps, stages)``: the step's start plus ``c_i h``, computed with
+    the same floating-point operations as the stepper, so a right-hand side
+    may precompute what it needs at these times (e.g. the interpolated input)
+    and look it up by the exact time it is called with.
+    """
+    tab = get_method(method)
+    t = check_time_grid(t, "t")
+    substeps = check_substeps(substeps)
+    coefficients, stages, _, _ = _structure(tab)
+    dt = uniform_step(t)
+    tt = t.tolist()
+    if dt is not None:
+        hs = [dt / substeps] * (t.size - 1)
+    else:
+        hs = [(tt[i + 1] - tt[i]) / substeps for i in range(t.size - 1)]
+    starts = np.array([tt[i] + sub * h for i, h in enumerate(hs) for sub in range(substeps)])
+    v = np.repeat(hs, substeps)[:, None] * coefficients
+    pcs = [pc for pc, _ in stages]
+    return np.column_stack([starts, starts[:, None] + v[:, pcs]]) if pcs else starts[:, None]
 
 
 def check_substeps(substeps) -> int:

@@ -53,8 +53,10 @@ from .integrate import (
     check_substeps,
     check_time_grid,
     integrate,
+    stage_times,
     uniform_step,
 )
+from .interconnect import compile_interconnect
 from .limits import check_memory
 from .lti import lti_solve
 from .methods import METHODS, ButcherTableau, get_method
@@ -1349,6 +1351,7 @@ def _io_response(
     opts,
     auto,
     events=None,
+    fast=True,
 ):
     """`input_output_response` for one system."""
     if not isinstance(sys, control.NonlinearIOSystem):
@@ -1417,6 +1420,7 @@ def _io_response(
 
     t_events: np.ndarray = np.empty(0)
     event_labels: tuple[str, ...] = ()
+    compiled = compile_interconnect(sys) if fast else None
     if x0.size == 0:  # a static system: nothing to integrate
         t_out = grid if at is None else grid[at]
         steps = nfev = 0
@@ -1429,6 +1433,9 @@ def _io_response(
         def f(t, x):
             return rhs(t, x, u_of_t(t))
 
+        if compiled is not None:  # the interconnection solved once (qc_control.interconnect)
+            stages = stage_times(grid, tab, substeps=n_sub)
+            f = compiled.make_rhs(u_of_t, (T, u_samples), stages)
         g, labels = _event_function(sys, events)
         if g is None:
             sol = integrate(f, grid, x0, tab, substeps=n_sub)
@@ -1455,7 +1462,11 @@ def _io_response(
     with np.errstate(over="ignore", invalid="ignore"):
         for i, t in enumerate(t_out.tolist()):
             u[:, i] = u_of_t(t)
-            y[:, i] = sys._out(t, x[:, i], u[:, i])
+        if compiled is not None and x0.size:
+            y[:] = compiled.outputs(t_out, x, u)
+        else:
+            for i, t in enumerate(t_out.tolist()):
+                y[:, i] = sys._out(t, x[:, i], u[:, i])
     resp = FixedStepResponse(
         t_out,
         y,
@@ -1497,6 +1508,7 @@ def input_output_response(
     method="rk4",
     substeps: int = 1,
     events=None,
+    fast: bool = True,
     **kwargs,
 ):
     """Response of a nonlinear (or any) input/output system, at a fixed step.
@@ -1573,6 +1585,13 @@ def input_output_response(
         the result's ``t_events`` (and ``event_labels``). True: the
         system's own ``sys.switching`` (`qc_control.nonlinear_quarter_car`
         has them). None (default): no event handling, as control.
+    fast : bool, default True, keyword-only
+        For an `control.InterconnectedSystem`: solve the interconnection
+        once (`qc_control.interconnect`: linear subsystems eliminated as
+        matrix products, the others' functions called directly) instead of
+        calling ``sys._rhs``, which re-solves it at every stage. The same
+        trajectory to rounding. Falls back to ``sys._rhs`` by itself where
+        the interconnection has an algebraic loop.
 
     Returns
     -------
@@ -1665,5 +1684,6 @@ def input_output_response(
         opts=opts,
         auto=False,
         events=events,
+        fast=fast,
     )
     return _each(sys, lambda s: _io_response(s, T, U, X0, **args))
