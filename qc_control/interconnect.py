@@ -194,17 +194,19 @@ class CompiledInterconnect:
             outfcn, params = sub.outfcn, sub._current_params
             n = Fx.shape[0]
             G = np.vstack([Fx, Px])  # one product gives both x's derivative part and u
+            # ... and one sum adds the input's terms to both: [Fw w; Pw w] per stage
+            pre = list(np.vstack([fw, uw[0]]).T)
             if sub.noutputs == 1:
                 column = Fn[:, 0].copy()
                 sequence = (list, tuple, np.ndarray)
 
                 def one(t, x):
-                    k = get(t)
-                    if k is None:
+                    try:
+                        z = G @ x + pre[index[t]]
+                    except KeyError:
                         return direct(t, x)
-                    z = G @ x
-                    r = outfcn(t, empty, z[n:] + uw_rows[k], params)
-                    return z[:n] + column * (r[0] if isinstance(r, sequence) else r) + fw_rows[k]
+                    r = outfcn(t, empty, z[n:], params)
+                    return z[:n] + column * (r[0] if isinstance(r, sequence) else r)
 
             else:
 
