@@ -108,6 +108,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         quarter_car,
         quarter_car_model,
     )
+    from .nonlinear import BumpStop, PiecewiseDamper, nonlinear_quarter_car
     from .plotting import plot_outputs
     from .report import write_report
     from .response import (
@@ -214,6 +215,10 @@ _LAZY: dict[str, str] = {
     "half_car_model": "halfcar",
     "full_car": "halfcar",
     "full_car_model": "halfcar",
+    # nonlinear quarter car (issue 11)
+    "nonlinear_quarter_car": "nonlinear",
+    "BumpStop": "nonlinear",
+    "PiecewiseDamper": "nonlinear",
 }
 
 
@@ -310,4 +315,7 @@ __all__ = [
     "half_car_model",
     "full_car",
     "full_car_model",
+    "nonlinear_quarter_car",
+    "BumpStop",
+    "PiecewiseDamper",
 ]

@@ -17,6 +17,7 @@ import control
 import numpy as np
 import pandas as pd
 import scipy.signal
+from scipy.integrate import solve_ivp
 
 from .halfcar import FullCarParams, HalfCarParams
 from .integrate import DivergenceWarning, check_time_grid, uniform_step
@@ -24,7 +25,13 @@ from .limits import check_memory
 from .methods import ButcherTableau, get_method
 from .modal import ModalAnalysis, modal_analysis
 from .model import SEED_X0, QuarterCarParams, as_params, quarter_car_model
-from .response import check_initial_state, check_input_samples, forced_response, initial_response
+from .response import (
+    check_initial_state,
+    check_input_samples,
+    forced_response,
+    initial_response,
+    linear_input,
+)
 from .ride import Transmissibility, ride_metrics, transmissibility
 from .stability import max_stable_step, numerical_modes
 from .vehicle import VehicleModel
@@ -48,6 +55,8 @@ __all__ = [
     "DEFAULT_T_END",
     "DEFAULT_H",
     "TOLERANCES",
+    "NonlinearReference",
+    "nonlinear_reference",
 ]
 
 #: The default scenario: the seed's vehicle, body released from 5 cm, 0-10 s, h = 0.01 s.
@@ -738,3 +747,129 @@ def compare_methods(
         ride_error=ride_error,
         transmissibility=trans,
     )
+
+
+# ---------------------------------------------------------------- nonlinear systems
+
+
+@dataclass(frozen=True)
+class NonlinearReference:
+    """A tight solve_ivp solution of a nonlinear system, and its own accuracy.
+
+    Attributes
+    ----------
+    t : ndarray (N,)
+    x : ndarray (n, N)
+        States at ``t``.
+    t_events : ndarray
+        Where a switching function changed sign (each a restart).
+    accuracy : float
+        Largest difference from the second solution at 100x tighter
+        tolerances, relative to the largest state: the reference's own error.
+    rtol : float
+    atol : ndarray (n,)
+    nfev : int
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    t_events: np.ndarray
+    accuracy: float
+    rtol: float
+    atol: np.ndarray
+    nfev: int
+
+
+def _piecewise_ivp(rhs, switching, T, x0, rtol, atol):
+    """DOP853 from event to event: no step straddles a kink of the right-hand side."""
+    span = float(T[-1] - T[0])
+    nudge = 1e-10 * span
+    n_ev = 0 if switching is None else int(np.size(switching(float(T[0]), x0)))
+    funcs = []
+    for k in range(n_ev):
+
+        def g(t, x, k=k):
+            return float(switching(t, x)[k])
+
+        g.terminal = True  # type: ignore[attr-defined]
+        funcs.append(g)
+    t, x = float(T[0]), np.asarray(x0, dtype=float)
+    out = np.empty((x.size, T.size))
+    events: list[float] = []
+    nfev = 0
+    kw = dict(method="DOP853", rtol=rtol, atol=atol, dense_output=True)
+    while True:
+        sol = solve_ivp(rhs, (t, float(T[-1])), x, events=funcs or None, **kw)
+        nfev += sol.nfev
+        if not sol.success and sol.status != 1:
+            raise RuntimeError(f"the reference solve_ivp failed at t = {t:.6g} s: {sol.message}")
+        t_end = float(sol.t[-1])
+        inside = (T >= t) & (T <= t_end)
+        out[:, inside] = sol.sol(T[inside])
+        if sol.status != 1 or t_end >= T[-1]:
+            break
+        events.append(t_end)
+        # past the root, where the switching function has its new sign
+        step = solve_ivp(rhs, (t_end, t_end + nudge), sol.y[:, -1], **kw)
+        nfev += step.nfev
+        t, x = float(step.t[-1]), step.y[:, -1]
+    return out, np.array(events), nfev
+
+
+def nonlinear_reference(
+    sys, T, U=0.0, X0=0.0, *, events=None, params=None, rtol: float = 1e-12
+) -> NonlinearReference:
+    """The reference for a nonlinear system: solve_ivp (DOP853) restarted at each event.
+
+    There is no exact solution to compare fixed-step methods with, so the
+    reference is scipy's DOP853 at ``rtol`` with ``atol = rtol · max|x_i|``
+    per state (the scale from a first solve at ``rtol = 1e-6``), stopped at
+    every sign change of the switching functions (``events``, as in
+    `qc_control.input_output_response`) and restarted just past it, so that
+    no step straddles a kink. The input is python-control's: linear between
+    the samples. Its own accuracy is estimated, as the matrix exponential's
+    is for linear systems, against a second solve at ``rtol / 100`` and
+    ``atol / 100``.
+
+    Parameters
+    ----------
+    sys : control.NonlinearIOSystem
+    T, U, X0, params
+        As for `qc_control.input_output_response`.
+    events : None, True or callable ``events(t, x, u, params)``
+    rtol : float, default 1e-12
+
+    Returns
+    -------
+    NonlinearReference
+    """
+    if not isinstance(sys, control.NonlinearIOSystem):
+        raise TypeError(f"sys must be a control.NonlinearIOSystem, got {type(sys).__name__}")
+    if not (isinstance(rtol, float) and 1e-14 <= rtol < 1e-3):
+        raise ValueError(f"rtol must be a float in [1e-14, 1e-3), got {rtol!r}")
+    T = check_time_grid(T, "T")
+    x0 = check_initial_state(X0, sys.nstates)
+    u = check_input_samples(U, sys.ninputs, T.size)
+    u_of_t = linear_input(T, u)
+    sys._update_params(params)
+    current = getattr(sys, "_current_params", params or {})
+    if events is True:
+        g = getattr(sys, "switching", None)
+        if g is None:
+            raise ValueError(f"events=True needs sys.switching; system {sys.name!r} has none")
+    elif events is None or callable(events):
+        g = events
+    else:
+        raise TypeError(f"events must be None, True or a callable, got {events!r}")
+
+    def rhs(t, x):
+        return sys._rhs(t, x, u_of_t(t))
+
+    switching = None if g is None else (lambda t, x: np.atleast_1d(g(t, x, u_of_t(t), current)))
+    rough, _, _ = _piecewise_ivp(rhs, switching, T, x0, 1e-6, 1e-9)
+    scale = np.maximum(np.max(np.abs(rough), axis=1), 1e-12)
+    atol = rtol * scale
+    x, t_events, nfev = _piecewise_ivp(rhs, switching, T, x0, rtol, atol)
+    tighter, _, _ = _piecewise_ivp(rhs, switching, T, x0, rtol / 100, atol / 100)
+    accuracy = float(np.max(np.abs(x - tighter)) / np.max(np.abs(tighter)))
+    return NonlinearReference(T, x, t_events, accuracy, rtol, atol, nfev)

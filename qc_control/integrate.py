@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import functools
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import brentq
 
 from .messages import show
 from .methods import ButcherTableau, get_method
@@ -18,6 +19,7 @@ __all__ = [
     "check_time_grid",
     "check_substeps",
     "uniform_step",
+    "stage_times",
     "UNIFORM_RTOL",
 ]
 
@@ -57,6 +59,13 @@ class Solution:
     status : str
         ``'success'`` or ``'diverged'``.
     message : str
+    t_events : ndarray, shape (k,)
+        With ``events``: the times at which an event function changed sign,
+        each located inside its step and stepped to exactly (see
+        `integrate`); empty otherwise.
+    i_events : ndarray of int, shape (k,)
+        Which event function (its index in the vector ``events`` returns)
+        changed sign at each of ``t_events``.
 
     Notes
     -----
@@ -71,6 +80,8 @@ class Solution:
     method: ButcherTableau
     status: str
     message: str
+    t_events: np.ndarray = field(default_factory=lambda: np.empty(0))
+    i_events: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=int))
 
     def __post_init__(self):
         if self.status not in ("success", "diverged"):
@@ -257,6 +268,30 @@ def _run(f, tab, tt, x, out, start, stop, substeps, dt):
     return x
 
 
+def stage_times(t, method="rk4", *, substeps: int = 1) -> np.ndarray:
+    """Every time at which `integrate` evaluates ``f`` on the grid ``t`` (no events).
+
+    Shape ``(steps, stages)``: the step's start plus ``c_i h``, computed with
+    the same floating-point operations as the stepper, so a right-hand side
+    may precompute what it needs at these times (e.g. the interpolated input)
+    and look it up by the exact time it is called with.
+    """
+    tab = get_method(method)
+    t = check_time_grid(t, "t")
+    substeps = check_substeps(substeps)
+    coefficients, stages, _, _ = _structure(tab)
+    dt = uniform_step(t)
+    tt = t.tolist()
+    if dt is not None:
+        hs = [dt / substeps] * (t.size - 1)
+    else:
+        hs = [(tt[i + 1] - tt[i]) / substeps for i in range(t.size - 1)]
+    starts = np.array([tt[i] + sub * h for i, h in enumerate(hs) for sub in range(substeps)])
+    v = np.repeat(hs, substeps)[:, None] * coefficients
+    pcs = [pc for pc, _ in stages]
+    return np.column_stack([starts, starts[:, None] + v[:, pcs]]) if pcs else starts[:, None]
+
+
 def check_substeps(substeps) -> int:
     """``substeps`` as an int >= 1, or a ValueError naming it."""
     if isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
@@ -264,7 +299,7 @@ def check_substeps(substeps) -> int:
     return int(substeps)
 
 
-def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
+def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solution:
     """Solve ``x' = f(t, x)`` with a fixed-step explicit Runge–Kutta method.
 
     Each interval ``[t[i], t[i+1]]`` of the grid is split into ``substeps``
@@ -292,6 +327,20 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
         A name in `qc_control.METHODS` or any explicit tableau.
     substeps : int, default 1
         Steps per interval of ``t``.
+    events : callable ``events(t, x) -> array_like``, optional
+        Switching functions: the points where one of them changes sign are
+        the kinks of ``f`` (a contact made or lost, a stop engaged). After
+        each step the signs are compared with those at its start; where one
+        changed, the crossing time ``t*`` is found by root finding on the
+        state, ``s ↦ events(t + s, Φ_s(x))`` with ``Φ_s`` the method's own
+        step of length ``s`` (Brent's method, to ``1e-12`` of the step);
+        the run steps from ``t`` to ``t*`` exactly, then on from ``t*``
+        across the rest of the step, so that no step straddles a kink and
+        the method keeps its order on a right-hand side that is smooth on
+        either side (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.6,
+        discontinuous right-hand sides). The times go to
+        ``Solution.t_events``. A single ``x0`` only (not a batch); a zero
+        touched without a sign change (grazing) is not an event.
 
     Returns
     -------
@@ -330,6 +379,12 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     if not callable(f):
         raise TypeError(f"f must be callable as f(t, x), got {show(f)}")
     x = _initial_state(x0)
+    if events is not None:
+        if not callable(events):
+            raise TypeError(f"events must be callable as events(t, x), got {show(events)}")
+        if x.ndim != 1:
+            raise ValueError(f"events need a single initial state of shape (n,), got {x.shape}")
+        return _integrate_events(f, t, x, tab, substeps, events)
 
     dt = uniform_step(t)  # a uniform grid is stepped with its one step, like the LTI engine
     out = np.empty((t.size,) + x.shape, dtype=x.dtype)
@@ -388,3 +443,106 @@ def _initial_state(x0) -> np.ndarray:
     if not np.all(np.isfinite(x)):
         raise ValueError(f"x0 must be finite, got {show(x0)}")
     return x
+
+
+#: Most events located inside one step before the rest of it is taken as it is.
+_MAX_EVENTS_PER_STEP = 16
+
+
+def _integrate_events(f, t, x, tab, substeps, events) -> Solution:
+    """`integrate` with switching functions: step to each sign change exactly."""
+    structure = _structure(tab)
+    coefficients = structure[0]
+    calls = [0]
+
+    def counted(tt, xx):
+        calls[0] += 1
+        return f(tt, xx)
+
+    buf = np.empty((2,) + x.shape, dtype=x.dtype)
+
+    def step(t0, x0, h):
+        return _steps(counted, [t0], [(coefficients * h).tolist()], x0, buf, structure).copy()
+
+    def switch(tt, xx):
+        return np.atleast_1d(np.asarray(events(tt, xx), dtype=float))
+
+    out = np.empty((t.size,) + x.shape, dtype=x.dtype)
+    out[0] = x
+    dt = uniform_step(t)
+    tt = t.tolist()
+    sign = np.sign(switch(tt[0], x))
+    t_ev: list[float] = []
+    i_ev: list[int] = []
+    steps, n_last, status, message = 0, t.size - 1, "success", ""
+    with np.errstate(over="ignore", invalid="ignore"):
+        for i in range(t.size - 1):
+            h_int = (tt[i + 1] - tt[i]) if dt is None else dt
+            h = h_int / substeps
+            for sub in range(substeps):
+                ta = tt[i] + sub * h
+                tb = tt[i + 1] if sub == substeps - 1 else ta + h
+                for located in range(_MAX_EVENTS_PER_STEP + 1):
+                    xb = step(ta, x, tb - ta)
+                    steps += 1
+                    gb = switch(tb, xb)
+                    sb = np.sign(gb)
+                    unset = sign == 0
+                    sign[unset] = sb[unset]
+                    changed = np.flatnonzero((sb != sign) & (sb != 0))
+                    if (
+                        changed.size == 0
+                        or located == _MAX_EVENTS_PER_STEP
+                        or not np.all(np.isfinite(xb))
+                    ):
+                        sign[changed] = sb[changed]
+                        break
+                    ga = switch(ta, x)
+                    roots = []
+                    for k in changed.tolist():
+                        if np.sign(ga[k]) != sign[k]:  # on its new side already (rounding)
+                            sign[k] = sb[k]
+                            continue
+
+                        def phi(s, k=k):
+                            return switch(ta + s, step(ta, x, s))[k]
+
+                        s_root = brentq(phi, 0.0, tb - ta, xtol=1e-12 * (tb - ta))
+                        roots.append((s_root, k))
+                    if not roots:
+                        break
+                    s_root, k = min(roots)
+                    if s_root <= 0.0:  # at the step's start: nothing to step to
+                        sign[k] = sb[k]
+                        continue
+                    x = step(ta, x, s_root)
+                    steps += 1
+                    ta = ta + s_root
+                    t_ev.append(ta)
+                    i_ev.append(k)
+                    sign[k] = sb[k]
+                    if ta >= tb:
+                        xb = x
+                        break
+                x = xb
+            out[i + 1] = x
+            if not np.all(np.isfinite(x)):
+                n_last = i
+                status = "diverged"
+                message = (
+                    f"{tab.name}: the state became non-finite after t = "
+                    f"{t[n_last]:.6g}; stopped after {n_last} of {t.size - 1} intervals"
+                )
+                warnings.warn(message, DivergenceWarning, stacklevel=3)
+                break
+    return Solution(
+        t=t[: n_last + 1],
+        x=np.moveaxis(out[: n_last + 1], 0, -1),
+        nfev=calls[0],
+        steps=steps,
+        method=tab,
+        status=status,
+        message=message,
+        t_events=np.array(t_ev),
+        i_events=np.array(i_ev, dtype=int),
+    )

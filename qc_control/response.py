@@ -53,8 +53,10 @@ from .integrate import (
     check_substeps,
     check_time_grid,
     integrate,
+    stage_times,
     uniform_step,
 )
+from .interconnect import compile_interconnect
 from .limits import check_memory
 from .lti import lti_solve
 from .methods import METHODS, ButcherTableau, get_method
@@ -106,6 +108,11 @@ class FixedStepResponse(control.TimeResponseData):
     max_stable_step : float or None
         The method's stability limit for this system [s] (see
         `qc_control.max_stable_step`), computed when asked.
+    t_events : ndarray
+        With ``events`` (`input_output_response`): the times [s] at which
+        a switching function changed sign, each stepped to exactly.
+    event_labels : tuple of str
+        Which switching function changed sign at each of ``t_events``.
     success, message
         As in python-control. ``success`` is False whenever the step
         exceeds the method's stability limit, the run diverged, or any
@@ -119,6 +126,8 @@ class FixedStepResponse(control.TimeResponseData):
     nfev: int = 0
     step_rule: str | None = None
     note: str | None = None
+    t_events: np.ndarray = np.empty(0)
+    event_labels: tuple[str, ...] = ()
     _eigenvalues: np.ndarray | None = None
 
     @property
@@ -1307,8 +1316,42 @@ def _evaluation_times(t_eval, T: np.ndarray) -> np.ndarray:
     return te
 
 
+def _event_function(sys, events):
+    """``(g(t, x, u, params), labels)`` from ``events``, or ``(None, ())``."""
+    if events is None or events is False:
+        return None, ()
+    if events is True:
+        g = getattr(sys, "switching", None)
+        if g is None:
+            raise ValueError(
+                f"events=True needs a system with switching functions (sys.switching, as "
+                f"qc.nonlinear_quarter_car gives); system {sys.name!r} has none: pass a "
+                "callable events(t, x, u, params) instead"
+            )
+        return g, tuple(getattr(sys, "switching_labels", ()))
+    if callable(events):
+        return events, ()
+    raise TypeError(
+        f"events must be None, True or a callable events(t, x, u, params), got {events!r}"
+    )
+
+
 def _io_response(
-    sys, T, U, X0, *, params, transpose, return_x, squeeze, t_eval, max_step, opts, auto
+    sys,
+    T,
+    U,
+    X0,
+    *,
+    params,
+    transpose,
+    return_x,
+    squeeze,
+    t_eval,
+    max_step,
+    opts,
+    auto,
+    events=None,
+    fast=True,
 ):
     """`input_output_response` for one system."""
     if not isinstance(sys, control.NonlinearIOSystem):
@@ -1375,6 +1418,9 @@ def _io_response(
             at = np.searchsorted(grid, te)
     h = float(np.diff(grid).max()) * (1 if n_sub == 1 else 1 / n_sub)
 
+    t_events: np.ndarray = np.empty(0)
+    event_labels: tuple[str, ...] = ()
+    compiled = compile_interconnect(sys) if fast else None
     if x0.size == 0:  # a static system: nothing to integrate
         t_out = grid if at is None else grid[at]
         steps = nfev = 0
@@ -1387,7 +1433,23 @@ def _io_response(
         def f(t, x):
             return rhs(t, x, u_of_t(t))
 
-        sol = integrate(f, grid, x0, tab, substeps=n_sub)
+        if compiled is not None:  # the interconnection solved once (qc_control.interconnect)
+            stages = stage_times(grid, tab, substeps=n_sub)
+            f = compiled.make_rhs(u_of_t, (T, u_samples), stages)
+        g, labels = _event_function(sys, events)
+        if g is None:
+            sol = integrate(f, grid, x0, tab, substeps=n_sub)
+        else:
+            current = getattr(sys, "_current_params", params or {})
+
+            def switching(t, x):
+                return g(t, x, u_of_t(t), current)
+
+            sol = integrate(f, grid, x0, tab, substeps=n_sub, events=switching)
+            t_events = sol.t_events
+            event_labels = tuple(
+                labels[i] if i < len(labels) else str(i) for i in sol.i_events.tolist()
+            )
         steps, nfev = sol.steps, sol.nfev
         success, message = sol.success, sol.message
         if at is None:
@@ -1398,9 +1460,16 @@ def _io_response(
     u = np.empty((ninputs, t_out.size))
     y = np.empty((noutputs, t_out.size))
     with np.errstate(over="ignore", invalid="ignore"):
-        for i, t in enumerate(t_out.tolist()):
-            u[:, i] = u_of_t(t)
-            y[:, i] = sys._out(t, x[:, i], u[:, i])
+        if t_out.size == T.size and np.array_equal(t_out, T):
+            u[:] = u_samples  # the samples themselves (u_of_t returns them at T)
+        else:
+            for i, t in enumerate(t_out.tolist()):
+                u[:, i] = u_of_t(t)
+        if compiled is not None and x0.size:
+            y[:] = compiled.outputs(t_out, x, u)
+        else:
+            for i, t in enumerate(t_out.tolist()):
+                y[:, i] = sys._out(t, x[:, i], u[:, i])
     resp = FixedStepResponse(
         t_out,
         y,
@@ -1421,6 +1490,7 @@ def _io_response(
     )
     resp.method, resp.h, resp.substeps = tab, h, substeps
     resp.steps, resp.nfev, resp.step_rule, resp.note = steps, nfev, step_rule, note
+    resp.t_events, resp.event_labels = t_events, event_labels
     resp._eigenvalues = eig
     return _finalise(resp)
 
@@ -1440,6 +1510,8 @@ def input_output_response(
     *,
     method="rk4",
     substeps: int = 1,
+    events=None,
+    fast: bool = True,
     **kwargs,
 ):
     """Response of a nonlinear (or any) input/output system, at a fixed step.
@@ -1507,13 +1579,30 @@ def input_output_response(
         ``solve_ivp_method``.
     substeps : int, default 1, keyword-only
         Steps per interval of ``T``.
+    events : None, True or callable, keyword-only
+        Switching functions ``events(t, x, u, params) -> array_like`` whose
+        sign changes are the kinks of the right-hand side (a wheel leaving
+        the road, a bump stop engaging). Each crossing is located inside its
+        step and stepped to exactly (`qc_control.integrate`'s ``events``),
+        which keeps the method's order across the kink; the times are in
+        the result's ``t_events`` (and ``event_labels``). True: the
+        system's own ``sys.switching`` (`qc_control.nonlinear_quarter_car`
+        has them). None (default): no event handling, as control.
+    fast : bool, default True, keyword-only
+        For an `control.InterconnectedSystem`: solve the interconnection
+        once (`qc_control.interconnect`: linear subsystems eliminated as
+        matrix products, the others' functions called directly) instead of
+        calling ``sys._rhs``, which re-solves it at every stage. The same
+        trajectory to rounding. Falls back to ``sys._rhs`` by itself where
+        the interconnection has an algebraic loop.
 
     Returns
     -------
     FixedStepResponse or control.TimeResponseList
-        With ``method``, ``h`` (the largest step), ``substeps``, ``steps``
-        and ``nfev``; ``success`` False with a ``message`` if the state
-        became non-finite (the response then stops at the last finite sample).
+        With ``method``, ``h`` (the largest step), ``substeps``, ``steps``,
+        ``nfev``, ``t_events`` and ``event_labels``; ``success`` False with
+        a ``message`` if the state became non-finite (the response then
+        stops at the last finite sample).
 
     Notes
     -----
@@ -1597,5 +1686,7 @@ def input_output_response(
         max_step=max_step,
         opts=opts,
         auto=False,
+        events=events,
+        fast=fast,
     )
     return _each(sys, lambda s: _io_response(s, T, U, X0, **args))

@@ -108,3 +108,18 @@ def test_accuracy_columns_match_an_independent_run(results):
 
     for row in _table(results, "LTI vs generic (rel.)"):
         assert float(row["LTI vs generic (rel.)"]) < 1e-12, row
+
+
+def test_interconnect_benchmark_table(results):
+    """The car + skyhook rows: ratios are numbers, and the fast path and sys._rhs
+    (the same trajectory to rounding) report the same error, below control's default
+    RK45 (rtol 1e-3) on this discontinuous controller."""
+    rows = {r["run"]: r for r in _table(results, "× faster than control (target ≥ 5)")}
+    fast = rows["qc RK4 h = 1 ms, fast path"]
+    rhs = rows["qc RK4 h = 1 ms, sys._rhs"]
+    theirs = rows["control.input_output_response (RK45 defaults)"]
+    for row in (fast, rhs):
+        ratio = float(row["× faster than control (target ≥ 5)"])
+        assert math.isfinite(ratio) and ratio > 0
+    assert fast["max state error / max state"] == rhs["max state error / max state"]
+    assert float(fast["max state error / max state"]) < float(theirs["max state error / max state"])

@@ -325,3 +325,105 @@ def test_discrete_and_static_systems_as_control():
         static = qc.input_output_response(square, T, T)
     np.testing.assert_allclose(static.outputs, T**2, rtol=0, atol=1e-15)
     assert static.nfev == 0 and "no states" in static.note
+
+
+# ---------------------------------------------------------------- the interconnection fast path
+
+
+def _car_and_skyhook(c_sky=3000.0):
+    """The seed car (a StateSpace, velocities as extra outputs) and a clipped skyhook (nlsys)."""
+    ss = qc.quarter_car(road=True, actuator=True)
+    A, B, C, D = (np.asarray(m) for m in (ss.A, ss.B, ss.C, ss.D))
+    car = control.ss(
+        A,
+        B,
+        np.vstack([C, np.eye(4)[:2]]),
+        np.vstack([D, np.zeros((2, 2))]),
+        states=ss.state_labels,
+        inputs=ss.input_labels,
+        outputs=[*ss.output_labels, "vs_m", "vu_m"],
+        name="car",
+    )
+
+    def skyhook(t, x, u, p):  # Karnopp's clipped skyhook, force limited to fmax
+        vs, vu = u
+        f = p["c_sky"] * vs if vs * (vs - vu) > 0 else 0.0
+        return [-min(max(f, -p["fmax"]), p["fmax"])]
+
+    ctrl = control.nlsys(
+        None,
+        skyhook,
+        inputs=["vs_m", "vu_m"],
+        outputs=["fa"],
+        name="skyhook",
+        params={"c_sky": c_sky, "fmax": 2000.0},
+    )
+    return control.interconnect([car, ctrl], inputs="zr", outputs=ss.output_labels, name="cl")
+
+
+def test_fast_path_equals_the_rhs_path_to_rounding():
+    from qc_control.interconnect import compile_interconnect
+
+    cl = _car_and_skyhook()
+    T = grid(1e-3, 2.0)
+    zr = qc.road.iso8608(T, "C", 20.0, seed=3)
+    fast = qc.input_output_response(cl, T, zr, [0.1, 0, 0.02, 0], params={"c_sky": 2500.0})
+    slow = qc.input_output_response(
+        cl, T, zr, [0.1, 0, 0.02, 0], params={"c_sky": 2500.0}, fast=False
+    )
+    # the same sums in another order: a few ulps per stage, grown by the dynamics
+    for a, b in ((fast.states, slow.states), (fast.outputs, slow.outputs)):
+        assert np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(b))
+    assert compile_interconnect(cl) is not None and fast.nfev == slow.nfev
+    # params reach the controller on the fast path too
+    other = qc.input_output_response(cl, T, zr, [0.1, 0, 0.02, 0])
+    assert np.max(np.abs(other.states - fast.states)) > 1e-4
+
+
+def test_fast_path_with_stateful_subsystems_and_events():
+    cl = _closed_loop()  # two nlsys subsystems with states, tanh saturation
+    T = grid(0.01)
+    U = 0.5 + 0.1 * T
+    fast = qc.input_output_response(cl, T, U, [0.5, 0, 0])
+    slow = qc.input_output_response(cl, T, U, [0.5, 0, 0], fast=False)
+    np.testing.assert_allclose(fast.states, slow.states, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(fast.outputs, slow.outputs, rtol=0, atol=1e-13)
+    # an event function on the interconnection: theta crossing 1 rad, located the same way
+    ev = dict(events=lambda t, x, u, p: x[0] - 1.0)
+    a = qc.input_output_response(cl, T, U, [0.5, 0, 0], **ev)
+    b = qc.input_output_response(cl, T, U, [0.5, 0, 0], fast=False, **ev)
+    assert a.t_events.size >= 1
+    np.testing.assert_allclose(a.t_events, b.t_events, rtol=0, atol=1e-12)
+
+
+def test_algebraic_loop_falls_back_to_control():
+    from qc_control.interconnect import compile_interconnect
+
+    # u = -y with y = u + x: a direct loop through a nonlinear block, which control iterates
+    plant = control.nlsys(
+        lambda t, x, u, p: -x + u, lambda t, x, u, p: x, inputs=1, outputs=1, states=1, name="p"
+    )
+    gain = control.nlsys(None, lambda t, x, u, p: 0.5 * u, inputs=1, outputs=1, name="k")
+    loop = control.nlsys(None, lambda t, x, u, p: u, inputs=1, outputs=1, name="l")
+    cl = control.interconnect(
+        [plant, gain, loop],
+        connections=[["k.u[0]", "l.y[0]"], ["l.u[0]", "k.y[0]"], ["p.u[0]", "k.y[0]"]],
+        inplist=[],
+        outlist=["p.y[0]"],
+    )
+    assert compile_interconnect(cl) is None
+
+
+def test_stage_times_are_the_steppers_own():
+    from qc_control.integrate import stage_times
+
+    seen = []
+
+    def f(t, x):
+        seen.append(t)
+        return -x
+
+    for T, substeps in ((grid(0.1, 1.0), 1), (np.array([0.0, 0.1, 0.35, 1.0]), 3)):
+        seen.clear()
+        qc.integrate(f, T, [1.0], "rk4", substeps=substeps)
+        assert np.array_equal(np.array(seen), stage_times(T, "rk4", substeps=substeps).ravel())

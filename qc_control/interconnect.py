@@ -1,0 +1,332 @@
+"""A precomputed `control.InterconnectedSystem`: the fast path of `input_output_response`.
+
+python-control evaluates an interconnection's right-hand side
+(``InterconnectedSystem._rhs``) by solving its static input/output
+relations afresh at every call: it evaluates every subsystem's output
+function, maps outputs to inputs through ``connect_map``, and repeats until
+nothing changes (up to ``len(syslist) + 1`` sweeps). At a fixed step that is
+most of the run's time. Here the interconnection is solved once, when the
+system is compiled:
+
+* **Linear subsystems** (``control.StateSpace``) are eliminated
+  algebraically. With ``K`` the connection map (subsystem inputs from
+  subsystem outputs), ``E`` the input map, ``w`` the external inputs and
+  ``y_N`` the outputs of the nonlinear subsystems, the linear outputs satisfy
+  ``y_L = C_L x_L + D_L (K_LL y_L + K_LN y_N + E_L w)``, so
+
+  .. math::
+
+      y_L = M^{-1}\\big(C_L x_L + D_L K_{LN}\\, y_N + D_L E_L\\, w\\big),
+      \\qquad M = I - D_L K_{LL},
+
+  and every subsystem input is then an affine map of ``x_L``, ``y_N`` and
+  ``w``; the linear states' derivative is ``A_L x_L + B_L u_L``, one matrix
+  product per term.
+* **Nonlinear subsystems** are evaluated once each, in an order in which
+  every input they need through the (eliminated) linear part is already
+  known: their update and output functions are called directly, with the
+  parameters python-control gives them (``sys._update_params``).
+
+The result equals python-control's ``_rhs``/``_out`` to rounding (the same
+sums in another order). When ``M`` is singular, or the nonlinear subsystems
+feed each other (or themselves) through a direct path, there is an
+algebraic loop that python-control resolves (or refuses) by iteration:
+`compile_interconnect` returns None and the caller uses ``sys._rhs``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import control
+import numpy as np
+
+__all__ = ["CompiledInterconnect", "compile_interconnect"]
+
+
+def _is_linear(sub) -> bool:
+    return isinstance(sub, control.StateSpace)
+
+
+class CompiledInterconnect:
+    """An interconnection solved once: see the module docstring.
+
+    Built by `compile_interconnect`. ``rhs(t, x, w)`` and ``out(t, x, w)``
+    equal the system's ``_rhs`` and ``_out`` to rounding; ``rhs_terms(W)``
+    precomputes the input terms for many input values at once.
+    """
+
+    def __init__(self, sys, lin, nonlin, order, mats):
+        self.sys = sys
+        self.nstates = sys.nstates
+        self._lin_x = lin  # indices of the linear subsystems' states in x
+        self._nonlin = nonlin  # per nonlinear subsystem: (sub, x slice, u rows)
+        self._order = order
+        (
+            self._Px,
+            self._Pn,
+            self._Pw,
+            self._Fx,
+            self._Fn,
+            self._Fw,
+            self._Ox,
+            self._On,
+            self._Ow,
+        ) = mats
+        self._lin_contiguous = lin.size == 0 or np.array_equal(lin, np.arange(lin.size))
+        self._all_linear_states = lin.size == self.nstates
+
+    # The stage-by-stage functions are written for few Python-level calls:
+    # one matrix product per term, the subsystems' own functions called directly.
+
+    def _nonlinear_outputs(self, t, x, xl, uw_terms):
+        """``(y_N pieces, u_N pieces)`` of the nonlinear subsystems, in evaluation order."""
+        ys: list = [None] * len(self._nonlin)
+        us: list = [None] * len(self._nonlin)
+        for j in self._order:
+            sub, xs, _ = self._nonlin[j]
+            u = self._Px[j] @ xl + uw_terms[j]
+            for i, Pn in self._Pn[j]:
+                u = u + Pn @ ys[i]
+            us[j] = u
+            y = sub._out(t, x[xs], u)
+            ys[j] = y
+        return ys, us
+
+    def rhs_terms(self, W: np.ndarray):
+        """The external input's terms for input values ``W`` (``(nw, K)``), stacked over K."""
+        uw = [Pw @ W for Pw in self._Pw]
+        fw = self._Fw @ W
+        return uw, fw
+
+    def rhs(self, t: float, x: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """``dx/dt`` at ``(t, x)`` with external input ``w``."""
+        return self._rhs(t, x, [Pw @ w for Pw in self._Pw], self._Fw @ w)
+
+    def _rhs(self, t, x, uw_terms, fw_term):
+        xl = x if self._all_linear_states else x[self._lin_x]
+        ys, us = self._nonlinear_outputs(t, x, xl, uw_terms)
+        dl = self._Fx @ xl + fw_term
+        for Fn, y in zip(self._Fn, ys):
+            dl = dl + Fn @ y
+        if self._all_linear_states:
+            return dl
+        xdot = np.empty(self.nstates)
+        xdot[self._lin_x] = dl
+        for (sub, xs, _), u in zip(self._nonlin, us):
+            if sub.nstates:
+                xdot[xs] = sub._rhs(t, x[xs], u)
+        return xdot
+
+    def out(self, t: float, x: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """The interconnection's outputs at ``(t, x)`` with external input ``w``."""
+        xl = x if self._all_linear_states else x[self._lin_x]
+        ys, _ = self._nonlinear_outputs(t, x, xl, [Pw @ w for Pw in self._Pw])
+        y = self._Ox @ xl + self._Ow @ w
+        for On, yn in zip(self._On, ys):
+            y = y + On @ yn
+        return y
+
+    def outputs(self, times: np.ndarray, X: np.ndarray, W: np.ndarray) -> np.ndarray:
+        """The outputs at many samples at once: ``(ny, K)`` from ``X (n, K)``, ``W (nw, K)``.
+
+        The linear terms are matrix products over all samples; only the
+        nonlinear subsystems' output functions are called sample by sample.
+        """
+        XL = X[self._lin_x]
+        ts = np.asarray(times, dtype=float).tolist()
+        Ys: list = [None] * len(self._nonlin)
+        for j in self._order:
+            sub, xs, _ = self._nonlin[j]
+            U = self._Px[j] @ XL + self._Pw[j] @ W
+            for i, Pn in self._Pn[j]:
+                U = U + Pn @ Ys[i]
+            Xj = X[xs]
+            Ys[j] = (
+                np.array([sub._out(t, Xj[:, k], U[:, k]) for k, t in enumerate(ts)], dtype=float)
+                .reshape(len(ts), -1)
+                .T
+            )
+        Y = self._Ox @ XL + self._Ow @ W
+        for On, Yn in zip(self._On, Ys):
+            Y = Y + On @ Yn
+        return Y
+
+    def make_rhs(self, u_of_t: Callable, inputs=None, times: np.ndarray | None = None):
+        """``f(t, x)`` for the stepper, the input ``u_of_t(t)`` read at each stage.
+
+        With ``inputs = (T, U)`` (the samples ``u_of_t`` interpolates
+        linearly) and ``times`` (every stage time the stepper will ask for,
+        `qc_control.integrate.stage_times`), the input's terms are computed
+        for all stages at once (``np.interp``), and a stage at one of those
+        times looks them up; any other time (an event's root finding)
+        computes them from ``u_of_t``.
+        """
+        rhs_ = self._rhs
+        Pw_list, Fw = self._Pw, self._Fw
+        nn = len(Pw_list)
+
+        def direct(t, x):
+            w = u_of_t(t)
+            return rhs_(t, x, [Pw @ w for Pw in Pw_list], Fw @ w)
+
+        if times is None or inputs is None or np.size(times) == 0:
+            return direct
+        T, U = inputs
+        flat = np.asarray(times, dtype=float).reshape(-1)
+        W = np.array([np.interp(flat, T, row) for row in U]).reshape(len(U), flat.size)
+        uw, fw = self.rhs_terms(W)
+        index = dict(zip(flat.tolist(), range(flat.size)))
+        fw_rows = list(fw.T)
+        if (
+            self._all_linear_states
+            and nn == 1
+            and not self._Pn[0]
+            and not self._nonlin[0][0].nstates
+        ):
+            # the common case (a plant and one static controller): no lists, no loops
+            (sub, _, _), Px, Fn = self._nonlin[0], self._Px[0], self._Fn[0]
+            uw_rows = list(uw[0].T)
+            Fx, empty = self._Fx, np.empty(0)
+            get, asarray = index.get, np.asarray
+            if sub.outfcn is None:  # the output is the (empty) state: nothing to feed back
+                return f_plain(Fx, fw_rows, get, direct)
+            outfcn, params = sub.outfcn, sub._current_params
+            n = Fx.shape[0]
+            G = np.vstack([Fx, Px])  # one product gives both x's derivative part and u
+            # ... and one sum adds the input's terms to both: [Fw w; Pw w] per stage
+            pre = list(np.vstack([fw, uw[0]]).T)
+            if sub.noutputs == 1:
+                column = Fn[:, 0].copy()
+                sequence = (list, tuple, np.ndarray)
+
+                def one(t, x):
+                    try:
+                        z = G @ x + pre[index[t]]
+                    except KeyError:
+                        return direct(t, x)
+                    r = outfcn(t, empty, z[n:], params)
+                    return z[:n] + column * (r[0] if isinstance(r, sequence) else r)
+
+            else:
+
+                def one(t, x):
+                    k = get(t)
+                    if k is None:
+                        return direct(t, x)
+                    z = G @ x
+                    y = asarray(outfcn(t, empty, z[n:] + uw_rows[k], params), dtype=float)
+                    return z[:n] + Fn @ y.reshape(-1) + fw_rows[k]
+
+            return one
+        rows = [list(u.T) for u in uw]
+
+        def f(t, x):
+            k = index.get(t)
+            if k is None:
+                return direct(t, x)
+            return rhs_(t, x, [rows[j][k] for j in range(nn)], fw_rows[k])
+
+        return f
+
+
+def f_plain(Fx, fw_rows, get, direct):
+    """``Fx x + fw``: a static subsystem with no output function feeds nothing back."""
+
+    def f(t, x):
+        k = get(t)
+        return direct(t, x) if k is None else Fx @ x + fw_rows[k]
+
+    return f
+
+
+def compile_interconnect(sys) -> CompiledInterconnect | None:
+    """``sys`` solved once (`CompiledInterconnect`), or None where that does not apply.
+
+    None for anything but a continuous-time `control.InterconnectedSystem`
+    that is not itself linear (a linear one is a `control.StateSpace`,
+    stepped as such), and for an algebraic loop (see the module docstring).
+    Call ``sys._update_params(params)`` before using the result, as for
+    ``sys._rhs``: the subsystems' functions read their current parameters.
+    """
+    if not isinstance(sys, control.InterconnectedSystem) or isinstance(sys, control.StateSpace):
+        return None
+    if control.isdtime(sys, strict=True):
+        return None
+    subs = list(sys.syslist)
+    K = np.asarray(sys.connect_map, dtype=float)
+    E = np.asarray(sys.input_map, dtype=float)
+    O = np.asarray(sys.output_map, dtype=float)
+    x_off = np.cumsum([0] + [s.nstates for s in subs])
+    u_off = np.cumsum([0] + [s.ninputs for s in subs])
+    y_off = np.cumsum([0] + [s.noutputs for s in subs])
+    lin = [i for i, s in enumerate(subs) if _is_linear(s)]
+    non = [i for i, s in enumerate(subs) if not _is_linear(s)]
+
+    def idx(offsets, group):
+        return np.concatenate(
+            [np.arange(offsets[i], offsets[i + 1]) for i in group] or [np.empty(0, int)]
+        ).astype(int)
+
+    xL, uL, yL = idx(x_off, lin), idx(u_off, lin), idx(y_off, lin)
+
+    def blockdiag(get, rows, cols):
+        out = np.zeros((rows, cols))
+        r = c = 0
+        for i in lin:
+            m = np.atleast_2d(np.asarray(get(subs[i]), dtype=float))
+            out[r : r + m.shape[0], c : c + m.shape[1]] = m
+            r, c = r + m.shape[0], c + m.shape[1]
+        return out
+
+    AL = blockdiag(lambda s: s.A, xL.size, xL.size)
+    BL = blockdiag(lambda s: s.B, xL.size, uL.size)
+    CL = blockdiag(lambda s: s.C, yL.size, xL.size)
+    DL = blockdiag(lambda s: s.D, yL.size, uL.size)
+    yN = [np.arange(y_off[i], y_off[i + 1]) for i in non]
+    uN = [np.arange(u_off[i], u_off[i + 1]) for i in non]
+    yN_all = np.concatenate(yN) if yN else np.empty(0, int)
+    M = np.eye(yL.size) - DL @ K[np.ix_(uL, yL)]
+    if yL.size and np.linalg.cond(M) > 1e12:
+        return None
+    Minv = np.linalg.inv(M) if yL.size else np.zeros((0, 0))
+    Gx = Minv @ CL
+    Gn = Minv @ DL @ K[np.ix_(uL, yN_all)]
+    Gw = Minv @ DL @ E[uL]
+    # every subsystem input as  Ux x_L + Un y_N + Uw w
+    Ux = K[:, yL] @ Gx
+    Un = K[:, yL] @ Gn + K[:, yN_all]
+    Uw = K[:, yL] @ Gw + E
+    # the nonlinear subsystems' inputs, and the order that resolves them
+    nn = len(non)
+    widths = [len(y) for y in yN]
+    starts = np.cumsum([0] + widths)
+    Px, Pn, Pw = [], [], []
+    needs: list[set[int]] = []
+    for j in range(nn):
+        rows = uN[j]
+        Px.append(Ux[rows])
+        Pw.append(Uw[rows])
+        deps = []
+        for i in range(nn):
+            block = Un[np.ix_(rows, np.arange(starts[i], starts[i + 1]))]
+            if np.any(block != 0):
+                deps.append((i, block))
+        Pn.append(deps)
+        needs.append({i for i, _ in deps})
+    order: list[int] = []
+    done: set[int] = set()
+    while len(order) < nn:
+        ready = [j for j in range(nn) if j not in done and needs[j] <= done]
+        if not ready:  # a loop through direct feedthrough: control iterates, so do we
+            return None
+        order.extend(ready)
+        done.update(ready)
+    Fx = AL + BL @ Ux[uL]
+    Fn = [BL @ Un[np.ix_(uL, np.arange(starts[i], starts[i + 1]))] for i in range(nn)]
+    Fw = BL @ Uw[uL]
+    Ox = O[:, yL] @ Gx
+    On = [O[:, yL] @ Gn[:, starts[i] : starts[i + 1]] + O[:, yN[i]] for i in range(nn)]
+    Ow = O[:, yL] @ Gw
+    nonlin = [(subs[i], slice(x_off[i], x_off[i + 1]), uN[j]) for j, i in enumerate(non)]
+    return CompiledInterconnect(sys, xL, nonlin, order, (Px, Pn, Pw, Fx, Fn, Fw, Ox, On, Ow))
