@@ -292,6 +292,14 @@ def stage_times(t, method="rk4", *, substeps: int = 1) -> np.ndarray:
     return np.column_stack([starts, starts[:, None] + v[:, pcs]]) if pcs else starts[:, None]
 
 
+def _non_finite_message(tab, t, n_last: int) -> str:
+    """The one wording of a run cut at its last finite sample (both stepping loops)."""
+    return (
+        f"{tab.name}: the state became non-finite after t = "
+        f"{t[n_last]:.6g}; stopped after {n_last} of {t.size - 1} intervals"
+    )
+
+
 def check_substeps(substeps) -> int:
     """``substeps`` as an int >= 1, or a ValueError naming it."""
     if isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
@@ -411,10 +419,7 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
                 n_last = start + int(np.argmax(bad))
                 n_computed = stop
                 status = "diverged"
-                message = (
-                    f"{tab.name}: the state became non-finite after t = "
-                    f"{t[n_last]:.6g}; stopped after {n_last} of {t.size - 1} intervals"
-                )
+                message = _non_finite_message(tab, t, n_last)
                 warnings.warn(message, DivergenceWarning, stacklevel=2)
                 break
     steps = n_computed * substeps
@@ -529,10 +534,7 @@ def _integrate_events(f, t, x, tab, substeps, events) -> Solution:
             if not np.all(np.isfinite(x)):
                 n_last = i
                 status = "diverged"
-                message = (
-                    f"{tab.name}: the state became non-finite after t = "
-                    f"{t[n_last]:.6g}; stopped after {n_last} of {t.size - 1} intervals"
-                )
+                message = _non_finite_message(tab, t, n_last)
                 warnings.warn(message, DivergenceWarning, stacklevel=3)
                 break
     return Solution(
