@@ -108,7 +108,12 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         quarter_car,
         quarter_car_model,
     )
-    from .nonlinear import BumpStop, PiecewiseDamper, nonlinear_quarter_car
+    from .nonlinear import (
+        BumpStop,
+        PiecewiseDamper,
+        nonlinear_quarter_car,
+        nonlinear_quarter_car_model,
+    )
     from .plotting import plot_outputs
     from .report import write_report
     from .response import (
@@ -217,6 +222,7 @@ _LAZY: dict[str, str] = {
     "full_car_model": "halfcar",
     # nonlinear quarter car (issue 11)
     "nonlinear_quarter_car": "nonlinear",
+    "nonlinear_quarter_car_model": "nonlinear",
     "BumpStop": "nonlinear",
     "PiecewiseDamper": "nonlinear",
 }
@@ -316,6 +322,7 @@ __all__ = [
     "full_car",
     "full_car_model",
     "nonlinear_quarter_car",
+    "nonlinear_quarter_car_model",
     "BumpStop",
     "PiecewiseDamper",
 ]

@@ -48,6 +48,7 @@ with ``events=True`` steps exactly to each of them.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -56,12 +57,13 @@ import control
 import numpy as np
 
 from .model import OUTPUTS, STATES, UNITS, as_params
-from .vehicle import STANDARD_GRAVITY
+from .vehicle import STANDARD_GRAVITY, Corner, SignalRoles, VehicleModel
 
 __all__ = [
     "PiecewiseDamper",
     "BumpStop",
     "nonlinear_quarter_car",
+    "nonlinear_quarter_car_model",
     "NONLINEAR_OUTPUTS",
     "NONLINEAR_UNITS",
 ]
@@ -398,3 +400,47 @@ def nonlinear_quarter_car(
     sys.switching = switching
     sys.switching_labels = tuple(labels)
     return sys
+
+
+def nonlinear_quarter_car_model(params=None, **options) -> VehicleModel:
+    """The nonlinear quarter car as a `VehicleModel`: `nonlinear_quarter_car` plus roles.
+
+    The roles are `qc_control.quarter_car_model`'s (body acceleration
+    ``body_acc``, body displacement ``xs``, one corner with ``susp_travel``,
+    ``tire_defl``, the road ``zr`` when the car has that input, the tire
+    stiffness ``ku`` and the static load ``(ms + mu)·g``), so that compare,
+    ride metrics, sweeps and the report read it as they read the linear car.
+    Its ``system`` is the `control.NonlinearIOSystem`; ``rebuild(params)``
+    builds the same car (same options) from other parameters.
+
+    Parameters
+    ----------
+    params : QuarterCarParams or dict, optional
+    **options
+        `nonlinear_quarter_car`'s keyword arguments (``tire``, ``bump_stop``,
+        ``damper``, ``spring``, ``gravity``, ``road``, ``actuator``, ``name``).
+
+    Examples
+    --------
+    >>> import qc_control as qc
+    >>> m = qc.nonlinear_quarter_car_model()
+    >>> m.body_acc, m.corners[0].road, m.system.output_labels[-1]
+    ('body_acc', 'zr', 'tire_force')
+    """
+    p = as_params(params)
+    sys = nonlinear_quarter_car(p, **options)
+    corner = Corner(
+        "",
+        "susp_travel",
+        "tire_defl",
+        "zr" if "zr" in sys.input_labels else None,
+        p.ku,
+        (p.ms + p.mu) * STANDARD_GRAVITY,
+    )
+    return VehicleModel(
+        sys,
+        p,
+        NONLINEAR_UNITS,
+        SignalRoles("body_acc", "xs", (corner,)),
+        functools.partial(nonlinear_quarter_car_model, **options),
+    )

@@ -343,3 +343,20 @@ def test_nonlinear_reference_restarts_at_events(lift_off_reference):
     # estimated, 7e-10 against the hand-written solve_ivp (also at 1e-12)
     assert 0 < ref.accuracy < 1e-8
     assert error <= 2 * ref.accuracy, (error, ref.accuracy)
+
+
+def test_nonlinear_model_has_the_quarter_cars_roles():
+    """The VehicleModel wrapper: quarter_car_model's roles, and rebuild keeps the options."""
+    lin = qc.quarter_car_model(P, road=True)
+    nl = qc.nonlinear_quarter_car_model(
+        P, tire="linear", bump_stop=qc.BumpStop(0.05, 1e5, clearance_rebound=0.05)
+    )
+    assert nl.roles == lin.roles
+    assert nl.unit("tire_force") == "N" and nl.road_inputs() == ["zr"]
+    other = nl.rebuild(qc.QuarterCarParams(cs=2000.0))
+    # the rebuilt car keeps the options (a stop, linear tire) and takes the new damping
+    assert other.system.params["cs"] == 2000.0
+    assert (
+        other.system.switching_labels == nl.system.switching_labels == ("bump stop", "rebound stop")
+    )
+    assert qc.nonlinear_quarter_car_model(road=False).road_inputs() == []
