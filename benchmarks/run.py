@@ -506,8 +506,19 @@ def main(argv=None) -> int:
         help="only the generic stepper against the hand-written loops (full size); "
         "prints its table, writes nothing",
     )
+    ap.add_argument(
+        "--only",
+        choices=["interconnect"],
+        default=None,
+        help="run one benchmark alone and print its table (writes nothing); "
+        "'interconnect': car + clipped skyhook, qc RK4 against control.input_output_response",
+    )
     args = ap.parse_args(argv)
     quick = args.quick
+    if args.only == "interconnect":
+        _, head, rows = interconnect_benchmark(quick)
+        print(table(head, rows))
+        return 0
     repeats = 1 if quick else 7
     n_samples = 1001 if quick else 10001  # the default grid: 0-10 s at 1 ms
     T = np.linspace(0.0, 10.0, n_samples)

@@ -16,6 +16,7 @@ __all__ = [
     "Solution",
     "DivergenceWarning",
     "integrate",
+    "integrate_stepper",
     "check_time_grid",
     "check_substeps",
     "uniform_step",
@@ -395,9 +396,52 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
         return _integrate_events(f, t, x, tab, substeps, events)
 
     dt = uniform_step(t)  # a uniform grid is stepped with its one step, like the LTI engine
+    tt = t.tolist()
+
+    def run(x, out, start, stop):
+        return _run(f, tab, tt, x, out, start, stop, substeps, dt)
+
+    return _blocks(run, t, x, tab, substeps, stacklevel=3)
+
+
+def integrate_stepper(stepper, t, x0, method="rk4") -> Solution:
+    """`integrate`'s loop (divergence checks, `Solution`) around a specialised stepper.
+
+    For a right-hand side that steps itself faster than ``f`` called
+    stage by stage can (`qc_control.interconnect`'s fused steps):
+    ``stepper(x, out, start, stop)`` takes the steps from ``t[start]`` to
+    ``t[stop]`` with ``method`` (one step per interval), writes the state
+    after each into ``out[i + 1]`` and returns the last. The run is cut,
+    warned about and reported exactly as `integrate` does, and ``nfev``
+    counts ``stages · steps`` as if ``f`` had been called per stage.
+
+    Parameters
+    ----------
+    stepper : callable ``stepper(x, out, start, stop) -> x``
+    t : array_like, shape (N,)
+        Output times, strictly increasing (`check_time_grid`).
+    x0 : array_like, shape (n,)
+        Initial state (real).
+    method : str or ButcherTableau, default ``'rk4'``
+        The tableau the stepper implements (for ``nfev`` and the message).
+
+    Returns
+    -------
+    Solution
+    """
+    tab = get_method(method)
+    t = check_time_grid(t, "t")
+    if not callable(stepper):
+        raise TypeError(
+            f"stepper must be callable as stepper(x, out, start, stop), got {show(stepper)}"
+        )
+    return _blocks(stepper, t, _initial_state(x0), tab, 1, stacklevel=3)
+
+
+def _blocks(run, t, x, tab, substeps, stacklevel) -> Solution:
+    """Run ``run(x, out, start, stop)`` block by block, checking for a non-finite state."""
     out = np.empty((t.size,) + x.shape, dtype=x.dtype)
     out[0] = x
-    tt = t.tolist()
     n_last, n_computed, status, message = t.size - 1, t.size - 1, "success", ""
     with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings():
         # a complex f on a real state would lose its imaginary part in `out`
@@ -405,7 +449,7 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
         for start in range(0, t.size - 1, _CHECK_EVERY):
             stop = min(start + _CHECK_EVERY, t.size - 1)
             try:
-                x = _run(f, tab, tt, x, out, start, stop, substeps, dt)
+                x = run(x, out, start, stop)
             except np.exceptions.ComplexWarning:
                 raise TypeError(
                     "f returned complex values for a real x0; pass a complex x0 (e.g. "
@@ -420,7 +464,7 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
                 n_computed = stop
                 status = "diverged"
                 message = _non_finite_message(tab, t, n_last)
-                warnings.warn(message, DivergenceWarning, stacklevel=2)
+                warnings.warn(message, DivergenceWarning, stacklevel=stacklevel)
                 break
     steps = n_computed * substeps
     return Solution(

@@ -41,7 +41,7 @@ from collections.abc import Callable
 import control
 import numpy as np
 
-__all__ = ["CompiledInterconnect", "compile_interconnect"]
+__all__ = ["CompiledInterconnect", "FusedSteps", "compile_interconnect"]
 
 
 def _is_linear(sub) -> bool:
@@ -228,6 +228,210 @@ class CompiledInterconnect:
             return rhs_(t, x, [rows[j][k] for j in range(nn)], fw_rows[k])
 
         return f
+
+    def fused(self, tab, h: float, stages: np.ndarray, inputs):
+        """Whole steps of ``tab`` at the step ``h`` (`FusedSteps`), or None where not applicable.
+
+        Applies when every state belongs to a linear subsystem and every
+        nonlinear subsystem is static with an output function (a plant and
+        a static controller); ``stages`` are the stage times
+        (`qc_control.integrate.stage_times` on a grid uniform with step
+        ``h``, one step per interval), ``inputs = (T, U)`` the samples the input interpolates.
+        """
+        if not self._all_linear_states or any(sub.outfcn is None for sub, _, _ in self._nonlin):
+            return None
+        return FusedSteps(self, tab, h, stages, inputs)
+
+    def outputs_known(self, X: np.ndarray, W: np.ndarray, YN: np.ndarray) -> np.ndarray:
+        """`outputs` with the nonlinear subsystems' outputs ``YN`` (stacked, ``(p, K)``) known."""
+        XL = X[self._lin_x]
+        Y = self._Ox @ XL + self._Ow @ W
+        start = 0
+        for On in self._On:
+            Y = Y + On @ YN[start : start + On.shape[1]]
+            start += On.shape[1]
+        return Y
+
+
+class FusedSteps:
+    r"""Whole Runge–Kutta steps of a linear plant closed by static nonlinear subsystems.
+
+    With every state linear and the nonlinear subsystems static, the
+    interconnection is ``x' = F x + g(t) + N y``, where ``y = φ(t, P x + q(t))``
+    stacks the nonlinear subsystems' outputs (``F``, ``N``, ``P`` from
+    `compile_interconnect`; ``g``, ``q`` the external input's terms). An
+    explicit Runge–Kutta step is then linear in ``x`` and in the stage
+    values ``y_l = φ(t + c_l h, z_l)``: by induction over the stages
+    (``X_l = x + h \sum_{j<l} a_{lj} k_j``, ``k_l = F X_l + g_l + N y_l``),
+
+    .. math::
+
+        X_l = A_l x + \gamma_l + \sum_{r<l} B_{lr}\, y_r, \qquad
+        A_l = I + h \sum_{j<l} a_{lj} F A_j, \quad
+        B_{lr} = h\, a_{lr} N + h \sum_{r<j<l} a_{lj} F B_{jr},
+
+    with ``γ_l`` the same recursion on the input terms, and the step's end
+    the same with ``b`` for ``a``. So each step is one matrix product for
+    ``P A_l x`` (every stage) and ``Φ x`` together, ``φ`` at each stage with
+    the earlier stages' ``y`` added through ``P B_{lr}``, and one product
+    for ``\sum_r W_r y_r``; the input's terms ``γ_l`` of every step are
+    computed for the whole run at once. The stepped values equal the
+    stage-by-stage RK step's to rounding (the same sums in another order).
+
+    The first stage is at ``(t_k, x_k)`` itself, so its ``y`` is the
+    nonlinear subsystems' output at the sample: it is kept (``yn``) and the
+    run's outputs need no second evaluation of ``φ``.
+    """
+
+    def __init__(self, compiled: CompiledInterconnect, tab, h, stages, inputs):
+        nonlin = compiled._nonlin
+        Px, Pw, Pn = compiled._Px, compiled._Pw, compiled._Pn
+        F, Fw = compiled._Fx, compiled._Fw
+        N = np.hstack(compiled._Fn)
+        P = np.vstack(Px)
+        n, p, m = F.shape[0], N.shape[1], P.shape[0]
+        a, b = np.asarray(tab.a, dtype=float), np.asarray(tab.b, dtype=float)
+        s = b.size
+        eye = np.eye(n)
+        A = [eye]
+        B: list[list[np.ndarray]] = [[]]
+        rows = [*a[1:], b]
+        for i, coef in enumerate(rows, start=1):
+            Ai = eye.copy()
+            Bi = [np.zeros((n, p)) for _ in range(i)]
+            for j in range(i):
+                if coef[j] == 0:
+                    continue
+                Ai = Ai + h * coef[j] * (F @ A[j])
+                Bi[j] = Bi[j] + h * coef[j] * N
+                for r in range(j):
+                    Bi[r] = Bi[r] + h * coef[j] * (F @ B[j][r])
+            A.append(Ai)
+            B.append(Bi)
+        # the input's terms at every stage of every step: gamma_l (n, K) and q_l (m, K)
+        T, U = inputs
+        K = stages.shape[0]
+        Wst = [np.array([np.interp(stages[:, l], T, row) for row in U]) for l in range(s)]
+        Wst = [w.reshape(len(U), K) for w in Wst]
+        gam = [np.zeros((n, K))]
+        for i, coef in enumerate(rows, start=1):
+            gi = np.zeros((n, K))
+            for j in range(i):
+                if coef[j] != 0:
+                    gi = gi + h * coef[j] * (F @ gam[j] + Fw @ Wst[j])
+            gam.append(gi)
+        Pw_all = np.vstack(Pw)
+        pre = np.vstack([P @ gam[l] + Pw_all @ Wst[l] for l in range(s)] + [gam[s]])
+        self._G = np.vstack([P @ A[l] for l in range(s)] + [A[s]])
+        self._Pw_all = Pw_all
+        self._pre = list(np.ascontiguousarray(pre.T))
+        # y_r's contribution to every later stage's input and to the step's end, one column block
+        self._C = [np.vstack([P @ B[l][r] for l in range(r + 1, s)] + [B[s][r]]) for r in range(s)]
+        self._times = stages.tolist()
+        self._n, self._m, self._p, self._s = n, m, p, s
+        self.yn = np.empty((K, p))  # phi at each step's first stage: the outputs at the samples
+        # phi: the nonlinear subsystems in their order, the later ones fed by the earlier
+        widths_u = [P_.shape[0] for P_ in Px]
+        u_start = np.cumsum([0] + widths_u)
+        widths_y = [Fn.shape[1] for Fn in compiled._Fn]
+        y_start = np.cumsum([0] + widths_y)
+        order = compiled._order
+        empty = np.empty(0)
+
+        def phi(t, z, y):
+            for j in order:
+                u = z[u_start[j] : u_start[j + 1]]
+                for i, Pn_ji in Pn[j]:
+                    u = u + Pn_ji @ y[y_start[i] : y_start[i + 1]]
+                sub = nonlin[j][0]
+                y[y_start[j] : y_start[j + 1]] = np.asarray(
+                    sub.outfcn(t, empty, u, sub._current_params)
+                ).reshape(-1)
+
+        self._phi = phi
+        self._single = len(nonlin) == 1
+        self._sub = nonlin[0][0]
+        self.compiled = compiled
+
+    def stepper(self):
+        """``run(x, out, start, stop)`` for `qc_control.integrate.integrate_stepper`."""
+        G, pre, times, yn = self._G, self._pre, self._times, self._yn_rows()
+        m, p, s = self._m, self._p, self._s
+        sm = s * m
+        # stage i reads z[i m : (i + 1) m]; y_r is added to z[(r + 1) m :] once known
+        zs = [slice(i * m, (i + 1) * m) for i in range(s)]
+        rest = [slice((r + 1) * m, None) for r in range(s)]
+        C = self._C
+        if self._single and p == 1:
+            # the common case (one static controller, one output): scalars, no y vector
+            sub = self._sub
+            outfcn, params, empty = sub.outfcn, sub._current_params, np.empty(0)
+            cols = [c[:, 0].copy() for c in C]
+            later = list(zip(range(1, s), zs[1:], cols[1:], rest[1:]))
+            z0, c0, rest0 = zs[0], cols[0], rest[0]
+
+            def run_one(x, out, start, stop):
+                for k in range(start, stop):
+                    z = G @ x + pre[k]
+                    ts = times[k]
+                    r = outfcn(ts[0], empty, z[z0], params)
+                    v = yn[k] = r[0] if type(r) is list and len(r) == 1 else _scalar(r)
+                    z[rest0] += c0 * v
+                    for i, zi, ci, ri in later:
+                        r = outfcn(ts[i], empty, z[zi], params)
+                        z[ri] += ci * (r[0] if type(r) is list and len(r) == 1 else _scalar(r))
+                    x = out[k + 1] = z[sm:]
+                return x
+
+            return run_one
+        phi = self._phi
+        y = np.empty(p)
+
+        def run(x, out, start, stop):
+            for k in range(start, stop):
+                z = G @ x + pre[k]
+                ts = times[k]
+                phi(ts[0], z[zs[0]], y)
+                yn[k] = y
+                z[rest[0]] += C[0] @ y
+                for i in range(1, s):
+                    phi(ts[i], z[zs[i]], y)
+                    z[rest[i]] += C[i] @ y
+                x = out[k + 1] = z[sm:]
+            return x
+
+        return run
+
+    def nonlinear_outputs(self, index: np.ndarray, t_out, X: np.ndarray, W: np.ndarray):
+        """The nonlinear subsystems' outputs ``(p, K)`` at grid samples ``index``.
+
+        Those kept from a step's first stage (every sample a step started
+        from); the others (the grid's last point) are evaluated here from
+        the state ``X`` and input ``W`` at ``t_out``.
+        """
+        index = np.asarray(index, dtype=int)
+        steps = self.yn.shape[0]
+        YN = np.empty((self._p, index.size))
+        kept = index < steps
+        YN[:, kept] = self.yn[index[kept]].T
+        P = self._G[: self._m]  # P A_1 = P
+        Pw = self._Pw_all
+        y = np.empty(self._p)
+        for c in np.flatnonzero(~kept).tolist():
+            self._phi(float(t_out[c]), P @ X[:, c] + Pw @ W[:, c], y)
+            YN[:, c] = y
+        return YN
+
+    def _yn_rows(self):
+        return self.yn[:, 0] if self._single and self._p == 1 else self.yn
+
+
+def _scalar(r):
+    """A one-output function's value as a number (control's ``asarray(r).reshape(-1)``)."""
+    flat = np.asarray(r, dtype=float).reshape(-1)
+    if flat.size != 1:
+        raise ValueError(f"the output function returned {flat.size} values; expected 1")
+    return flat[0]
 
 
 def f_plain(Fx, fw_rows, get, direct):

@@ -53,6 +53,7 @@ from .integrate import (
     check_substeps,
     check_time_grid,
     integrate,
+    integrate_stepper,
     stage_times,
     uniform_step,
 )
@@ -1421,6 +1422,7 @@ def _io_response(
     t_events: np.ndarray = np.empty(0)
     event_labels: tuple[str, ...] = ()
     compiled = compile_interconnect(sys) if fast else None
+    fused = None
     if x0.size == 0:  # a static system: nothing to integrate
         t_out = grid if at is None else grid[at]
         steps = nfev = 0
@@ -1433,11 +1435,17 @@ def _io_response(
         def f(t, x):
             return rhs(t, x, u_of_t(t))
 
+        g, labels = _event_function(sys, events)
         if compiled is not None:  # the interconnection solved once (qc_control.interconnect)
             stages = stage_times(grid, tab, substeps=n_sub)
-            f = compiled.make_rhs(u_of_t, (T, u_samples), stages)
-        g, labels = _event_function(sys, events)
-        if g is None:
+            dt = uniform_step(grid)
+            if g is None and n_sub == 1 and dt is not None:
+                fused = compiled.fused(tab, dt, stages, (T, u_samples))
+            if fused is None:
+                f = compiled.make_rhs(u_of_t, (T, u_samples), stages)
+        if fused is not None:  # whole steps at once (qc_control.interconnect.FusedSteps)
+            sol = integrate_stepper(fused.stepper(), grid, x0, tab)
+        elif g is None:
             sol = integrate(f, grid, x0, tab, substeps=n_sub)
         else:
             current = getattr(sys, "_current_params", params or {})
@@ -1453,6 +1461,7 @@ def _io_response(
         steps, nfev = sol.steps, sol.nfev
         success, message = sol.success, sol.message
         if at is None:
+            keep = np.arange(sol.t.size)
             t_out, x = sol.t, sol.x
         else:
             keep = at[at < sol.t.size]
@@ -1465,7 +1474,9 @@ def _io_response(
         else:
             for i, t in enumerate(t_out.tolist()):
                 u[:, i] = u_of_t(t)
-        if compiled is not None and x0.size:
+        if fused is not None:  # the nonlinear outputs kept from each step's first stage
+            y[:] = fused.compiled.outputs_known(x, u, fused.nonlinear_outputs(keep, t_out, x, u))
+        elif compiled is not None and x0.size:
             y[:] = compiled.outputs(t_out, x, u)
         else:
             for i, t in enumerate(t_out.tolist()):
