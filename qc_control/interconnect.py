@@ -248,7 +248,11 @@ class CompiledInterconnect:
         Y = self._Ox @ XL + self._Ow @ W
         start = 0
         for On in self._On:
-            Y = Y + On @ YN[start : start + On.shape[1]]
+            # only the nonlinear outputs that reach an output: an overflowed one that
+            # does not (an inf times a zero column) must not turn the outputs into NaN
+            used = np.flatnonzero(np.any(On != 0, axis=0))
+            if used.size:
+                Y = Y + On[:, used] @ YN[start + used]
             start += On.shape[1]
         return Y
 
@@ -325,8 +329,14 @@ class FusedSteps:
         self._G = np.vstack([P @ A[l] for l in range(s)] + [A[s]])
         self._Pw_all = Pw_all
         self._pre = list(np.ascontiguousarray(pre.T))
-        # y_r's contribution to every later stage's input and to the step's end, one column block
-        self._C = [np.vstack([P @ B[l][r] for l in range(r + 1, s)] + [B[s][r]]) for r in range(s)]
+        # y_r's contribution to every later stage's input and to the step's end, as one
+        # full-length column block (zeros for the stages up to r): z += C_r y_r, no slicing
+        self._C = [
+            np.vstack(
+                [np.zeros(((r + 1) * m, p))] + [P @ B[l][r] for l in range(r + 1, s)] + [B[s][r]]
+            )
+            for r in range(s)
+        ]
         self._times = stages.tolist()
         self._n, self._m, self._p, self._s = n, m, p, s
         self.yn = np.empty((K, p))  # phi at each step's first stage: the outputs at the samples
@@ -358,17 +368,16 @@ class FusedSteps:
         G, pre, times, yn = self._G, self._pre, self._times, self._yn_rows()
         m, p, s = self._m, self._p, self._s
         sm = s * m
-        # stage i reads z[i m : (i + 1) m]; y_r is added to z[(r + 1) m :] once known
+        # stage i reads z[i m : (i + 1) m]; C_r y_r is added to z once y_r is known
         zs = [slice(i * m, (i + 1) * m) for i in range(s)]
-        rest = [slice((r + 1) * m, None) for r in range(s)]
         C = self._C
         if self._single and p == 1:
             # the common case (one static controller, one output): scalars, no y vector
             sub = self._sub
             outfcn, params, empty = sub.outfcn, sub._current_params, np.empty(0)
             cols = [c[:, 0].copy() for c in C]
-            later = list(zip(range(1, s), zs[1:], cols[1:], rest[1:]))
-            z0, c0, rest0 = zs[0], cols[0], rest[0]
+            later = list(zip(range(1, s), zs[1:], cols[1:]))
+            z0, c0 = zs[0], cols[0]
 
             def run_one(x, out, start, stop):
                 for k in range(start, stop):
@@ -376,10 +385,10 @@ class FusedSteps:
                     ts = times[k]
                     r = outfcn(ts[0], empty, z[z0], params)
                     v = yn[k] = r[0] if type(r) is list and len(r) == 1 else _scalar(r)
-                    z[rest0] += c0 * v
-                    for i, zi, ci, ri in later:
+                    z += c0 * v
+                    for i, zi, ci in later:
                         r = outfcn(ts[i], empty, z[zi], params)
-                        z[ri] += ci * (r[0] if type(r) is list and len(r) == 1 else _scalar(r))
+                        z += ci * (r[0] if type(r) is list and len(r) == 1 else _scalar(r))
                     x = out[k + 1] = z[sm:]
                 return x
 
@@ -393,10 +402,10 @@ class FusedSteps:
                 ts = times[k]
                 phi(ts[0], z[zs[0]], y)
                 yn[k] = y
-                z[rest[0]] += C[0] @ y
+                z += C[0] @ y
                 for i in range(1, s):
                     phi(ts[i], z[zs[i]], y)
-                    z[rest[i]] += C[i] @ y
+                    z += C[i] @ y
                 x = out[k + 1] = z[sm:]
             return x
 
