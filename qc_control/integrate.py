@@ -404,14 +404,15 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
     return _blocks(run, t, x, tab, substeps, stacklevel=3)
 
 
-def integrate_stepper(stepper, t, x0, method="rk4") -> Solution:
+def integrate_stepper(stepper, t, x0, method="rk4", *, substeps: int = 1) -> Solution:
     """`integrate`'s loop (divergence checks, `Solution`) around a specialised stepper.
 
     For a right-hand side that steps itself faster than ``f`` called
     stage by stage can (`qc_control.interconnect`'s fused steps):
     ``stepper(x, out, start, stop)`` takes the steps from ``t[start]`` to
-    ``t[stop]`` with ``method`` (one step per interval), writes the state
-    after each into ``out[i + 1]`` and returns the last. The run is cut,
+    ``t[stop]`` with ``method`` (``substeps`` per interval), writes the
+    state at the end of each interval ``i`` into ``out[i + 1]`` and
+    returns the last. The run is cut,
     warned about and reported exactly as `integrate` does, and ``nfev``
     counts ``stages · steps`` as if ``f`` had been called per stage.
 
@@ -424,6 +425,8 @@ def integrate_stepper(stepper, t, x0, method="rk4") -> Solution:
         Initial state (real).
     method : str or ButcherTableau, default ``'rk4'``
         The tableau the stepper implements (for ``nfev`` and the message).
+    substeps : int, default 1
+        The steps the stepper takes per interval (for ``steps`` and ``nfev``).
 
     Returns
     -------
@@ -435,7 +438,8 @@ def integrate_stepper(stepper, t, x0, method="rk4") -> Solution:
         raise TypeError(
             f"stepper must be callable as stepper(x, out, start, stop), got {show(stepper)}"
         )
-    return _blocks(stepper, t, _initial_state(x0), tab, 1, stacklevel=3)
+    substeps = check_substeps(substeps)
+    return _blocks(stepper, t, _initial_state(x0), tab, substeps, stacklevel=3)
 
 
 def _blocks(run, t, x, tab, substeps, stacklevel) -> Solution:

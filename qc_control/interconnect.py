@@ -229,18 +229,19 @@ class CompiledInterconnect:
 
         return f
 
-    def fused(self, tab, h: float, stages: np.ndarray, inputs):
+    def fused(self, tab, h: float, stages: np.ndarray, inputs, substeps: int = 1):
         """Whole steps of ``tab`` at the step ``h`` (`FusedSteps`), or None where not applicable.
 
         Applies when every state belongs to a linear subsystem and every
         nonlinear subsystem is static with an output function (a plant and
-        a static controller); ``stages`` are the stage times
-        (`qc_control.integrate.stage_times` on a grid uniform with step
-        ``h``, one step per interval), ``inputs = (T, U)`` the samples the input interpolates.
+        a static controller); ``stages`` are the stage times of every step
+        (`qc_control.integrate.stage_times` on a uniform grid, ``substeps``
+        steps ``h`` per interval), ``inputs = (T, U)`` the samples the
+        input interpolates.
         """
         if not self._all_linear_states or any(sub.outfcn is None for sub, _, _ in self._nonlin):
             return None
-        return FusedSteps(self, tab, h, stages, inputs)
+        return FusedSteps(self, tab, h, stages, inputs, substeps)
 
     def outputs_known(self, X: np.ndarray, W: np.ndarray, YN: np.ndarray) -> np.ndarray:
         """`outputs` with the nonlinear subsystems' outputs ``YN`` (stacked, ``(p, K)``) known."""
@@ -287,7 +288,7 @@ class FusedSteps:
     run's outputs need no second evaluation of ``φ``.
     """
 
-    def __init__(self, compiled: CompiledInterconnect, tab, h, stages, inputs):
+    def __init__(self, compiled: CompiledInterconnect, tab, h, stages, inputs, substeps=1):
         nonlin = compiled._nonlin
         Px, Pw, Pn = compiled._Px, compiled._Pw, compiled._Pn
         F, Fw = compiled._Fx, compiled._Fw
@@ -339,6 +340,7 @@ class FusedSteps:
         ]
         self._times = stages.tolist()
         self._n, self._m, self._p, self._s = n, m, p, s
+        self._substeps = substeps
         self.yn = np.empty((K, p))  # phi at each step's first stage: the outputs at the samples
         # phi: the nonlinear subsystems in their order, the later ones fed by the earlier
         widths_u = [P_.shape[0] for P_ in Px]
@@ -364,7 +366,28 @@ class FusedSteps:
         self.compiled = compiled
 
     def stepper(self):
-        """``run(x, out, start, stop)`` for `qc_control.integrate.integrate_stepper`."""
+        """``run(x, out, start, stop)`` for `qc_control.integrate.integrate_stepper`.
+
+        ``substeps`` steps per interval of the grid, as `qc_control.integrate.integrate`
+        takes them: into a scratch buffer, every ``substeps``-th kept.
+        """
+        steps = self._steps()
+        ns, n = self._substeps, self._n
+        if ns == 1:
+            return lambda x, out, start, stop: steps(x, out, start, stop, 0)
+
+        def run(x, out, start, stop):
+            q0, q1 = start * ns, stop * ns
+            buf = np.empty((q1 - q0 + 1, n))
+            x = steps(x, buf, q0, q1, q0)
+            out[start + 1 : stop + 1] = buf[ns::ns]
+            return x
+
+        return run
+
+    def _steps(self):
+        """``steps(x, out, start, stop, base)``: steps ``start`` to ``stop``, step ``k``'s
+        end in ``out[k + 1 - base]``."""
         G, pre, times, yn = self._G, self._pre, self._times, self._yn_rows()
         m, p, s = self._m, self._p, self._s
         sm = s * m
@@ -379,7 +402,7 @@ class FusedSteps:
             later = list(zip(range(1, s), zs[1:], cols[1:]))
             z0, c0 = zs[0], cols[0]
 
-            def run_one(x, out, start, stop):
+            def run_one(x, out, start, stop, base):
                 for k in range(start, stop):
                     z = G @ x + pre[k]
                     ts = times[k]
@@ -389,14 +412,14 @@ class FusedSteps:
                     for i, zi, ci in later:
                         r = outfcn(ts[i], empty, z[zi], params)
                         z += ci * (r[0] if type(r) is list and len(r) == 1 else _scalar(r))
-                    x = out[k + 1] = z[sm:]
+                    x = out[k + 1 - base] = z[sm:]
                 return x
 
             return run_one
         phi = self._phi
         y = np.empty(p)
 
-        def run(x, out, start, stop):
+        def run(x, out, start, stop, base):
             for k in range(start, stop):
                 z = G @ x + pre[k]
                 ts = times[k]
@@ -406,7 +429,7 @@ class FusedSteps:
                 for i in range(1, s):
                     phi(ts[i], z[zs[i]], y)
                     z += C[i] @ y
-                x = out[k + 1] = z[sm:]
+                x = out[k + 1 - base] = z[sm:]
             return x
 
         return run
@@ -418,7 +441,7 @@ class FusedSteps:
         from); the others (the grid's last point) are evaluated here from
         the state ``X`` and input ``W`` at ``t_out``.
         """
-        index = np.asarray(index, dtype=int)
+        index = np.asarray(index, dtype=int) * self._substeps  # the step starting there
         steps = self.yn.shape[0]
         YN = np.empty((self._p, index.size))
         kept = index < steps

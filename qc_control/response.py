@@ -1439,12 +1439,12 @@ def _io_response(
         if compiled is not None:  # the interconnection solved once (qc_control.interconnect)
             stages = stage_times(grid, tab, substeps=n_sub)
             dt = uniform_step(grid)
-            if g is None and n_sub == 1 and dt is not None:
-                fused = compiled.fused(tab, dt, stages, (T, u_samples))
+            if g is None and dt is not None:
+                fused = compiled.fused(tab, dt / n_sub, stages, (T, u_samples), n_sub)
             if fused is None:
                 f = compiled.make_rhs(u_of_t, (T, u_samples), stages)
         if fused is not None:  # whole steps at once (qc_control.interconnect.FusedSteps)
-            sol = integrate_stepper(fused.stepper(), grid, x0, tab)
+            sol = integrate_stepper(fused.stepper(), grid, x0, tab, substeps=n_sub)
         elif g is None:
             sol = integrate(f, grid, x0, tab, substeps=n_sub)
         else:

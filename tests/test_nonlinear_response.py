@@ -479,6 +479,27 @@ def test_fused_steps_equal_the_rhs_path_for_every_tableau(method):
     assert fused_calls == fast.nfev + 1 + sizing
 
 
+@pytest.mark.parametrize(
+    "options",
+    [
+        dict(substeps=3),  # every third step kept
+        dict(substeps=3, evaluation_times=None),  # every step returned
+        dict(evaluation_times=np.linspace(0.0, 1.0, 126)[1::5]),  # points of the grid
+    ],
+    ids=["substeps", "every-step", "evaluation-times"],
+)
+def test_fused_steps_with_substeps_and_evaluation_times(options):
+    cl = _car_and_skyhook()
+    T = grid(4e-3, 1.0)
+    zr = qc.road.iso8608(T, "C", 20.0, seed=5)
+    fast = qc.input_output_response(cl, T, zr, [0.1, 0, 0.02, 0], **options)
+    slow = qc.input_output_response(cl, T, zr, [0.1, 0, 0.02, 0], fast=False, **options)
+    np.testing.assert_array_equal(fast.t, slow.t)
+    assert _rel(fast.states, slow.states) <= 1e-12  # measured 2.6e-14 at most
+    assert _rel(fast.outputs, slow.outputs) <= 1e-12
+    assert fast.nfev == slow.nfev
+
+
 def _car_sensor_law():
     """The seed car under two chained static nlsys blocks (a sensor feeding a smooth law)."""
     ss = qc.quarter_car(road=True, actuator=True)
