@@ -28,7 +28,14 @@ system is compiled:
   parameters python-control gives them (``sys._update_params``).
 
 The result equals python-control's ``_rhs``/``_out`` to rounding (the same
-sums in another order). When ``M`` is singular, or the nonlinear subsystems
+sums in another order).
+
+When every state is a linear subsystem's and the nonlinear subsystems are
+static (a car and a static controller), a whole Runge–Kutta step is linear
+in the state and in the controller's stage values: `FusedSteps` takes each
+step as one matrix product plus the controller's calls, with the input's
+terms of all steps computed at once, and keeps the controller's value at
+each sample for the outputs. When ``M`` is singular, or the nonlinear subsystems
 feed each other (or themselves) through a direct path, there is an
 algebraic loop that python-control resolves (or refuses) by iteration:
 `compile_interconnect` returns None and the caller uses ``sys._rhs``.
@@ -276,12 +283,19 @@ class FusedSteps:
         B_{lr} = h\, a_{lr} N + h \sum_{r<j<l} a_{lj} F B_{jr},
 
     with ``γ_l`` the same recursion on the input terms, and the step's end
-    the same with ``b`` for ``a``. So each step is one matrix product for
-    ``P A_l x`` (every stage) and ``Φ x`` together, ``φ`` at each stage with
-    the earlier stages' ``y`` added through ``P B_{lr}``, and one product
-    for ``\sum_r W_r y_r``; the input's terms ``γ_l`` of every step are
-    computed for the whole run at once. The stepped values equal the
-    stage-by-stage RK step's to rounding (the same sums in another order).
+    ``x + h \sum_l b_l k_l = Φ x + γ + \sum_r W_r y_r`` the same with ``b``
+    for ``a``. So each step is one matrix product giving ``P A_l x`` (every
+    stage) and ``Φ x`` together; then, stage by stage, ``φ`` is called and
+    its value ``y_r`` added through one column block (``P B_{lr}`` for the
+    later stages' inputs, ``W_r`` for the end). The input's terms of every
+    step (``P γ_l + q_l`` and ``γ``) are computed for the whole run at
+    once, with the same interpolation as `CompiledInterconnect.make_rhs`.
+    The stepped values equal the stage-by-stage step's to rounding (the
+    same sums in another order: 2.4e-14 of the largest state over 10 s of
+    car and clipped skyhook).
+
+    Built by `CompiledInterconnect.fused`; ``stepper()`` is what
+    `qc_control.integrate.integrate_stepper` runs.
 
     The first stage is at ``(t_k, x_k)`` itself, so its ``y`` is the
     nonlinear subsystems' output at the sample: it is kept (``yn``) and the
