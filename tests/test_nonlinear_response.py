@@ -330,8 +330,8 @@ def test_discrete_and_static_systems_as_control():
 # ---------------------------------------------------------------- the interconnection fast path
 
 
-def _car_and_skyhook(c_sky=3000.0):
-    """The seed car (a StateSpace, velocities as extra outputs) and a clipped skyhook (nlsys)."""
+def _car_with_velocities():
+    """The seed car as a StateSpace with the body and wheel velocities as extra outputs."""
     ss = qc.quarter_car(road=True, actuator=True)
     A, B, C, D = (np.asarray(m) for m in (ss.A, ss.B, ss.C, ss.D))
     car = control.ss(
@@ -344,6 +344,12 @@ def _car_and_skyhook(c_sky=3000.0):
         outputs=[*ss.output_labels, "vs_m", "vu_m"],
         name="car",
     )
+    return ss, car
+
+
+def _car_and_skyhook(c_sky=3000.0):
+    """The seed car (a StateSpace, velocities as extra outputs) and a clipped skyhook (nlsys)."""
+    ss, car = _car_with_velocities()
 
     def skyhook(t, x, u, p):  # Karnopp's clipped skyhook, force limited to fmax
         vs, vu = u
@@ -502,18 +508,7 @@ def test_fused_steps_with_substeps_and_evaluation_times(options):
 
 def _car_sensor_law():
     """The seed car under two chained static nlsys blocks (a sensor feeding a smooth law)."""
-    ss = qc.quarter_car(road=True, actuator=True)
-    A, B, C, D = (np.asarray(m) for m in (ss.A, ss.B, ss.C, ss.D))
-    car = control.ss(
-        A,
-        B,
-        np.vstack([C, np.eye(4)[:2]]),
-        np.vstack([D, np.zeros((2, 2))]),
-        states=ss.state_labels,
-        inputs=ss.input_labels,
-        outputs=[*ss.output_labels, "vs_m", "vu_m"],
-        name="car",
-    )
+    ss, car = _car_with_velocities()
     sensor = control.nlsys(
         None,
         lambda t, x, u, p: [u[0], u[0] - u[1]],
