@@ -474,6 +474,10 @@ class FusedSteps:
 
 def _scalar(r):
     """A one-output function's value as a number (control's ``asarray(r).reshape(-1)``)."""
+    if type(r) is np.ndarray and r.shape == (1,):  # np.array([f]): the usual return
+        return r[0]
+    if type(r) is float:
+        return r
     flat = np.asarray(r, dtype=float).reshape(-1)
     if flat.size != 1:
         raise ValueError(f"the output function returned {flat.size} values; expected 1")

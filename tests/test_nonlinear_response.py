@@ -506,6 +506,31 @@ def test_fused_steps_with_substeps_and_evaluation_times(options):
     assert fast.nfev == slow.nfev
 
 
+@pytest.mark.parametrize(
+    "wrap",
+    [list, np.array, float, lambda v: np.array([[v]]), lambda v: np.float64(v)],
+    ids=["list", "array", "float", "array-1x1", "float64"],
+)
+def test_fused_steps_take_any_one_output_control_takes(wrap):
+    # control reads an output function's value as asarray(r).reshape(-1): a list, an
+    # array of any shape with one element, a number. The fused steps read the value
+    # directly in the common cases; each must give the sys._rhs path's run (to rounding).
+    ss, car = _car_with_velocities()
+
+    def law(t, x, u, p):
+        value = -3000.0 * u[0] * np.tanh(50.0 * u[0] * (u[0] - u[1]))
+        return wrap([value]) if wrap is list else wrap(value)
+
+    ctrl = control.nlsys(None, law, inputs=["vs_m", "vu_m"], outputs=["fa"], name="law")
+    cl = control.interconnect([car, ctrl], inputs="zr", outputs=ss.output_labels)
+    T = grid(1e-3, 0.5)
+    zr = qc.road.iso8608(T, "C", 20.0, seed=6)
+    fast = qc.input_output_response(cl, T, zr, [0.1, 0, 0.02, 0])
+    slow = qc.input_output_response(cl, T, zr, [0.1, 0, 0.02, 0], fast=False)
+    assert _rel(fast.states, slow.states) <= 1e-12
+    assert _rel(fast.outputs, slow.outputs) <= 1e-12
+
+
 def _car_sensor_law():
     """The seed car under two chained static nlsys blocks (a sensor feeding a smooth law)."""
     ss, car = _car_with_velocities()
