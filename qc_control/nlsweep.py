@@ -340,10 +340,14 @@ def _run_vectorised(
         if streamed:
             if stream is not None:
                 result.update(stream.result())
-            if late:  # on the kept signals, whole (the registry's formula)
-                signals = RideSignals(T, kept, roles, *args[2:])
-                for column, metric, corner in late:
-                    result[column] = np.asarray(metric.formula(signals, corner))
+            if late:  # on the kept signals, whole (the registry's formula), by slices
+                for column, metric, corner in late:  # of designs (cache-sized temporaries)
+                    result[column] = np.concatenate(
+                        [
+                            np.asarray(metric.formula(_rows(T, kept, roles, args, sl), corner))
+                            for sl in _slices(m)
+                        ]
+                    )
         else:
             signals = RideSignals(T, kept, roles, *args[2:])
             for column, metric, corner in items:
@@ -352,6 +356,21 @@ def _run_vectorised(
                 else:
                     result[column] = np.asarray(metric(signals), dtype=float)
     return result, x_all
+
+
+def _slices(m: int, size: int = 128) -> list[slice]:
+    return [slice(s, s + size) for s in range(0, m, size)]
+
+
+def _rows(T, kept, roles, args, sl) -> RideSignals:
+    """The kept signals of the designs ``sl``, as a `RideSignals`."""
+    return RideSignals(
+        T,
+        {label: y[sl] for label, y in kept.items()},
+        roles,
+        tuple(k[sl] for k in args[2]),
+        tuple(w[sl] for w in args[3]),
+    )
 
 
 def _run_responses(model, params, T, X0, U, tab, substeps, metric_items, keep, events):
