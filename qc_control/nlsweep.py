@@ -56,7 +56,7 @@ from .integrate import (
 )
 from .limits import check_memory
 from .methods import ButcherTableau, get_method
-from .metrics import METRICS, MetricStream, RideSignals
+from .metrics import METRICS, Metric, MetricStream, RideSignals
 from .response import input_output_response, linear_input
 from .vehicle import SignalRoles, VehicleModel
 
@@ -143,29 +143,29 @@ def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
     ts = stage_times(T, tab, substeps=substeps)  # (steps, s): the stepper's own times
     u_of = linear_input(T, U)
     k = U.shape[0]
-    stage_u = [[u_of(t) for t in row] for row in ts.tolist()] if k else None
     none = np.zeros(0)
+    stage_u = [[u_of(t) for t in row] if k else [none] * len(row) for row in ts.tolist()]
     ends = np.append(ts[1:, 0], T[-1])
     x = np.array(np.broadcast_to(np.asarray(X0, dtype=float)[:, None], (n, m)))
     buf = np.empty((n, m, block))
     buf[:, :, 0] = x
     filled = 1
-    sw = g_a = None
-    if events:
-        sw = dynamics.switching
-        g_a = sw(float(T[0]), x, u_of(float(T[0])) if k else none)
+    sw = dynamics.switching
+    g_a = sw(float(T[0]), x, u_of(float(T[0])) if k else none) if events else none
     step = 0
+    rhs = dynamics.rhs
+    times_list = ts.tolist()
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         for sample in range(1, T.size):
             for _ in range(substeps):
-                times = ts[step]
-                us = stage_u[step] if k else None
+                times = times_list[step]
+                us = stage_u[step]
                 ks: list[np.ndarray] = []
                 for i, terms in enumerate(stages):
                     xi = x
                     for j, c in terms:
                         xi = xi + c * ks[j]
-                    ks.append(dynamics.rhs(times[i], xi, us[i] if k else none))
+                    ks.append(rhs(times[i], xi, us[i]))
                 x_new = x
                 for c, idx in groups:
                     acc = ks[idx[0]]
@@ -273,7 +273,7 @@ def simulate_batch(
         with np.errstate(over="ignore", invalid="ignore"):
             for label, y in dynamics.outputs(T[sl], xb, U[:, sl]).items():
                 outputs[label][:, sl] = y
-    success = np.isfinite(states).all(axis=(1, 2))
+    success = np.asarray(np.isfinite(states).all(axis=(1, 2)))
     return BatchResponse(T, states, outputs, success, t_events)
 
 
@@ -292,7 +292,7 @@ def _run_vectorised(
         for column, metric, corner in metric_items
     ]
     args = (roles, T, dynamics.tire_stiffness, dynamics.static_load)
-    registered = all(hasattr(metric, "formula") for _, metric, _ in items)
+    registered = all(isinstance(metric, Metric) for _, metric, _ in items)
     streamed = registered and not keep and MetricStream.supports(items, roles)
     if streamed:
         streamed = not MetricStream(items, *args).weighted  # the Wk filter: whole signals
@@ -351,7 +351,7 @@ def _run_vectorised(
         else:
             signals = RideSignals(T, kept, roles, *args[2:])
             for column, metric, corner in items:
-                if hasattr(metric, "formula"):
+                if isinstance(metric, Metric):
                     result[column] = np.asarray(metric.formula(signals, corner))
                 else:
                     result[column] = np.asarray(metric(signals), dtype=float)

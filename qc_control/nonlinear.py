@@ -227,13 +227,20 @@ class BumpStop:
         """`force` over an array of extensions (elementwise, same formula).
 
         Returns the float 0.0 when no element of ``d`` is past a clearance
-        (the common case, skipped at the cost of one comparison per stop).
+        (the common case, skipped at the cost of one comparison per stop; a
+        NaN element, a diverged design, is left out of that comparison).
         """
-        out = 0.0
-        if math.isfinite(self.clearance_bound) and d.min() < -self.clearance_bound:
+        out: float | np.ndarray = 0.0
+        if (
+            math.isfinite(self.clearance_bound)
+            and np.fmin.reduce(d, axis=None) < -self.clearance_bound
+        ):
             p = np.maximum(-d - self.clearance_bound, 0.0)
             out = out - (self.stiffness * p + self.cubic * p**3)
-        if math.isfinite(self.clearance_rebound) and d.max() > self.clearance_rebound:
+        if (
+            math.isfinite(self.clearance_rebound)
+            and np.fmax.reduce(d, axis=None) > self.clearance_rebound
+        ):
             p = np.maximum(d - self.clearance_rebound, 0.0)
             out = out + (self.stiffness * p + self.cubic * p**3)
         return out
@@ -512,7 +519,7 @@ def _design_arrays(values: dict) -> dict[str, np.ndarray]:
         if bad.size:
             i = int(bad[0])
             need = ">= 0" if name == "cs" else "> 0"
-            raise ValueError(f"{name}[{i}] must be finite and {need}, got {a[i]!r}")
+            raise ValueError(f"{name}[{i}] must be finite and {need}, got {float(a[i])!r}")
     return out
 
 
