@@ -224,25 +224,29 @@ class BumpStop:
         return 0.0
 
     def forces(self, d: np.ndarray):
-        """`force` over an array of extensions (elementwise, same formula).
+        """`force` over an array of extensions (elementwise), as
+        ``F = q (k + k3 q²)`` with ``q`` the signed penetration (``min(d +
+        c_b, 0)`` in bound, ``max(d - c_r, 0)`` in rebound): the same values
+        to a few ulps, in fewer operations.
 
         Returns the float 0.0 when no element of ``d`` is past a clearance
         (the common case, skipped at the cost of one comparison per stop; a
         NaN element, a diverged design, is left out of that comparison).
         """
         out: float | np.ndarray = 0.0
+        k, k3 = self.stiffness, self.cubic
         if (
             math.isfinite(self.clearance_bound)
             and np.fmin.reduce(d, axis=None) < -self.clearance_bound
         ):
-            p = np.maximum(-d - self.clearance_bound, 0.0)
-            out = out - (self.stiffness * p + self.cubic * p**3)
+            q = np.minimum(d + self.clearance_bound, 0.0)
+            out = q * (k + k3 * (q * q))
         if (
             math.isfinite(self.clearance_rebound)
             and np.fmax.reduce(d, axis=None) > self.clearance_rebound
         ):
-            p = np.maximum(d - self.clearance_rebound, 0.0)
-            out = out + (self.stiffness * p + self.cubic * p**3)
+            q = np.maximum(d - self.clearance_rebound, 0.0)
+            out = out + q * (k + k3 * (q * q))
         return out
 
     def energy(self, d: float) -> float:
