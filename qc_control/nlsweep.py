@@ -57,7 +57,12 @@ from .integrate import (
 from .limits import check_memory
 from .methods import ButcherTableau, get_method
 from .metrics import METRICS, Metric, MetricStream, RideSignals
-from .response import input_output_response, linear_input
+from .response import (
+    check_initial_state,
+    check_input_samples,
+    input_output_response,
+    linear_input,
+)
 from .vehicle import SignalRoles, VehicleModel
 
 __all__ = ["simulate_batch", "BatchResponse", "nonlinear_sweep", "is_nonlinear", "BLOCK"]
@@ -117,18 +122,9 @@ def _tableau_rows(tab: ButcherTableau, h: float):
 
 
 def _inputs(dynamics, T: np.ndarray, U) -> np.ndarray:
-    """The input samples ``(k, N)`` (zeros when ``U`` is None)."""
-    k = len(dynamics.input_labels)
-    if U is None:
-        return np.zeros((k, T.size))
-    U = np.asarray(U, dtype=float)
-    U = U.reshape(1, -1) if U.ndim == 1 else U
-    if U.shape != (k, T.size) or not np.all(np.isfinite(U)):
-        raise ValueError(
-            f"U must be finite, of shape ({T.size},) or ({k}, {T.size}) for the inputs "
-            f"{list(dynamics.input_labels)} on T, got shape {U.shape}"
-        )
-    return U
+    """The input samples ``(k, N)`` (`qc_control.response.check_input_samples`:
+    python-control's shapes; None is zero)."""
+    return check_input_samples(U, len(dynamics.input_labels), T.size)
 
 
 def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
@@ -219,12 +215,7 @@ def _check(dynamics, T, X0, U, method, substeps):
     tab = get_method(method)
     T = check_time_grid(T, "T")
     substeps = check_substeps(substeps)
-    n = len(dynamics.state_labels)
-    X0 = np.asarray(X0, dtype=float)
-    if X0.shape != (n,) or not np.all(np.isfinite(X0)):
-        raise ValueError(
-            f"X0 must be {n} finite numbers {list(dynamics.state_labels)}, got {X0.tolist()}"
-        )
+    X0 = check_initial_state(X0, len(dynamics.state_labels))
     return tab, T, X0, _inputs(dynamics, T, U), substeps
 
 

@@ -255,9 +255,9 @@ def test_bad_input_names_the_value():
     with pytest.raises(ValueError, match=r"cs\[0\] must be finite and >= 0, got nan"):
         NonlinearQuarterCarBatch([300.0], [40.0], [2e4], [2e5], [math.nan])
     model = qc.nonlinear_quarter_car_model()
-    with pytest.raises(ValueError, match="X0 must be 4 finite numbers"):
+    with pytest.raises(ValueError, match=r"X0 must have shape \(4,\) .* got \(2,\)"):
         simulate_batch(model.batch_dynamics(DESIGNS[:1]), T2, [0.0, 0.0])
-    with pytest.raises(ValueError, match=r"U must be finite, of shape \(2001,\)"):
+    with pytest.raises(ValueError, match=r"U must have shape \(2001,\) or \(1, 2001\)"):
         simulate_batch(model.batch_dynamics(DESIGNS[:1]), T2, np.zeros(4), ROAD[:10])
     bad = [DESIGNS[0], {**DESIGNS[1], "ms": -1.0}]
     with pytest.warns(RuntimeWarning, match="1 of 2 designs were rejected"):
