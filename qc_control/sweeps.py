@@ -368,7 +368,8 @@ def sweep(
         designs at once with its ``batch_dynamics`` (`qc_control.nlsweep`);
         a nonlinear system without one (`qc_control.closed_loop` with a
         clipped controller) runs one `qc_control.input_output_response` per
-        design: the same numbers, as slow as that many responses.
+        design: the same numbers, as slow as that many responses. For a
+        nonlinear model ``stable`` says the state stayed finite.
     substeps : int, default 1
     chunk_size : int, default 64
         Designs per chunk: the unit of work sent to the executor (make it
