@@ -105,20 +105,23 @@ def is_nonlinear(model: VehicleModel) -> bool:
 
 
 def _tableau_rows(tab: ButcherTableau, h: float):
-    """``(stage terms, weight groups)`` of the non-zero ``h a_ij`` and ``h b_i``.
+    """Each stage's ``h a_ij`` and the weights ``h b``, as the batch step uses them.
 
-    As `qc_control.integrate` forms a step: each stage's input is summed
-    term by term, and stages of equal weight are summed before they are
-    scaled (RK4: ``x + h/6 (k1 + k4) + h/3 (k2 + k3)``), so a batch step is
-    the single stepper's step to rounding.
+    Per stage: None (no ``a_ij``), ``(j, h a_ij)`` for one non-zero entry
+    (RK4's), or the row ``h a_i,:i``, summed with the stored slopes in one
+    product; the weights likewise. The generic stepper (`qc_control.integrate`)
+    sums the same terms in another order: the steps agree to rounding.
     """
-    a, b = tab.a.tolist(), tab.b.tolist()
-    stages = [[(j, a[i][j] * h) for j in range(i) if a[i][j] != 0] for i in range(tab.stages)]
-    groups: dict[float, list[int]] = {}
-    for i, bi in enumerate(b):
-        if bi != 0:
-            groups.setdefault(bi, []).append(i)
-    return stages, [(bi * h, idx) for bi, idx in groups.items()]
+    rows: list = []
+    for i in range(tab.stages):
+        nonzero = [j for j in range(i) if tab.a[i, j] != 0]
+        if not nonzero:
+            rows.append(None)
+        elif len(nonzero) == 1:
+            rows.append((nonzero[0], float(tab.a[i, nonzero[0]] * h)))
+        else:
+            rows.append(np.array(tab.a[i, : nonzero[-1] + 1] * h))
+    return rows, np.asarray(tab.b * h)
 
 
 def _inputs(dynamics, T: np.ndarray, U) -> np.ndarray:
@@ -135,12 +138,18 @@ def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
     if dt is None:
         raise ValueError("T must be uniformly spaced for a batched nonlinear run")
     h = dt / substeps
-    stages, groups = _tableau_rows(tab, h)
+    single, weights = _tableau_rows(tab, h)
     ts = stage_times(T, tab, substeps=substeps)  # (steps, s): the stepper's own times
     u_of = linear_input(T, U)
     k = U.shape[0]
     none = np.zeros(0)
-    stage_u = [[u_of(t) for t in row] if k else [none] * len(row) for row in ts.tolist()]
+    # the inputs at every stage time, linear between the samples (np.interp: the
+    # same formula as control's interpolation), as one (k,) view per stage
+    if k:
+        at = np.stack([np.interp(ts, T, row) for row in U], axis=-1)
+        stage_u = [list(row) for row in at]
+    else:
+        stage_u = [[none] * ts.shape[1]] * ts.shape[0]
     ends = np.append(ts[1:, 0], T[-1])
     x = np.array(np.broadcast_to(np.asarray(X0, dtype=float)[:, None], (n, m)))
     buf = np.empty((n, m, block))
@@ -151,23 +160,22 @@ def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
     step = 0
     rhs = dynamics.rhs
     times_list = ts.tolist()
+    K = np.empty((tab.stages, n, m))  # the stages' slopes, written in place
+    flat = K.reshape(tab.stages, n * m)  # a view: Σ_i w_i K_i as one vector-matrix product
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         for sample in range(1, T.size):
             for _ in range(substeps):
                 times = times_list[step]
                 us = stage_u[step]
-                ks: list[np.ndarray] = []
-                for i, terms in enumerate(stages):
-                    xi = x
-                    for j, c in terms:
-                        xi = xi + c * ks[j]
-                    ks.append(rhs(times[i], xi, us[i]))
-                x_new = x
-                for c, idx in groups:
-                    acc = ks[idx[0]]
-                    for i in idx[1:]:
-                        acc = acc + ks[i]
-                    x_new = x_new + c * acc
+                for i, rows in enumerate(single):
+                    if rows is None:
+                        xi = x
+                    elif isinstance(rows, tuple):  # one non-zero a_ij
+                        xi = x + rows[1] * K[rows[0]]
+                    else:
+                        xi = x + (rows @ flat[: rows.size]).reshape(n, m)
+                    rhs(times[i], xi, us[i], K[i])
+                x_new = x + (weights @ flat).reshape(n, m)
                 if events:
                     tb = float(ends[step])
                     ub = u_of(tb) if k else none

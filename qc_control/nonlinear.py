@@ -233,21 +233,19 @@ class BumpStop:
         (the common case, skipped at the cost of one comparison per stop; a
         NaN element, a diverged design, is left out of that comparison).
         """
-        out: float | np.ndarray = 0.0
         k, k3 = self.stiffness, self.cubic
-        if (
-            math.isfinite(self.clearance_bound)
-            and np.fmin.reduce(d, axis=None) < -self.clearance_bound
-        ):
-            q = np.minimum(d + self.clearance_bound, 0.0)
-            out = q * (k + k3 * (q * q))
-        if (
-            math.isfinite(self.clearance_rebound)
-            and np.fmax.reduce(d, axis=None) > self.clearance_rebound
-        ):
-            q = np.maximum(d - self.clearance_rebound, 0.0)
-            out = out + q * (k + k3 * (q * q))
-        return out
+        cb, cr = self.clearance_bound, self.clearance_rebound
+        bound = math.isfinite(cb) and np.fmin.reduce(d, axis=None) < -cb
+        rebound = math.isfinite(cr) and np.fmax.reduce(d, axis=None) > cr
+        if bound and rebound:  # one of the two is 0 at each element
+            q = np.minimum(d + cb, 0.0) + np.maximum(d - cr, 0.0)
+        elif bound:
+            q = np.minimum(d + cb, 0.0)
+        elif rebound:
+            q = np.maximum(d - cr, 0.0)
+        else:
+            return 0.0
+        return q * (k + k3 * (q * q)) if k3 else k * q
 
     def energy(self, d: float) -> float:
         """The stops' potential energy at extension ``d`` [J]: ``k p²/2 + k3 p⁴/4``."""
