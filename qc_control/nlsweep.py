@@ -152,8 +152,8 @@ def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
         stage_u = [[none] * ts.shape[1]] * ts.shape[0]
     ends = np.append(ts[1:, 0], T[-1])
     x = np.array(np.broadcast_to(np.asarray(X0, dtype=float)[:, None], (n, m)))
-    buf = np.empty((n, m, block))
-    buf[:, :, 0] = x
+    buf = np.empty((n, block, m))  # a sample's states are contiguous rows: cheap to store
+    buf[:, 0] = x
     filled = 1
     sw = dynamics.switching
     g_a = sw(float(T[0]), x, u_of(float(T[0])) if k else none) if events else none
@@ -191,10 +191,10 @@ def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
                     g_a = g_b
                 x = x_new
                 step += 1
-            buf[:, :, filled] = x
+            buf[:, filled] = x
             filled += 1
             if filled == block or sample == T.size - 1:
-                yield sample + 1 - filled, buf[:, :, :filled]
+                yield sample + 1 - filled, np.swapaxes(buf[:, :filled], 1, 2)
                 filled = 0
 
 
@@ -319,12 +319,10 @@ def _run_vectorised(
     final: dict = {}  # filled with the last samples once known; read only by result()
     if stream is not None:
         stream.start(final)
-    finite = np.ones(m, dtype=bool)
     ys: dict = {}
     for start, xb in _march(dynamics, T, X0, U, tab, substeps, events, None):
         L = xb.shape[-1]
         sl = slice(start, start + L)
-        finite &= np.isfinite(xb).all(axis=(0, 2))
         if x_all is not None:
             x_all[:, :, sl] = np.moveaxis(xb, 0, 1)
         with np.errstate(over="ignore", invalid="ignore"):
@@ -334,7 +332,8 @@ def _run_vectorised(
         for label in kept_labels:
             kept[label][:, sl] = ys[label]
     final.update({label: np.array(y[:, -1]) for label, y in ys.items()})
-    result: dict = {"stable": finite}
+    # a state that was ever non-finite stays so (x + h Σ b_i k_i keeps an inf or a nan)
+    result: dict = {"stable": np.asarray(np.isfinite(xb[..., -1]).all(axis=0))}
     with np.errstate(over="ignore", invalid="ignore"):
         if streamed:
             if stream is not None:
