@@ -518,7 +518,7 @@ def nonlinear_sweep_benchmark(quick: bool) -> tuple[list[str], list[str], list[l
         "road (20 m/s)",
         "designs",
         "lifted off / hit a stop",
-        "qc.sweep [s]",
+        "qc.sweep, nonlinear [s]",
         f"control loop [s] ({len(picks)} designs timed, scaled)",
         "ratio (target ≥ 300)",
         "batch vs qc.input_output_response (rel.)",
