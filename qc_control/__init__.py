@@ -108,8 +108,10 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         quarter_car,
         quarter_car_model,
     )
+    from .nlsweep import BatchResponse, simulate_batch
     from .nonlinear import (
         BumpStop,
+        NonlinearQuarterCarBatch,
         PiecewiseDamper,
         nonlinear_quarter_car,
         nonlinear_quarter_car_model,
@@ -225,6 +227,10 @@ _LAZY: dict[str, str] = {
     "nonlinear_quarter_car_model": "nonlinear",
     "BumpStop": "nonlinear",
     "PiecewiseDamper": "nonlinear",
+    # batched nonlinear sweeps (issue 11 item 7)
+    "NonlinearQuarterCarBatch": "nonlinear",
+    "simulate_batch": "nlsweep",
+    "BatchResponse": "nlsweep",
 }
 
 
@@ -325,4 +331,7 @@ __all__ = [
     "nonlinear_quarter_car_model",
     "BumpStop",
     "PiecewiseDamper",
+    "NonlinearQuarterCarBatch",
+    "simulate_batch",
+    "BatchResponse",
 ]

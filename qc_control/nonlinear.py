@@ -64,6 +64,7 @@ __all__ = [
     "BumpStop",
     "nonlinear_quarter_car",
     "nonlinear_quarter_car_model",
+    "NonlinearQuarterCarBatch",
     "NONLINEAR_OUTPUTS",
     "NONLINEAR_UNITS",
 ]
@@ -150,6 +151,17 @@ class PiecewiseDamper:
             return self.bound * v
         return -self.bound * self.knee_bound + self.bound_high * (v + self.knee_bound)
 
+    def forces(self, v: np.ndarray) -> np.ndarray:
+        """`__call__` over an array of extension rates (elementwise, same formula)."""
+        low = np.where(v >= 0, self.rebound * v, self.bound * v)
+        if math.isfinite(self.knee_rebound):
+            k = self.knee_rebound
+            low = np.where(v > k, self.rebound * k + self.rebound_high * (v - k), low)
+        if math.isfinite(self.knee_bound):
+            k = self.knee_bound
+            low = np.where(v < -k, -self.bound * k + self.bound_high * (v + k), low)
+        return low
+
     def knees(self) -> tuple[float, ...]:
         """The finite knee velocities, signed (rebound positive)."""
         return tuple(
@@ -210,6 +222,30 @@ class BumpStop:
         if p > 0:
             return self.stiffness * p + self.cubic * p**3
         return 0.0
+
+    def forces(self, d: np.ndarray):
+        """`force` over an array of extensions (elementwise), as
+        ``F = q (k + k3 q²)`` with ``q`` the signed penetration (``min(d +
+        c_b, 0)`` in bound, ``max(d - c_r, 0)`` in rebound): the same values
+        to a few ulps, in fewer operations.
+
+        Returns the float 0.0 when no element of ``d`` is past a clearance
+        (the common case, skipped at the cost of one comparison per stop; a
+        NaN element, a diverged design, is left out of that comparison).
+        """
+        k, k3 = self.stiffness, self.cubic
+        cb, cr = self.clearance_bound, self.clearance_rebound
+        bound = math.isfinite(cb) and np.fmin.reduce(d, axis=None) < -cb
+        rebound = math.isfinite(cr) and np.fmax.reduce(d, axis=None) > cr
+        if bound and rebound:  # one of the two is 0 at each element
+            q = np.minimum(d + cb, 0.0) + np.maximum(d - cr, 0.0)
+        elif bound:
+            q = np.minimum(d + cb, 0.0)
+        elif rebound:
+            q = np.maximum(d - cr, 0.0)
+        else:
+            return 0.0
+        return q * (k + k3 * (q * q)) if k3 else k * q
 
     def energy(self, d: float) -> float:
         """The stops' potential energy at extension ``d`` [J]: ``k p²/2 + k3 p⁴/4``."""
@@ -411,7 +447,11 @@ def nonlinear_quarter_car_model(params=None, **options) -> VehicleModel:
     stiffness ``ku`` and the static load ``(ms + mu)·g``), so that compare,
     ride metrics, sweeps and the report read it as they read the linear car.
     Its ``system`` is the `control.NonlinearIOSystem`; ``rebuild(params)``
-    builds the same car (same options) from other parameters.
+    builds the same car (same options) from other parameters;
+    ``batch_dynamics(designs)`` gives the `NonlinearQuarterCarBatch` of many
+    designs, which `qc_control.sweep` steps all at once (None when a callable
+    ``spring`` or ``damper`` does not vectorise over arrays: a sweep then runs
+    one response per design).
 
     Parameters
     ----------
@@ -437,10 +477,299 @@ def nonlinear_quarter_car_model(params=None, **options) -> VehicleModel:
         p.ku,
         (p.ms + p.mu) * STANDARD_GRAVITY,
     )
+    laws = [options.get(k) for k in ("spring", "damper")]
+    vectorised = all(
+        not callable(f) or isinstance(f, PiecewiseDamper) or _vectorises(f) for f in laws
+    )
     return VehicleModel(
         sys,
         p,
         NONLINEAR_UNITS,
         SignalRoles("body_acc", "xs", (corner,)),
         functools.partial(nonlinear_quarter_car_model, **options),
+        batch_dynamics=(
+            functools.partial(NonlinearQuarterCarBatch.from_params, **options)
+            if vectorised
+            else None
+        ),
     )
+
+
+#: The design fields of a batch: each an array of shape (m,).
+_BATCH_FIELDS = ("ms", "mu", "ks", "ku", "cs")
+
+
+def _design_arrays(values: dict) -> dict[str, np.ndarray]:
+    """The five design arrays, 1-D of one length, finite, masses and stiffnesses > 0,
+    ``cs`` >= 0; a ValueError naming the field, the design and the value."""
+    out: dict[str, np.ndarray] = {}
+    for name in _BATCH_FIELDS:
+        try:
+            a = np.asarray(values[name], dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be an array of numbers, got {values[name]!r}") from None
+        if a.ndim != 1 or a.size == 0:
+            raise ValueError(f"{name} must be a 1-D array of designs, got shape {a.shape}")
+        out[name] = a
+    sizes = {name: a.size for name, a in out.items()}
+    if len(set(sizes.values())) != 1:
+        raise ValueError(
+            f"the design arrays must have one length (one value per design), got sizes {sizes}"
+        )
+    for name, a in out.items():
+        bad = np.flatnonzero(~np.isfinite(a) | (a < 0 if name == "cs" else a <= 0))
+        if bad.size:
+            i = int(bad[0])
+            need = ">= 0" if name == "cs" else "> 0"
+            raise ValueError(f"{name}[{i}] must be finite and {need}, got {float(a[i])!r}")
+    return out
+
+
+def _vectorises(fn) -> bool:
+    """Whether a user force law ``fn`` maps an array to the array of its scalar values."""
+    probe = np.array([-0.3, -0.01, 0.0, 0.02, 0.4])
+    try:
+        with np.errstate(all="ignore"):
+            got = np.asarray(fn(probe), dtype=float)
+            want = np.array([float(fn(float(v))) for v in probe])
+    except Exception:
+        return False
+    return got.shape == probe.shape and bool(np.allclose(got, want, rtol=1e-12, atol=0.0))
+
+
+class NonlinearQuarterCarBatch:
+    """``m`` designs of `nonlinear_quarter_car` (one set of options), over arrays.
+
+    The same equations as `nonlinear_quarter_car` (module docstring), written
+    with NumPy over the designs: ``ms, mu, ks, ku, cs`` are arrays of shape
+    ``(m,)`` and a state is ``x`` of shape ``(4, m)`` (or ``(4, m, L)`` for
+    ``L`` samples at once), states in `quarter_car`'s order. The force
+    elements are the single car's (`BumpStop.forces`, `PiecewiseDamper.forces`
+    are `BumpStop.force` and `PiecewiseDamper.__call__` elementwise), with
+    the same operations in the same order, so a design's right-hand side
+    equals the single car's to rounding. `qc_control.nlsweep` steps it.
+
+    A user callable ``spring(d)`` or ``damper(v)`` must vectorise: called
+    with an array, return the array of its values (NumPy ufuncs, ``np.where``;
+    an ``if`` on the value does not); otherwise a TypeError says so.
+
+    Parameters
+    ----------
+    ms, mu, ks, ku, cs : array_like, shape (m,)
+        Masses [kg] and stiffnesses [N/m] > 0, damping [N·s/m] >= 0.
+    **options
+        `nonlinear_quarter_car`'s keyword arguments (``tire``, ``bump_stop``,
+        ``damper``, ``spring``, ``gravity``, ``road``, ``actuator``,
+        ``name``), checked by it.
+
+    Raises
+    ------
+    ValueError
+        Arrays of different lengths, or a value out of range (naming the
+        field, the design and the value).
+    TypeError
+        A callable force law that does not vectorise; a bad option.
+    """
+
+    def __init__(self, ms, mu, ks, ku, cs, **options):
+        a = _design_arrays({"ms": ms, "mu": mu, "ks": ks, "ku": ku, "cs": cs})
+        first = {name: float(v[0]) for name, v in a.items()}
+        single = nonlinear_quarter_car(first, **options)  # checks the options once
+        for which in ("spring", "damper"):
+            fn = options.get(which)
+            if callable(fn) and not isinstance(fn, PiecewiseDamper) and not _vectorises(fn):
+                raise TypeError(
+                    f"{which} {fn!r} does not vectorise over arrays (called with an array it "
+                    "must return the array of its values); a batch needs that. Write it with "
+                    "NumPy (np.where, ufuncs), or sweep the model without a batch form"
+                )
+        self.options = dict(options)
+        self.state_labels = tuple(single.state_labels)
+        self.input_labels = tuple(single.input_labels)
+        self.output_labels = tuple(single.output_labels)
+        self.switching_labels = tuple(single.switching_labels)
+        self._g = STANDARD_GRAVITY if options.get("gravity", True) else 0.0
+        self._unilateral = options.get("tire", "unilateral") == "unilateral"
+        spring = options.get("spring")
+        self._spring = spring if callable(spring) else None
+        self._k3 = None if spring is None or callable(spring) else float(spring)
+        self._damper = options.get("damper")
+        self._stop = options.get("bump_stop")
+        road = options.get("road", True)
+        self._profile = road if callable(road) else None
+        self._iz = 0 if road is True else None
+        self._ia = (1 if road is True else 0) if options.get("actuator", False) else None
+        self._set(a)
+
+    def _set(self, a: dict[str, np.ndarray]) -> None:
+        a = dict(a)
+        a["static"] = (a["ms"] + a["mu"]) * self._g
+        self.params = a
+        self._col = {k: v[:, None] for k, v in a.items()}  # for (4, m, L) blocks
+        self.rhs = self._stepping_rhs()
+
+    def _stepping_rhs(self):
+        """``rhs(t, x, u, out=None)``, specialised to the options: the fewest NumPy
+        calls on ``(4, m)`` states, with the parameters bound.
+
+        The single car's formulas with the constants folded, ``-F/m_s`` as
+        ``F·(-1/m_s)`` and the tire's dynamic force ``F_t - k_u δ0`` as
+        ``max(k_u (z_r - x_u), -k_u δ0)``: the same values to rounding (a
+        few ulps), in fewer operations.
+        """
+        ms, mu, ks, ku, cs, static = (self.params[k] for k in (*_BATCH_FIELDS, "static"))
+        neg_inv_ms, inv_mu, neg_static = -1.0 / ms, 1.0 / mu, -static
+        spring, k3, damper, stop = self._spring, self._k3, self._damper, self._stop
+        piecewise = isinstance(damper, PiecewiseDamper)
+        unilateral, iz, ia, profile = self._unilateral, self._iz, self._ia, self._profile
+        maximum, multiply = np.maximum, np.multiply
+
+        def rhs(t: float, x: np.ndarray, u, out: np.ndarray | None = None) -> np.ndarray:
+            """``dx/dt`` ``(4, m)`` of every design at the states ``x`` ``(4, m)``,
+            with ``u`` this time's inputs ``(k,)``."""
+            if x.ndim != 2:
+                return self._block_rhs(t, x, u, out)
+            vs, vu, xs, xu = x
+            d = xs - xu
+            if spring is not None:
+                fs = np.asarray(spring(d), dtype=float)
+            elif k3 is not None:
+                fs = ks * d + k3 * d**3
+            else:
+                fs = ks * d
+            if damper is None:
+                f = fs + cs * (vs - vu)
+            elif piecewise:
+                f = fs + damper.forces(vs - vu)
+            else:
+                f = fs + np.asarray(damper(vs - vu), dtype=float)
+            if stop is not None:
+                fb = stop.forces(d)
+                if isinstance(fb, np.ndarray):
+                    f = f + fb
+            zr = u[iz] if iz is not None else (0.0 if profile is None else float(profile(t)))
+            tire = ku * (zr - xu)  # F_t - k_u δ0
+            if unilateral:
+                tire = maximum(tire, neg_static, out=tire)
+            out = np.empty_like(x) if out is None else out
+            if ia is None:
+                multiply(f, neg_inv_ms, out=out[0])
+                multiply(f + tire, inv_mu, out=out[1])
+            else:
+                fa = u[ia]
+                multiply(f - fa, neg_inv_ms, out=out[0])
+                multiply(f - fa + tire, inv_mu, out=out[1])
+            out[2:] = x[:2]
+            return out
+
+        return rhs
+
+    def _block_rhs(self, t, x, u, out=None):
+        """`rhs` on states with more axes (``(4, m, L)``): the general formula."""
+        q = self._col
+        f, ft, _ = self._elements(t, x, u)
+        out = np.empty_like(x) if out is None else out
+        fa = 0.0 if self._ia is None else u[self._ia]
+        out[0] = (fa - f) / q["ms"]
+        out[1] = (f - fa + (ft - q["static"])) / q["mu"]
+        out[2:] = x[:2]
+        return out
+
+    @classmethod
+    def from_params(cls, designs, **options) -> NonlinearQuarterCarBatch:
+        """A batch from parameter objects (`QuarterCarParams` or dicts), in order."""
+        ps = [as_params(p) for p in designs]
+        if not ps:
+            raise ValueError("designs is empty: give at least one design")
+        return cls(*([float(getattr(p, f)) for p in ps] for f in _BATCH_FIELDS), **options)
+
+    @property
+    def size(self) -> int:
+        """The number of designs ``m``."""
+        return int(self.params["ms"].size)
+
+    @property
+    def tire_stiffness(self) -> tuple[np.ndarray, ...]:
+        """Per corner (one), each design's tire stiffness [N/m] (as `Corner`)."""
+        return (self.params["ku"],)
+
+    @property
+    def static_load(self) -> tuple[np.ndarray, ...]:
+        """Per corner (one), each design's static wheel load ``(ms + mu)·g`` [N] (as `Corner`)."""
+        return ((self.params["ms"] + self.params["mu"]) * STANDARD_GRAVITY,)
+
+    def take(self, index) -> NonlinearQuarterCarBatch:
+        """The designs at ``index`` (an integer array or slice), same options."""
+        out = object.__new__(type(self))
+        out.__dict__.update(self.__dict__)
+        out._set({k: np.atleast_1d(self.params[k][index]) for k in _BATCH_FIELDS})
+        return out
+
+    def _road(self, t, u):
+        if self._iz is not None:
+            return u[self._iz]
+        if self._profile is not None:
+            if np.ndim(t):
+                return np.array([float(self._profile(s)) for s in np.ravel(t)])
+            return float(self._profile(t))
+        return 0.0
+
+    def _elements(self, t, x, u):
+        """``(F_s + F_d + F_b, F_t, δ)`` at the states ``x`` (the single car's ``elements``)."""
+        q = self.params if x.ndim == 2 else self._col
+        vs, vu, xs, xu = x[0], x[1], x[2], x[3]
+        d, v = xs - xu, vs - vu
+        if self._spring is not None:
+            fs = np.asarray(self._spring(d), dtype=float)
+        elif self._k3 is not None:
+            fs = q["ks"] * d + self._k3 * d**3
+        else:
+            fs = q["ks"] * d
+        damper = self._damper
+        if damper is None:
+            fd = q["cs"] * v
+        elif isinstance(damper, PiecewiseDamper):
+            fd = damper.forces(v)
+        else:
+            fd = np.asarray(damper(v), dtype=float)
+        f = fs + fd
+        if self._stop is not None:
+            f = f + self._stop.forces(d)  # 0.0 when no stop touches: exact
+        delta = xu - self._road(t, u)
+        ft = q["static"] - q["ku"] * delta
+        if self._unilateral:
+            ft = np.maximum(ft, 0.0)
+        return f, ft, delta
+
+    def outputs(self, t, x: np.ndarray, u) -> dict[str, np.ndarray]:
+        """Every output by label, shape ``x.shape[1:]``: ``x`` ``(4, m, L)`` at the
+        times ``t`` ``(L,)`` with the inputs ``u`` ``(k, L)`` (or one time: ``(4, m)``)."""
+        q = self.params if x.ndim == 2 else self._col
+        f, ft, delta = self._elements(t, x, u)
+        acc = -f if self._ia is None else u[self._ia] - f
+        values = {
+            "xs": x[2],
+            "xu": x[3],
+            "susp_travel": x[2] - x[3],
+            "tire_defl": np.broadcast_to(delta, x[3].shape),
+            "body_acc": acc / q["ms"],
+            "tire_force": np.broadcast_to(ft, x[3].shape),
+        }
+        return {label: values[label] for label in self.output_labels}
+
+    def switching(self, t: float, x: np.ndarray, u) -> np.ndarray:
+        """The switching functions ``(q, m)`` (``switching_labels``; the single car's)."""
+        q = self.params
+        d = x[2] - x[3]
+        rows = []
+        if self._unilateral:
+            rows.append(q["static"] / q["ku"] - (x[3] - self._road(t, u)))
+        stop = self._stop
+        if stop is not None:
+            if math.isfinite(stop.clearance_bound):
+                rows.append(d + stop.clearance_bound)
+            if math.isfinite(stop.clearance_rebound):
+                rows.append(stop.clearance_rebound - d)
+        if isinstance(self._damper, PiecewiseDamper):
+            rows += [x[0] - x[1] - k for k in self._damper.knees()]
+        return np.array(rows).reshape(len(rows), x.shape[1])

@@ -27,6 +27,7 @@ from .metrics import (
     metric_columns,
 )
 from .model import SEED_X0, quarter_car_model
+from .nlsweep import is_nonlinear, nonlinear_sweep
 from .spectral import SPECTRAL_METRICS, ISO8608Road, spectral_metrics
 from .stability import step_is_stable
 from .vehicle import BatchedModel, SignalRoles, VehicleModel
@@ -330,6 +331,7 @@ def sweep(
     chunk_size: int = 64,
     progress: bool | None = None,
     road: ISO8608Road | None = None,
+    events: bool = False,
 ) -> SweepResult:
     """Simulate many designs of a vehicle at once and tabulate their metrics.
 
@@ -361,7 +363,13 @@ def sweep(
     model : VehicleModel, optional
         The vehicle the designs are variants of; default
         ``quarter_car_model(road=U is not None)``. Designs are rebuilt with
-        its ``batch`` (vectorised for the quarter car).
+        its ``batch`` (vectorised for the quarter car). A nonlinear model
+        (`qc_control.nonlinear_quarter_car_model`) is stepped for all
+        designs at once with its ``batch_dynamics`` (`qc_control.nlsweep`);
+        a nonlinear system without one (`qc_control.closed_loop` with a
+        clipped controller) runs one `qc_control.input_output_response` per
+        design: the same numbers, as slow as that many responses. For a
+        nonlinear model ``stable`` says the state stayed finite.
     substeps : int, default 1
     chunk_size : int, default 64
         Designs per chunk: the unit of work sent to the executor (make it
@@ -383,6 +391,10 @@ def sweep(
         ``metrics`` among `qc_control.spectral.SPECTRAL_CAPABLE` (default
         `qc_control.spectral.SPECTRAL_METRICS`). Runs here, vectorised over
         all designs (``executor`` is not used).
+    events : bool, default False
+        Nonlinear models only: locate each kink (contact, stop, damper knee)
+        inside its step, for the designs that have one in that step
+        (`qc_control.nlsweep`); by default the steps go through the kinks.
 
     Returns
     -------
@@ -456,6 +468,15 @@ def sweep(
     )
 
     params, errors = _validate(designs, type(model.params))
+    if is_nonlinear(model):  # stepped in a batch (qc_control.nlsweep), or one by one
+        stable, table, kept = nonlinear_sweep(
+            model, params, T, X0, U, tab, substeps, metric_items, states,
+            events=events, executor=executor, chunk_size=chunk_size,
+        )  # fmt: skip
+        frame, err_frame = _tables(designs, params, errors, model, stable, table)
+        return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)
+    if events:
+        raise ValueError("events=True applies to a nonlinear model; this one is linear")
     good = [i for i, p in enumerate(params) if p is not None]
     batch = (
         model.batch([params[i] for i in good])

@@ -133,6 +133,17 @@ class VehicleModel:
     rebuild_batch : callable ``Sequence[params] -> BatchedModel``, optional
         A vectorised `rebuild` for sweeps. Without it, `batch` stacks the
         matrices of one `rebuild` per design.
+    batch_dynamics : callable ``Sequence[params] -> dynamics``, optional
+        For a nonlinear ``system``: its right-hand side over arrays of
+        designs, which `qc_control.sweep` steps for all designs at once
+        (`qc_control.nlsweep`). The dynamics object has ``size``,
+        ``state_labels``, ``input_labels``, ``output_labels``,
+        ``switching_labels``, ``tire_stiffness`` and ``static_load`` (per
+        corner, ``(m,)``), ``rhs(t, x, u)`` on states ``(n, m)``,
+        ``outputs(t, x, u)`` (label -> ``x.shape[1:]``, also on blocks
+        ``(n, m, L)``), ``switching(t, x, u) -> (q, m)`` and ``take(index)``;
+        `qc_control.NonlinearQuarterCarBatch` is the example. Without it,
+        a sweep of a nonlinear model runs one response per design.
     """
 
     system: control.StateSpace
@@ -141,6 +152,7 @@ class VehicleModel:
     roles: SignalRoles
     rebuild: Callable[[Any], VehicleModel]
     rebuild_batch: Callable[[Sequence[Any]], BatchedModel] | None = field(default=None)
+    batch_dynamics: Callable[[Sequence[Any]], Any] | None = field(default=None)
 
     def __post_init__(self):
         outputs, inputs = list(self.system.output_labels), list(self.system.input_labels)

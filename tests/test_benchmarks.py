@@ -123,3 +123,14 @@ def test_interconnect_benchmark_table(results):
         assert math.isfinite(ratio) and ratio > 0
     assert fast["max state error / max state"] == rhs["max state error / max state"]
     assert float(fast["max state error / max state"]) < float(theirs["max state error / max state"])
+
+
+def test_nonlinear_sweep_benchmark_table(results):
+    """The batched nonlinear sweep's rows: the ratio is a positive number, and the
+    batch equals qc.input_output_response on the timed designs to rounding."""
+    rows = _table(results, "qc.sweep, nonlinear [s]")
+    assert [r["road (20 m/s)"] for r in rows] == ["ISO 8608 class C", "ISO 8608 class D"]
+    for row in rows:
+        ratio = float(row["ratio (target ≥ 300)"])
+        assert math.isfinite(ratio) and ratio > 0
+        assert float(row["batch vs qc.input_output_response (rel.)"]) < 1e-12

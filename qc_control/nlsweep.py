@@ -1,0 +1,484 @@
+"""Batched nonlinear sweeps: every design stepped at once, loop over steps only.
+
+A nonlinear model (`qc_control.nonlinear_quarter_car_model`) gives its
+right-hand side over arrays of designs (``VehicleModel.batch_dynamics``, a
+`qc_control.NonlinearQuarterCarBatch`). This module steps it with any
+explicit tableau for ``m`` designs together: the Python loop runs over the
+steps, NumPy over the designs. One step is the generic stepper's
+(`qc_control.integrate`)
+
+.. math::
+
+    k_i = f\\big(t + c_i h,\\; x + h \\textstyle\\sum_{j<i} a_{ij} k_j,\\;
+          u(t + c_i h)\\big), \\qquad
+    x \\leftarrow x + h \\textstyle\\sum_i b_i k_i ,
+
+with ``x`` of shape ``(n, m)``, the same stage times
+(`qc_control.integrate.stage_times`) and the input interpolated linearly
+between its samples as python-control interpolates it
+(`qc_control.response.linear_input`), so that each design's trajectory is
+`qc_control.input_output_response`'s on that design to rounding.
+
+The registered metrics are reduced as the samples go by
+(`qc_control.metrics.MetricStream`, a block of samples at a time), so no
+``(designs, samples, outputs)`` array is formed; a metric that needs the
+last sample before it can read the others (the settling time) keeps its one
+signal, ``(designs, samples)``.
+
+**Events in a batch.** Without ``events`` the batch steps through the kinks
+(contact lost or regained, a stop engaged, a damper knee) as the plain
+stepper does: the trajectory is `input_output_response`'s without events,
+and near a kink the method loses its order (RK4 falls to about order 1-2 on
+a lift-off, see the README's nonlinear section). With ``events=True``, after
+each step the designs whose switching functions changed sign inside it
+(and only those) take the step again alone with `qc_control.integrate`'s
+event location (root finding on the method's own step, stepping to the
+kink exactly): each design's trajectory is then `input_output_response`'s
+with ``events=True`` to rounding, at the price of a Python call per event.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from concurrent.futures import Executor
+from dataclasses import dataclass
+
+import numpy as np
+
+from .integrate import (
+    DivergenceWarning,
+    check_substeps,
+    check_time_grid,
+    integrate,
+    stage_times,
+    uniform_step,
+)
+from .limits import check_memory
+from .methods import ButcherTableau, get_method
+from .metrics import METRICS, Metric, MetricStream, RideSignals
+from .response import (
+    check_initial_state,
+    check_input_samples,
+    input_output_response,
+    linear_input,
+)
+from .vehicle import SignalRoles, VehicleModel
+
+__all__ = ["simulate_batch", "BatchResponse", "nonlinear_sweep", "is_nonlinear", "BLOCK"]
+
+#: Samples per block: the states of a block, ``(n, m, BLOCK)``, are turned into
+#: outputs and reduced together (a few MB for a thousand designs).
+BLOCK = 64
+#: Designs stepped together when no executor splits them: large enough that
+#: NumPy's per-call cost is spread over many designs, small enough for the cache.
+NL_VECTOR_DESIGNS = 2048
+
+
+@dataclass(eq=False)
+class BatchResponse:
+    """What `simulate_batch` returns.
+
+    Attributes
+    ----------
+    t : ndarray (N,)
+    states : ndarray (m, n, N)
+    outputs : dict label -> ndarray (m, N)
+    success : ndarray of bool (m,)
+        Whether each design's state stayed finite (a design that blows up
+        becomes NaN from there on; the others are unaffected).
+    t_events : list of ndarray
+        Per design, the located event times (empty without ``events``).
+    """
+
+    t: np.ndarray
+    states: np.ndarray
+    outputs: dict
+    success: np.ndarray
+    t_events: list
+
+
+def is_nonlinear(model: VehicleModel) -> bool:
+    """Whether `qc_control.sweep` must take the nonlinear path for ``model``:
+    it has a vectorised right-hand side, or its system is not a StateSpace."""
+    return model.batch_dynamics is not None or not hasattr(model.system, "A")
+
+
+def _tableau_rows(tab: ButcherTableau, h: float):
+    """Each stage's ``h a_ij`` and the weights ``h b``, as the batch step uses them.
+
+    Per stage: None (no ``a_ij``), ``(j, h a_ij)`` for one non-zero entry
+    (RK4's), or the row ``h a_i,:i``, summed with the stored slopes in one
+    product; the weights likewise. The generic stepper (`qc_control.integrate`)
+    sums the same terms in another order: the steps agree to rounding.
+    """
+    rows: list = []
+    for i in range(tab.stages):
+        nonzero = [j for j in range(i) if tab.a[i, j] != 0]
+        if not nonzero:
+            rows.append(None)
+        elif len(nonzero) == 1:
+            rows.append((nonzero[0], float(tab.a[i, nonzero[0]] * h)))
+        else:
+            rows.append(np.array(tab.a[i, : nonzero[-1] + 1] * h))
+    return rows, np.asarray(tab.b * h)
+
+
+def _inputs(dynamics, T: np.ndarray, U) -> np.ndarray:
+    """The input samples ``(k, N)`` (`qc_control.response.check_input_samples`:
+    python-control's shapes; None is zero)."""
+    return check_input_samples(U, len(dynamics.input_labels), T.size)
+
+
+def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
+    """Step every design; yield ``(start, states (n, m, L))`` for the samples
+    ``start .. start + L - 1`` of ``T`` (sample 0 is ``X0``)."""
+    m, n = dynamics.size, len(dynamics.state_labels)
+    dt = uniform_step(T)
+    if dt is None:
+        raise ValueError("T must be uniformly spaced for a batched nonlinear run")
+    h = dt / substeps
+    single, weights = _tableau_rows(tab, h)
+    ts = stage_times(T, tab, substeps=substeps)  # (steps, s): the stepper's own times
+    u_of = linear_input(T, U)
+    k = U.shape[0]
+    none = np.zeros(0)
+    # the inputs at every stage time, linear between the samples (np.interp: the
+    # same formula as control's interpolation), as one (k,) view per stage
+    if k:
+        at = np.stack([np.interp(ts, T, row) for row in U], axis=-1)
+        stage_u = [list(row) for row in at]
+    else:
+        stage_u = [[none] * ts.shape[1]] * ts.shape[0]
+    ends = np.append(ts[1:, 0], T[-1])
+    x = np.array(np.broadcast_to(np.asarray(X0, dtype=float)[:, None], (n, m)))
+    buf = np.empty((n, block, m))  # a sample's states are contiguous rows: cheap to store
+    buf[:, 0] = x
+    filled = 1
+    sw = dynamics.switching
+    g_a = sw(float(T[0]), x, u_of(float(T[0])) if k else none) if events else none
+    step = 0
+    rhs = dynamics.rhs
+    times_list = ts.tolist()
+    K = np.empty((tab.stages, n, m))  # the stages' slopes, written in place
+    flat = K.reshape(tab.stages, n * m)  # a view: Σ_i w_i K_i as one vector-matrix product
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        for sample in range(1, T.size):
+            for _ in range(substeps):
+                times = times_list[step]
+                us = stage_u[step]
+                for i, rows in enumerate(single):
+                    if rows is None:
+                        xi = x
+                    elif isinstance(rows, tuple):  # one non-zero a_ij
+                        xi = x + rows[1] * K[rows[0]]
+                    else:
+                        xi = x + (rows @ flat[: rows.size]).reshape(n, m)
+                    rhs(times[i], xi, us[i], K[i])
+                x_new = x + (weights @ flat).reshape(n, m)
+                if events:
+                    tb = float(ends[step])
+                    ub = u_of(tb) if k else none
+                    g_b = sw(tb, x_new, ub)
+                    s_b = np.sign(g_b)
+                    hit = np.flatnonzero(np.any((s_b != np.sign(g_a)) & (s_b != 0), axis=0))
+                    if hit.size:
+                        x_new = x_new.copy()
+                        _locate(
+                            dynamics, hit, float(times[0]), tb, x, x_new, tab, u_of, k, t_events
+                        )
+                        g_b = sw(tb, x_new, ub)
+                    g_a = g_b
+                x = x_new
+                step += 1
+            buf[:, filled] = x
+            filled += 1
+            if filled == block or sample == T.size - 1:
+                yield sample + 1 - filled, np.swapaxes(buf[:, :filled], 1, 2)
+                filled = 0
+
+
+def _locate(dynamics, hit, ta, tb, x_a, x_b, tab, u_of, k, t_events):
+    """Take the step ``ta -> tb`` again for the designs ``hit`` alone, with
+    `qc_control.integrate`'s event location; write their ends into ``x_b``."""
+    none = np.zeros(0)
+    for j in hit.tolist():
+        one = dynamics.take(np.array([j]))
+
+        def f(t, x, one=one):
+            return one.rhs(t, x[:, None], u_of(t) if k else none)[:, 0]
+
+        def g(t, x, one=one):
+            return one.switching(t, x[:, None], u_of(t) if k else none)[:, 0]
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DivergenceWarning)
+            sol = integrate(f, [ta, tb], x_a[:, j], tab, events=g)
+        x_b[:, j] = sol.x[:, -1] if sol.success else np.nan
+        if t_events is not None and sol.t_events.size:
+            t_events[j] = np.concatenate([t_events[j], sol.t_events])
+
+
+def _check(dynamics, T, X0, U, method, substeps):
+    tab = get_method(method)
+    T = check_time_grid(T, "T")
+    substeps = check_substeps(substeps)
+    X0 = check_initial_state(X0, len(dynamics.state_labels))
+    return tab, T, X0, _inputs(dynamics, T, U), substeps
+
+
+def simulate_batch(
+    dynamics, T, X0, U=None, method="rk4", *, substeps: int = 1, events: bool = False
+) -> BatchResponse:
+    """Every design's trajectory, stepped together (whole outputs kept).
+
+    Parameters
+    ----------
+    dynamics : NonlinearQuarterCarBatch (or an object with its interface)
+        E.g. ``model.batch_dynamics(designs)``.
+    T : array_like (N,)
+        Uniform time grid [s].
+    X0 : array_like (n,)
+        The initial state of every design.
+    U : array_like (N,) or (k, N), optional
+        Input samples at ``T`` (the road ``zr`` [m]), linear in between;
+        None: zero.
+    method : str or ButcherTableau, default ``'rk4'``
+    substeps : int, default 1
+    events : bool, default False
+        Locate the kinks of the designs whose switching functions change
+        sign inside a step (see the module docstring).
+
+    Returns
+    -------
+    BatchResponse
+        Memory ``m × (n + outputs) × N × 8`` bytes: for many designs use
+        `qc_control.sweep`, which reduces the metrics as it goes.
+    """
+    tab, T, X0, U, substeps = _check(dynamics, T, X0, U, method, substeps)
+    m, n = dynamics.size, len(dynamics.state_labels)
+    p = len(dynamics.output_labels)
+    check_memory(
+        m * (n + p) * T.size * 8.0,
+        f"a batch of {m} designs over {T.size} samples",
+        "use fewer designs or samples (qc.sweep streams the metrics)",
+    )
+    states = np.empty((m, n, T.size))
+    outputs = {label: np.empty((m, T.size)) for label in dynamics.output_labels}
+    t_events: list = [np.empty(0) for _ in range(m)]
+    for start, xb in _march(dynamics, T, X0, U, tab, substeps, events, t_events):
+        sl = slice(start, start + xb.shape[-1])
+        states[:, :, sl] = np.moveaxis(xb, 0, 1)
+        with np.errstate(over="ignore", invalid="ignore"):
+            for label, y in dynamics.outputs(T[sl], xb, U[:, sl]).items():
+                outputs[label][:, sl] = y
+    success = np.asarray(np.isfinite(states).all(axis=(1, 2)))
+    return BatchResponse(T, states, outputs, success, t_events)
+
+
+def _run_vectorised(
+    factory, params, T, X0, U, tab, substeps, metric_items, roles: SignalRoles, keep, events
+):
+    """One chunk of designs: ``({'stable': ..., column: ...}, states or None)``.
+
+    Module level, so that an executor can pickle it (``factory`` is the
+    model's ``batch_dynamics``, a picklable partial).
+    """
+    dynamics = factory(params)
+    m, n = dynamics.size, len(dynamics.state_labels)
+    items = [
+        (column, METRICS[metric] if isinstance(metric, str) else metric, corner)
+        for column, metric, corner in metric_items
+    ]
+    args = (roles, T, dynamics.tire_stiffness, dynamics.static_load)
+    registered = all(isinstance(metric, Metric) for _, metric, _ in items)
+    streamed = registered and not keep and MetricStream.supports(items, roles)
+    if streamed:
+        streamed = not MetricStream(items, *args).weighted  # the Wk filter: whole signals
+    if streamed:
+        # a metric reading the last sample during the stream (the settling time)
+        # is reduced afterwards, from its one kept signal
+        late = [
+            it
+            for it in items
+            if any(kind == "settle" for kind, _ in MetricStream([it], *args).needs)
+        ]
+        now = [it for it in items if it not in late]
+        stream = MetricStream(now, *args) if now else None
+        kept_labels = MetricStream(late, *args).labels if late else ()
+    else:
+        late, stream = [], None
+        kept_labels = tuple(dynamics.output_labels)
+    check_memory(
+        (len(kept_labels) + n * keep) * m * T.size * 8.0 + 8.0 * n * m * BLOCK * 4,
+        f"a nonlinear sweep chunk of {m} designs over {T.size} samples",
+        "use fewer samples, a smaller chunk_size or states=False",
+    )
+    kept = {label: np.empty((m, T.size)) for label in kept_labels}
+    x_all = np.empty((m, n, T.size)) if keep else None
+    final: dict = {}  # filled with the last samples once known; read only by result()
+    if stream is not None:
+        stream.start(final)
+    ys: dict = {}
+    for start, xb in _march(dynamics, T, X0, U, tab, substeps, events, None):
+        L = xb.shape[-1]
+        sl = slice(start, start + L)
+        if x_all is not None:
+            x_all[:, :, sl] = np.moveaxis(xb, 0, 1)
+        with np.errstate(over="ignore", invalid="ignore"):
+            ys = dynamics.outputs(T[sl], xb, U[:, sl])
+            if stream is not None:
+                stream.update(np.arange(start, start + L), {lb: ys[lb] for lb in stream.labels})
+        for label in kept_labels:
+            kept[label][:, sl] = ys[label]
+    final.update({label: np.array(y[:, -1]) for label, y in ys.items()})
+    # a state that was ever non-finite stays so (x + h Σ b_i k_i keeps an inf or a nan)
+    result: dict = {"stable": np.asarray(np.isfinite(xb[..., -1]).all(axis=0))}
+    with np.errstate(over="ignore", invalid="ignore"):
+        if streamed:
+            if stream is not None:
+                result.update(stream.result())
+            if late:  # on the kept signals, whole (the registry's formula), by slices
+                for column, metric, corner in late:  # of designs (cache-sized temporaries)
+                    result[column] = np.concatenate(
+                        [
+                            np.asarray(metric.formula(_rows(T, kept, roles, args, sl), corner))
+                            for sl in _slices(m)
+                        ]
+                    )
+        else:
+            signals = RideSignals(T, kept, roles, *args[2:])
+            for column, metric, corner in items:
+                if isinstance(metric, Metric):
+                    result[column] = np.asarray(metric.formula(signals, corner))
+                else:
+                    result[column] = np.asarray(metric(signals), dtype=float)
+    return result, x_all
+
+
+def _slices(m: int, size: int = 128) -> list[slice]:
+    return [slice(s, s + size) for s in range(0, m, size)]
+
+
+def _rows(T, kept, roles, args, sl) -> RideSignals:
+    """The kept signals of the designs ``sl``, as a `RideSignals`."""
+    return RideSignals(
+        T,
+        {label: y[sl] for label, y in kept.items()},
+        roles,
+        tuple(k[sl] for k in args[2]),
+        tuple(w[sl] for w in args[3]),
+    )
+
+
+def _run_responses(model, params, T, X0, U, tab, substeps, metric_items, keep, events):
+    """The fallback: one `qc_control.input_output_response` per design."""
+    rows: list[dict] = []
+    states = []
+    for p in params:
+        one = model.rebuild(p)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DivergenceWarning)
+            r = input_output_response(
+                one.system,
+                T,
+                0.0 if U is None else U,
+                X0,
+                method=tab,
+                substeps=substeps,
+                events=True if events else None,
+            )
+        y = np.full((len(r.output_labels), T.size), np.nan)
+        y[:, : r.time.size] = np.asarray(r.outputs).reshape(len(r.output_labels), -1)
+        signals = RideSignals(
+            T,
+            {label: y[i][None] for i, label in enumerate(r.output_labels)},
+            one.roles,
+            tuple(np.array([c.tire_stiffness]) for c in one.corners),
+            tuple(np.array([c.static_load]) for c in one.corners),
+        )
+        row = {"stable": np.array([bool(r.success)])}
+        with np.errstate(over="ignore", invalid="ignore"):
+            for column, metric, corner in metric_items:
+                if isinstance(metric, str):
+                    row[column] = np.asarray(METRICS[metric].formula(signals, corner))
+                else:
+                    row[column] = np.asarray(metric(signals), dtype=float)
+        rows.append(row)
+        if keep:
+            x = np.full((len(r.state_labels), T.size), np.nan)
+            x[:, : r.time.size] = np.asarray(r.states).reshape(len(r.state_labels), -1)
+            states.append(x)
+    result = {key: np.concatenate([np.ravel(r[key]) for r in rows]) for key in rows[0]}
+    return result, (np.stack(states) if keep else None)
+
+
+def nonlinear_sweep(
+    model: VehicleModel,
+    params: Sequence,
+    T: np.ndarray,
+    X0: np.ndarray,
+    U,
+    tab: ButcherTableau,
+    substeps: int,
+    metric_items,
+    keep_states: bool,
+    *,
+    events: bool = False,
+    executor=None,
+    chunk_size: int = 64,
+):
+    """`qc_control.sweep`'s path for a nonlinear model (its arguments already checked).
+
+    ``params`` holds one validated parameter object per design, or None for
+    a rejected one. With ``model.batch_dynamics`` the designs are stepped
+    together (`NL_VECTOR_DESIGNS` at a time, or ``chunk_size`` per task of
+    an ``executor``); without it (e.g. `qc_control.closed_loop` with a
+    clipped semi-active controller, or a callable force law that does not
+    vectorise) each design runs through `qc_control.input_output_response`
+    in this process: correct, the same numbers, but about as slow as that
+    many single responses.
+
+    Returns
+    -------
+    (stable, table, states)
+        ``stable (designs,)``: the state stayed finite; ``table``: column ->
+        ``(designs,)`` (NaN for rejected designs); ``states`` ``(designs, n,
+        N)`` or None.
+    """
+    good = [i for i, p in enumerate(params) if p is not None]
+    chosen = [params[i] for i in good]
+    n = model.system.nstates
+    columns = [column for column, _, _ in metric_items]
+    stable = np.zeros(len(params), dtype=bool)
+    table = {column: np.full(len(params), np.nan) for column in columns}
+    kept = np.full((len(params), n, T.size), np.nan) if keep_states else None
+    if not good:
+        return stable, table, kept
+    factory = model.batch_dynamics
+    size = chunk_size if executor is not None else NL_VECTOR_DESIGNS
+    parts = [(good[s : s + size], chosen[s : s + size]) for s in range(0, len(good), size)]
+    if factory is None:
+        results = (
+            _run_responses(model, ps, T, X0, U, tab, substeps, metric_items, keep_states, events)
+            for _, ps in parts
+        )
+    else:
+        U = _inputs(factory(chosen[:1]), T, U)
+        args = (T, X0, U, tab, substeps, metric_items, model.roles, keep_states, events)
+        if executor is None:
+            results = (_run_vectorised(factory, ps, *args) for _, ps in parts)
+        elif isinstance(executor, Executor) or hasattr(executor, "submit"):
+            futures = [executor.submit(_run_vectorised, factory, ps, *args) for _, ps in parts]
+            results = (f.result() for f in futures)
+        else:
+            raise TypeError(
+                f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}"
+            )
+    for (idx, _), (result, x) in zip(parts, results):
+        stable[idx] = result["stable"]
+        for column in columns:
+            table[column][idx] = result[column]
+        if kept is not None:
+            kept[idx] = x
+    return stable, table, kept
