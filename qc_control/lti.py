@@ -22,7 +22,11 @@ over steps or blocks, only over the log2 rounds of the scans.
 from __future__ import annotations
 
 import math
+import threading
 import warnings
+from collections import OrderedDict
+from collections.abc import Callable, Hashable
+from typing import Any
 
 import numpy as np
 
@@ -30,7 +34,50 @@ from .integrate import DivergenceWarning, Solution, check_substeps, check_time_g
 from .methods import ButcherTableau, get_method
 from .stability import stability_coefficients
 
-__all__ = ["step_matrices", "affine_scan", "OutputStream", "lti_trajectory", "lti_solve"]
+__all__ = [
+    "step_matrices",
+    "affine_scan",
+    "OutputStream",
+    "lti_trajectory",
+    "lti_solve",
+    "memo",
+    "array_key",
+]
+
+#: How many step maps (and free-response power tables, eigenvalues) `memo` keeps.
+MEMO_SIZE = 32
+_memo_store: OrderedDict = OrderedDict()
+_memo_lock = threading.Lock()
+
+
+def array_key(a: np.ndarray) -> tuple:
+    """A hashable key for an array's dtype, shape and values (for `memo`)."""
+    a = np.asarray(a)
+    return (a.dtype.str, a.shape, a.tobytes())
+
+
+def memo(key: Hashable, build: Callable[[], Any]) -> Any:
+    """``build()``, remembered under ``key`` (the `MEMO_SIZE` most recent keys).
+
+    Single responses call the engine again and again on one system and grid
+    (a study, a plot, a benchmark); what depends only on ``(A, B, h,
+    method)`` - the step map, the eigenvalues, the free response's power
+    tables - is built once. Arrays built here are made read-only, so a
+    caller cannot change what the next call reads.
+    """
+    with _memo_lock:
+        if key in _memo_store:
+            _memo_store.move_to_end(key)
+            return _memo_store[key]
+    value = build()
+    for v in value if isinstance(value, tuple) else (value,):
+        if isinstance(v, np.ndarray):
+            v.flags.writeable = False
+    with _memo_lock:
+        _memo_store[key] = value
+        while len(_memo_store) > MEMO_SIZE:
+            _memo_store.popitem(last=False)
+    return value
 
 
 def step_matrices(
@@ -100,19 +147,28 @@ def _scan(V: np.ndarray, Q: np.ndarray) -> None:
         d *= 2
 
 
-def _free_response(phi, x0, N, C, time_last):
-    """``x_k = Φ^k x0`` with no recurrence: ``x_{j·nb+b} = (Φ^nb)^j Φ^b x0``.
-
-    Two power tables of ~√N entries and one product, whose result is laid
-    out (signal, j, b), i.e. time-last in time order.
-    """
-    n = phi.shape[-1]
-    batch = phi.shape[:-2]
+def _free_tables(phi: np.ndarray, N: int) -> tuple[np.ndarray, np.ndarray]:
+    """`_free_response`'s power tables: ``Φ^b`` for ``b < nb`` and ``(Φ^nb)^j``
+    for ``j < L`` (``nb ≈ √N``), which depend only on ``Φ`` and ``N``."""
     nb = max(1, math.ceil(math.sqrt(N)))
     L = math.ceil(N / nb)
     Pb = _powers(phi, nb)
-    xb = (Pb[..., :nb, :, :] @ x0[..., None, :, None])[..., 0]  # (..., b, a): Φ^b x0
     Pj = _powers(Pb[..., nb, :, :], L - 1)  # (Φ^nb)^j
+    return Pb[..., :nb, :, :], Pj
+
+
+def _free_response(phi, x0, N, C, time_last, tables=None):
+    """``x_k = Φ^k x0`` with no recurrence: ``x_{j·nb+b} = (Φ^nb)^j Φ^b x0``.
+
+    Two power tables of ~√N entries (`_free_tables`, or ``tables`` built
+    before) and one product, whose result is laid out (signal, j, b), i.e.
+    time-last in time order.
+    """
+    n = phi.shape[-1]
+    batch = phi.shape[:-2]
+    Pb, Pj = _free_tables(phi, N) if tables is None else tables
+    nb, L = Pb.shape[-3], Pj.shape[-3]
+    xb = (Pb @ x0[..., None, :, None])[..., 0]  # (..., b, a): Φ^b x0
     obs = Pj if C is None else C[..., None, :, :] @ Pj  # (..., j, r, a)
     p = obs.shape[-2]
     lhs = np.swapaxes(obs, -3, -2).reshape(batch + (p * L, n))  # rows (r, j)
@@ -512,17 +568,23 @@ def lti_trajectory(
     Past the method's stability limit the states overflow to inf or nan
     without a RuntimeWarning; `lti_solve` cuts them off and warns.
     """
-    H = (T[-1] - T[0]) / (T.size - 1)
+    H = float((T[-1] - T[0]) / (T.size - 1))
+    A, B = np.asarray(A, dtype=float), np.asarray(B, dtype=float)
+    key = ("step", method, substeps, H, array_key(A), array_key(B))
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        phi, g_lo, g_hi = step_matrices(method, A, B, H, substeps)
-        W = None
-        if U is not None and U.size and np.any(U):
-            n, k = phi.shape[-1], U.shape[0]
-            # fewer inputs than states: the windows of U carry the input, not W
-            W = (g_lo, g_hi, U) if k < n else U[:, :-1].T @ g_lo.T + U[:, 1:].T @ g_hi.T
-        # Without input there is no block-Toeplitz product, so longer blocks
-        # (fewer scan rounds) win; with input, 16 keeps that product small.
-        return affine_scan(phi, x0, W, T.size, block=16 if W is not None else 32, time_last=True)
+        phi, g_lo, g_hi = memo(key, lambda: step_matrices(method, A, B, H, substeps))
+        if U is None or not U.size or not np.any(U):
+            # the free response: its power tables depend on Φ and N only
+            tables = memo(key + ("free", T.size), lambda: _free_tables(phi, T.size))
+            x0 = np.asarray(x0, dtype=float)
+            if T.size == 1:
+                return x0[:, None].copy()
+            return _free_response(phi, x0, T.size, None, True, tables)
+        n, k = phi.shape[-1], U.shape[0]
+        # fewer inputs than states: the windows of U carry the input, not W
+        W = (g_lo, g_hi, U) if k < n else U[:, :-1].T @ g_lo.T + U[:, 1:].T @ g_hi.T
+        # with input, blocks of 16 keep the block-Toeplitz product small
+        return affine_scan(phi, x0, W, T.size, block=16, time_last=True)
 
 
 def lti_solve(method, A, B, T, U, x0, substeps: int = 1, *, uniform: bool = False) -> Solution:
@@ -569,9 +631,13 @@ def lti_solve(method, A, B, T, U, x0, substeps: int = 1, *, uniform: bool = Fals
         if uniform_step(T) is None:
             raise ValueError("the LTI engine needs a uniformly spaced T (see uniform_step)")
     x = lti_trajectory(tab, A, B, T, U, np.asarray(x0, dtype=float), substeps)
-    finite = np.isfinite(x).all(axis=0)
     n_keep, status, message = T.size, "success", ""
-    if not finite.all():
+    # one pass on a good run: a NaN or inf makes the sum non-finite (an overflow
+    # of the sum alone sends it to the sample-by-sample check, which finds none)
+    with np.errstate(over="ignore", invalid="ignore"):
+        suspect = not np.isfinite(x.sum())
+    finite = np.isfinite(x).all(axis=0) if suspect else None
+    if finite is not None and not finite.all():
         n_keep = int(np.argmin(finite))
         status = "diverged"
         message = (
