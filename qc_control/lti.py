@@ -429,6 +429,8 @@ class OutputStream:
                 m, p * L, (L + 1) * k
             )
         self._Q = P[:, L]
+        #: while iterating: the state where the next segment starts (its first block's carry)
+        self.carry: np.ndarray | None = None
         # first pass: the carries segment by segment, keeping only where each
         # segment starts (memory: designs × n × segments, not × blocks)
         starts = np.empty((m, n, -(-nb // self.run) + 1))
@@ -484,9 +486,10 @@ class OutputStream:
         V[:, :, 0] = c
         if self._forced:
             V[:, :, 1:] = np.matmul(self._E_mat, self._window(b0, b1))
-        Q, d = self._Q, 1
-        while d < V.shape[-1]:
-            V[:, :, d:] += Q @ V[:, :, :-d]
+        Q, d, total = self._Q, 1, V.shape[-1]
+        tmp = np.empty_like(V)  # one buffer for every round's product (no fresh pages per round)
+        while d < total:
+            V[:, :, d:] += np.matmul(Q, V[:, :, :-d], out=tmp[:, :, : total - d])
             Q = Q @ Q
             d *= 2
         return V
@@ -531,16 +534,30 @@ class OutputStream:
         return total.reshape(self.batch + (final.shape[-1],))
 
     def __iter__(self):
+        """Yield ``(index, y)`` segment by segment.
+
+        ``y`` is a view of a buffer that the next segment overwrites: reduce it
+        (or copy it) before asking for the next. Reusing the buffers, rather
+        than allocating a segment's outputs (about 1 MB) anew each time, spares
+        the page faults of fresh memory, which cost as much as the products
+        where the allocator hands large blocks back to the system at once (as
+        under Dask's workers, whose ``MALLOC_TRIM_THRESHOLD_`` is set).
+        """
         p, L, N = self.p, self.L, self.N
+        full = np.empty((self.m, p * L, self.step))
+        extra = np.empty_like(full) if self._forced else None
         for i, r0 in enumerate(range(0, self.nb, self.run)):
             r1 = min(r0 + self.run, self.nb)
             V = self._carries(self._starts[:, :, i], r0, r1)
             for b0 in range(r0, r1, self.step):
                 b1 = min(b0 + self.step, r1)
                 S = b1 - b0
-                out = np.matmul(self._obs_mat, V[:, :, b0 - r0 : b1 - r0])  # (m, p L, S)
+                buf = full if S == self.step else np.empty((self.m, p * L, S))
+                out = np.matmul(self._obs_mat, V[:, :, b0 - r0 : b1 - r0], out=buf)  # (m, p L, S)
                 if self._forced:
-                    out += np.matmul(self._G_mat, self._window(b0, b1))
+                    add = extra if S == self.step else np.empty_like(buf)
+                    out += np.matmul(self._G_mat, self._window(b0, b1), out=add)
+                self.carry = V[:, :, b1 - r0]  # the state at sample b1 L
                 index = np.arange(b0, b1)[None, :] * L + np.arange(L)[:, None]  # (L, S)
                 y = out.reshape(self.batch + (p, L, S))
                 if b1 * L > N - 1:  # the last segment: drop the padding past sample N - 2

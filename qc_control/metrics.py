@@ -381,6 +381,16 @@ class MetricStream:
         self.labels = tuple(sorted(str(x) for x in labels - {WEIGHTED_ACC}))
         self._acc: dict = {}
         self._given: set = set()
+        self._scratch: dict = {}
+
+    def _buffer(self, shape, dtype=float) -> np.ndarray:
+        """A scratch array, reused from piece to piece: fresh memory for every
+        piece's temporaries costs page faults comparable to the arithmetic."""
+        key = (tuple(shape), np.dtype(dtype).str)
+        buf = self._scratch.get(key)
+        if buf is None:
+            buf = self._scratch[key] = np.empty(shape, dtype)
+        return buf
 
     @staticmethod
     def supports(items, roles: SignalRoles) -> bool:
@@ -436,13 +446,15 @@ class MetricStream:
             if kind == "sumsq":
                 acc[(kind, key)] = acc.get((kind, key), 0.0) + np.vecdot(v, v)
             elif kind == "quartic":
-                v2 = v * v
+                v2 = np.multiply(v, v, out=self._buffer(v.shape))
                 acc[(kind, key)] = acc.get((kind, key), 0.0) + np.vecdot(v2, v2)
             elif kind == "peak":
                 top = np.maximum(v.max(axis=-1), -v.min(axis=-1))
                 acc[(kind, key)] = np.maximum(acc[(kind, key)], top) if (kind, key) in acc else top
             elif kind == "lifted" and isinstance(key, int):
-                over = v > _lift_threshold(self, key)[..., None]
+                over = np.greater(
+                    v, _lift_threshold(self, key)[..., None], out=self._buffer(v.shape, bool)
+                )
                 acc[(kind, key)] = acc.get((kind, key), 0) + np.count_nonzero(over, axis=-1)
 
     def _settle(self, label: str, v: np.ndarray, index: np.ndarray) -> None:
@@ -452,7 +464,10 @@ class MetricStream:
         occurs is itself outside, and after it the threshold no longer moves."""
         acc = self._acc
         final = self._final[label]
-        dev = np.abs(v - final.reshape(final.shape + (1,) * index.ndim))
+        dev = np.subtract(
+            v, final.reshape(final.shape + (1,) * index.ndim), out=self._buffer(v.shape)
+        )
+        np.abs(dev, out=dev)
         m = dev.shape[0]
         if index.ndim == 2:  # (L, S) blocks: find the last block column outside, then the sample
             cols = dev.max(axis=-2)  # (m, S)
