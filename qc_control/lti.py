@@ -42,6 +42,7 @@ __all__ = [
     "lti_solve",
     "memo",
     "array_key",
+    "TailBound",
 ]
 
 #: How many step maps (and free-response power tables, eigenvalues) `memo` keeps.
@@ -438,9 +439,13 @@ class OutputStream:
         self._gram_K = np.zeros((m, n, n))  # Σ c_b c_bᵀ over the whole blocks b < nb - 1
         b_last, jl = divmod(N - 1, L)
         carry_last = None
+        # with one run, its carries are kept (no second scan while streaming)
+        self._one_run: np.ndarray | None = None
         for i, b0 in enumerate(range(0, nb, self.run)):
             starts[:, :, i] = c
             V = self._carries(c, b0, min(b0 + self.run, nb))
+            if self.run >= nb:
+                self._one_run = V
             upto = min(V.shape[-1] - 1, nb - 1 - b0)
             if upto > 0:
                 self._gram_K += V[:, :, :upto] @ np.swapaxes(V[:, :, :upto], -1, -2)
@@ -475,6 +480,12 @@ class OutputStream:
         )
         return view.reshape((L + 1) * k, b1 - b0)
 
+    def _run_carries(self, i: int, b0: int, b1: int) -> np.ndarray:
+        """Run ``i``'s carries (blocks ``b0 .. b1``), kept or scanned again."""
+        if self._one_run is not None:
+            return self._one_run
+        return self._carries(self._starts[:, :, i], b0, b1)
+
     def _carries(self, c: np.ndarray, b0: int, b1: int) -> np.ndarray:
         """``(m, n, b1 - b0 + 1)``: the carries ``c_{b0} .. c_{b1}`` from ``c = c_{b0}``.
 
@@ -493,6 +504,21 @@ class OutputStream:
             Q = Q @ Q
             d *= 2
         return V
+
+    def block_carries(self) -> np.ndarray:
+        """``(m, n, nb + 1)``: the state where every block starts (and the last
+        block's end), from the stored run starts (memory: designs × n × blocks)."""
+        out = np.empty((self.m, self.n, self.nb + 1))
+        for i, r0 in enumerate(range(0, self.nb, self.run)):
+            r1 = min(r0 + self.run, self.nb)
+            out[:, :, r0 : r1 + 1] = self._run_carries(i, r0, r1)
+        return out
+
+    def free_samples(self, row: int, carries: np.ndarray) -> np.ndarray:
+        """``(m, L, S)``: streamed output ``row`` over the blocks whose start states are
+        ``carries`` ``(m, n, S)``: sample ``j`` of each block (free response only)."""
+        L = self.L
+        return np.matmul(self._obs_mat[:, row * L : (row + 1) * L], carries)
 
     def keep_rows(self, rows) -> None:
         """Stream only these output rows (`final` keeps them all)."""
@@ -522,13 +548,13 @@ class OutputStream:
         if self._forced:
             raise ValueError("sum_squares is the free response's: this stream has an input")
         L, nb, N = self.L, self.nb, self.N
-        obs = self._obs  # (m, L, p, n): C Φ^j
-        gram = np.einsum("mjra,mjrb->mrab", obs, obs)  # (m, p, n, n)
-        total = np.einsum("mrab,mab->mr", gram, self._gram_K)
+        obs = np.swapaxes(self._obs, 1, 2)  # (m, p, L, n): C Φ^j
+        gram = np.swapaxes(obs, -1, -2) @ obs  # (m, p, n, n)
+        total = (gram * self._gram_K[:, None]).sum(axis=(-2, -1))
         J = (N - 1) - (nb - 1) * L  # samples of the last block before sample N - 1
-        part = np.einsum("mjra,mjrb->mrab", obs[:, :J], obs[:, :J])
+        part = np.swapaxes(obs[:, :, :J], -1, -2) @ obs[:, :, :J]
         c = self._c_partial
-        total += np.einsum("mrab,ma,mb->mr", part, c, c)
+        total += ((part @ c[:, None, :, None])[..., 0] * c[:, None, :]).sum(axis=-1)
         final = self.final.reshape(self.m, -1)
         total += final * final
         return total.reshape(self.batch + (final.shape[-1],))
@@ -548,7 +574,7 @@ class OutputStream:
         extra = np.empty_like(full) if self._forced else None
         for i, r0 in enumerate(range(0, self.nb, self.run)):
             r1 = min(r0 + self.run, self.nb)
-            V = self._carries(self._starts[:, :, i], r0, r1)
+            V = self._run_carries(i, r0, r1)
             for b0 in range(r0, r1, self.step):
                 b1 = min(b0 + self.step, r1)
                 S = b1 - b0
@@ -564,6 +590,62 @@ class OutputStream:
                     keep = index < N - 1
                     index, y = index[keep], y[..., keep]
                 yield index, y
+
+
+class TailBound:
+    r"""Bounds on every later output of a free recurrence ``x_{k+1} = Φ x_k``.
+
+    With ``Φ = V Λ V⁻¹`` and every ``|λ_i| < 1``,
+
+    .. math::
+
+        y_{K+j,r} = \sum_i (C V)_{ri}\, λ_i^j\, (V^{-1} x_K)_i
+        \;\Rightarrow\;
+        |y_{K+j,r}| \le β_r(x_K) = \sum_i |(C V)_{ri}|\,|(V^{-1} x_K)_i|
+        \quad (j \ge 0),
+
+    the modal expansion of the free response (Kailath, *Linear Systems*,
+    1980, §2.2) with ``|λ_i|^j <= 1``. A mode that decays keeps the bound
+    tight (one lightly damped pair: β is its envelope). The returned bound
+    carries a margin for rounding, ``β (1 + 1e-6) + 1e-12 κ(V) ‖C_r‖₁ ‖x‖∞``
+    (``κ`` the 1-norm condition number of ``V``); a design whose ``Φ`` has an
+    eigenvalue on or outside the unit circle, or whose ``V`` is
+    ill-conditioned (``κ > 1e8``, near-defective), gets ``inf``.
+
+    Parameters
+    ----------
+    phi : array, shape (m, n, n)
+    C : array, shape (m, p, n)
+    """
+
+    def __init__(self, phi: np.ndarray, C: np.ndarray):
+        phi, C = np.asarray(phi, dtype=float), np.asarray(C, dtype=float)
+        m, n = phi.shape[0], phi.shape[-1]
+        ok = np.all(np.isfinite(phi), axis=(-2, -1))
+        lam, V = np.linalg.eig(np.where(ok[:, None, None], phi, 0.0))
+        ok &= np.abs(lam).max(axis=-1) < 1.0
+        with np.errstate(all="ignore"):
+            W = np.linalg.inv(np.where(ok[:, None, None], V, np.eye(n)))
+            # κ₁(V) = ‖V‖₁‖V⁻¹‖₁, the largest column sums
+            cond = np.abs(V).sum(axis=-2).max(axis=-1) * np.abs(W).sum(axis=-2).max(axis=-1)
+        ok &= np.isfinite(cond) & (cond < 1e8)
+        V = np.where(ok[:, None, None], V, np.eye(n))
+        self._W = np.where(ok[:, None, None], W, np.eye(n))
+        self._a = np.abs(C @ V)  # (m, p, n)
+        self._abs = 1e-12 * np.where(ok, cond, 0.0)[:, None] * np.abs(C).sum(axis=-1)
+        self._ok = ok
+        self.m = m
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """Bounds on ``|y_{k,r}|`` for all ``k >= K`` from ``x = x_K``: ``(m, n)`` gives
+        ``(m, p)``; ``(m, n, S)`` (S states per design) gives ``(m, p, S)``."""
+        single = x.ndim == 2
+        x = x[..., None] if single else x
+        z = np.abs(self._W @ x)  # |V⁻¹ x|: (m, n, S)
+        beta = (self._a @ z) * (1 + 1e-6)
+        beta += self._abs[..., None] * np.abs(x).max(axis=-2)[:, None, :]
+        beta = np.where(self._ok[:, None, None], beta, np.inf)
+        return beta[..., 0] if single else beta
 
 
 def lti_trajectory(

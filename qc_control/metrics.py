@@ -406,14 +406,56 @@ class MetricStream:
             return False
         return True
 
-    def only_mean_square(self, label: str) -> bool:
-        """Whether the metrics read ``label`` only through its mean square."""
-        kinds = {
+    def kinds(self, label: str) -> set[str]:
+        """The reductions the metrics read of ``label`` (``'sumsq'``, ``'peak'``, ...)."""
+        return {
             kind
             for kind, key in self.needs
             if (self.roles.corners[key].tire_defl if isinstance(key, int) else key) == label
         }
-        return kinds == {"sumsq"}
+
+    def only_mean_square(self, label: str) -> bool:
+        """Whether the metrics read ``label`` only through its mean square."""
+        return self.kinds(label) == {"sumsq"}
+
+    def settled(self, bound: Mapping[str, np.ndarray], *, band: bool = True) -> np.ndarray:
+        """Per design, ``(m,)``: whether no later sample can change a reduction,
+        given that every later sample of each streamed label satisfies
+        ``|v| <= bound[label]`` (e.g. `qc_control.lti.TailBound`).
+
+        A peak stays when ``bound <= peak``; a lift-off count when ``bound <=``
+        the threshold (no later ``v`` exceeds it); the settling time when
+        ``(bound + |final|)(1 + 1e-12) <= 0.02 M`` with ``M`` the largest
+        excursion from the final value so far (no later deviation is outside
+        the band, and ``M`` does not grow; the factor covers the rounding of
+        ``v - final``); with ``band=False`` only ``M`` must be final
+        (``(bound + |final|)(1 + 1e-12) <= M``), the last sample outside the
+        band being found otherwise (`settling_state`, `set_last_outside`).
+        Sums of squares and fourth powers need every sample,
+        unless given in closed form (`start`'s ``sums``). Call after the
+        first `update`.
+        """
+        acc = self._acc
+        m = len(next(iter(self._final.values()))) if self._final else 0
+        ok = np.ones(m, dtype=bool)
+        for kind, key in self.needs:
+            label = self.roles.corners[key].tire_defl if isinstance(key, int) else str(key)
+            if kind == "sumsq" and label in self._given:
+                continue
+            if kind in ("sumsq", "quartic"):
+                return np.zeros(m, dtype=bool)
+            b = bound[label]
+            if kind == "peak":
+                here = b <= acc[("peak", key)]
+            elif kind == "lifted" and isinstance(key, int):
+                here = b <= _lift_threshold(self, key)
+            elif kind == "settle":
+                reach = (b + np.abs(self._final[label])) * (1 + 1e-12)
+                here = reach <= (0.02 if band else 1.0) * acc[("settle_max", label)]
+            else:  # pragma: no cover - every kind is listed above
+                raise AssertionError(kind)
+            ok &= here
+        return ok
 
     def start(self, final: Mapping[str, np.ndarray], sums=None) -> None:
         """Begin: each signal's last sample; optionally ``{label: (Σ v², v_0)}``
@@ -489,6 +531,15 @@ class MetricStream:
         prev = acc.get(("settle", label), np.full(M.shape, -1))
         acc[("settle_max", label)] = M
         acc[("settle", label)] = np.maximum(prev, last)
+
+    def settling_state(self, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """``(final, M)``: the final value and the largest excursion from it so far."""
+        return self._final[label], self._acc[("settle_max", label)]
+
+    def set_last_outside(self, label: str, last: np.ndarray) -> None:
+        """Set the settling time's last sample outside the band (-1: none), found
+        by a search of its own (`qc_control.sweeps`' backward search)."""
+        self._acc[("settle", label)] = np.asarray(last)
 
     def _ends(self, label):
         return self._acc[("first", label)], self._final[label]
