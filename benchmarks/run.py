@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import datetime as dt
+import os
 import platform
 import statistics
 import sys
@@ -281,10 +282,15 @@ def dask_comparison(quick: bool, m: int = 100_000, chunk: int = 5_000):
     chunks = -(-m // chunk)
     default_env = dask.config.get("distributed.nanny.pre-spawn-environ")
     rows = []
+    saved = dict(os.environ)
     for label, env in (
         ("Dask's default", default_env),
         ("DASK_WORKER_ENV", {**default_env, **DASK_WORKER_ENV}),
     ):
+        # the nanny copies its pre-spawn environment into this process's
+        # os.environ, which then overrides the next cluster's config: restore it
+        os.environ.clear()
+        os.environ.update(saved)
         with (
             dask.config.set({"distributed.nanny.pre-spawn-environ": env}),
             LocalCluster(
@@ -299,6 +305,8 @@ def dask_comparison(quick: bool, m: int = 100_000, chunk: int = 5_000):
             run(pool)
             client_cpu, t2 = time.process_time() - cpu0, time.perf_counter() - wall0
             workers_cpu = sum(client.run(time.process_time).values()) - before
+        os.environ.clear()
+        os.environ.update(saved)
         overhead = (client_cpu + workers_cpu - cpu1) / chunks
         rows.append(
             [
