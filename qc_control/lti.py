@@ -631,6 +631,8 @@ class TailBound:
         ok &= np.isfinite(cond) & (cond < 1e8)
         V = np.where(ok[:, None, None], V, np.eye(n))
         self._W = np.where(ok[:, None, None], W, np.eye(n))
+        # V⁻¹ as real rows [Re; Im], for products with real states
+        self._W_ri = np.concatenate([self._W.real, self._W.imag], axis=1)  # (m, 2n, n)
         self._a = np.abs(C @ V)  # (m, p, n)
         self._abs = 1e-12 * np.where(ok, cond, 0.0)[:, None] * np.abs(C).sum(axis=-1)
         self._ok = ok
@@ -639,13 +641,18 @@ class TailBound:
     def __call__(self, x: np.ndarray) -> np.ndarray:
         """Bounds on ``|y_{k,r}|`` for all ``k >= K`` from ``x = x_K``: ``(m, n)`` gives
         ``(m, p)``; ``(m, n, S)`` (S states per design) gives ``(m, p, S)``."""
-        single = x.ndim == 2
-        x = x[..., None] if single else x
-        z = np.abs(self._W @ x)  # |V⁻¹ x|: (m, n, S)
+        n = x.shape[1]
+        if x.ndim == 2:  # one state per design: broadcasting beats m tiny matmuls
+            ri = (self._W_ri * x[:, None, :]).sum(axis=-1)  # (m, 2n)
+            z = np.hypot(ri[:, :n], ri[:, n:])  # |V⁻¹ x|
+            beta = (self._a * z[:, None, :]).sum(axis=-1) * (1 + 1e-6)
+            beta += self._abs * np.abs(x).max(axis=-1)[:, None]
+            return np.where(self._ok[:, None], beta, np.inf)
+        ri = self._W_ri @ x  # (m, 2n, S)
+        z = np.hypot(ri[:, :n], ri[:, n:])
         beta = (self._a @ z) * (1 + 1e-6)
         beta += self._abs[..., None] * np.abs(x).max(axis=-2)[:, None, :]
-        beta = np.where(self._ok[:, None, None], beta, np.inf)
-        return beta[..., 0] if single else beta
+        return np.where(self._ok[:, None, None], beta, np.inf)
 
 
 def lti_trajectory(
