@@ -644,12 +644,13 @@ class TailBound:
         n = x.shape[1]
         if x.ndim == 2:  # one state per design: broadcasting beats m tiny matmuls
             ri = (self._W_ri * x[:, None, :]).sum(axis=-1)  # (m, 2n)
-            z = np.hypot(ri[:, :n], ri[:, n:])  # |V⁻¹ x|
+            z = np.sqrt(ri[:, :n] ** 2 + ri[:, n:] ** 2)  # |V⁻¹ x| (np.hypot is slower)
             beta = (self._a * z[:, None, :]).sum(axis=-1) * (1 + 1e-6)
             beta += self._abs * np.abs(x).max(axis=-1)[:, None]
             return np.where(self._ok[:, None], beta, np.inf)
         ri = self._W_ri @ x  # (m, 2n, S)
-        z = np.hypot(ri[:, :n], ri[:, n:])
+        ri *= ri
+        z = np.sqrt(ri[:, :n] + ri[:, n:])
         beta = (self._a @ z) * (1 + 1e-6)
         beta += self._abs[..., None] * np.abs(x).max(axis=-2)[:, None, :]
         return np.where(self._ok[:, None, None], beta, np.inf)
