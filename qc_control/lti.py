@@ -177,19 +177,11 @@ def _free_response(phi, x0, N, C, time_last, tables=None):
     return out if time_last else np.swapaxes(out, -1, -2)
 
 
-def _input_offsets(P, g0, g1, U, N: int, L: int, nb: int) -> np.ndarray:
-    """``Y[b, q] = Σ_{i<=q} Φ^{q-i} (Γ₀ u_{bL+i} + Γ₁ u_{bL+i+1})`` from the input samples.
-
-    With ``k`` inputs (fewer than the ``n`` states) one product of each
-    block's window ``u_{bL} .. u_{bL+L}`` with the ``((L+1)k, L n)`` matrix of
-    ``Φ^{q-r}Γ₀ [r<=q] + Φ^{q+1-r}Γ₁ [1<=r<=q+1]``: ``2(L+1)kn`` flops per step
-    instead of the ``2L n²`` of the Toeplitz product with ``W``.
-    """
-    n, k = P.shape[-1], U.shape[0]
+def _input_matrix(P, g0, g1, L: int) -> np.ndarray:
+    """`_input_offsets`' ``((L+1)k, L n)`` matrix of ``Φ^{q-r}Γ₀ [r<=q] +
+    Φ^{q+1-r}Γ₁ [1<=r<=q+1]``: rows (r, input), columns (q, state)."""
+    n, k = P.shape[-1], g0.shape[-1]
     batch = P.shape[:-3]
-    padded = np.zeros((nb * L + 1, k))
-    padded[:N] = U.T
-    windows = padded[np.arange(nb)[:, None] * L + np.arange(L + 1)].reshape(nb, (L + 1) * k)
     PG0 = P[..., :L, :, :] @ g0[..., None, :, :]  # Φ^i Γ₀: (..., L, n, k)
     PG1 = P[..., :L, :, :] @ g1[..., None, :, :]
     q, r = np.meshgrid(np.arange(L), np.arange(L + 1), indexing="ij")
@@ -197,9 +189,23 @@ def _input_offsets(P, g0, g1, U, N: int, L: int, nb: int) -> np.ndarray:
     lo, hi = r <= q, (r >= 1) & (r <= q + 1)
     E[..., q[lo], r[lo], :, :] += PG0[..., (q - r)[lo], :, :]
     E[..., q[hi], r[hi], :, :] += PG1[..., (q + 1 - r)[hi], :, :]
-    # rows (r, input), columns (q, state)
-    E = np.moveaxis(E, (-4, -3, -2, -1), (-2, -4, -1, -3)).reshape(batch + ((L + 1) * k, L * n))
-    return (windows @ E).reshape(batch + (nb, L, n))
+    return np.moveaxis(E, (-4, -3, -2, -1), (-2, -4, -1, -3)).reshape(batch + ((L + 1) * k, L * n))
+
+
+def _input_offsets(E, U, N: int, L: int, nb: int) -> np.ndarray:
+    """``Y[b, q] = Σ_{i<=q} Φ^{q-i} (Γ₀ u_{bL+i} + Γ₁ u_{bL+i+1})`` from the input samples.
+
+    With ``k`` inputs (fewer than the ``n`` states) one product of each
+    block's window ``u_{bL} .. u_{bL+L}`` with the ``((L+1)k, L n)`` matrix
+    ``E`` (`_input_matrix`): ``2(L+1)kn`` flops per step instead of the
+    ``2L n²`` of the Toeplitz product with ``W``.
+    """
+    k = U.shape[0]
+    n = E.shape[-1] // L
+    padded = np.zeros((nb * L + 1, k))
+    padded[:N] = U.T
+    windows = padded[np.arange(nb)[:, None] * L + np.arange(L + 1)].reshape(nb, (L + 1) * k)
+    return (windows @ E).reshape(E.shape[:-2] + (nb, L, n))
 
 
 def affine_scan(
@@ -210,6 +216,7 @@ def affine_scan(
     block: int = 16,
     C: np.ndarray | None = None,
     time_last: bool = False,
+    tables: tuple | None = None,
 ) -> np.ndarray:
     r"""Solve ``x_0 = x0``, ``x_{k+1} = Φ x_k + W_k`` for k < N-1; return x or C x.
 
@@ -231,6 +238,10 @@ def affine_scan(
     time_last : bool, default False
         Return ``(..., p, N)`` (time last, contiguous per signal) instead
         of ``(..., N, p)``, without a separate transposing copy.
+    tables : tuple, optional
+        ``(P, E)`` built before for this ``Φ`` (and ``Γ``'s) and block
+        length: the powers ``Φ^0 .. Φ^L`` (`_powers`) and, for a tuple
+        ``W``, the input matrix (`_input_matrix`; else None).
 
     Returns
     -------
@@ -261,10 +272,11 @@ def affine_scan(
         return _free_response(phi, x0, N, C, time_last)
     L = max(1, min(block, N - 1))
     nb = -(-(N - 1) // L)
-    P = _powers(phi, L)
+    P, E = tables if tables is not None else (_powers(phi, L), None)
     if isinstance(W, tuple):  # (Γ₀, Γ₁, U): the input's samples, not W = Γ₀u + Γ₁u⁺
         g0, g1, U = W
-        Y = _input_offsets(P, g0, g1, U, N, L, nb)
+        E = _input_matrix(P, g0, g1, L) if E is None else E
+        Y = _input_offsets(E, U, N, L, nb)
     else:
         # Y_{b, q+1} for every block: one product with the block-Toeplitz matrix
         # M[(i, a), (q, c)] = (Φ^{q-i})[c, a] for i <= q (row block i feeds Y_{b, q+1})
@@ -688,10 +700,22 @@ def lti_trajectory(
                 return x0[:, None].copy()
             return _free_response(phi, x0, T.size, None, True, tables)
         n, k = phi.shape[-1], U.shape[0]
-        # fewer inputs than states: the windows of U carry the input, not W
-        W = (g_lo, g_hi, U) if k < n else U[:, :-1].T @ g_lo.T + U[:, 1:].T @ g_hi.T
         # with input, blocks of 16 keep the block-Toeplitz product small
-        return affine_scan(phi, x0, W, T.size, block=16, time_last=True)
+        L = max(1, min(16, T.size - 1))
+        if k < n:  # fewer inputs than states: the windows of U carry the input, not W
+            W: tuple | np.ndarray = (g_lo, g_hi, U)
+
+            def build():
+                P = _powers(phi, L)
+                return P, _input_matrix(P, g_lo, g_hi, L)
+        else:
+            W = U[:, :-1].T @ g_lo.T + U[:, 1:].T @ g_hi.T
+
+            def build():
+                return _powers(phi, L), None
+
+        tables = memo(key + ("forced", L, k < n), build)
+        return affine_scan(phi, x0, W, T.size, block=L, time_last=True, tables=tables)
 
 
 def lti_solve(method, A, B, T, U, x0, substeps: int = 1, *, uniform: bool = False) -> Solution:
