@@ -134,7 +134,11 @@ def _powers(phi: np.ndarray, L: int) -> np.ndarray:
     k = 1
     while k < L:
         top = min(2 * k, L)
-        P[..., k + 1 : top + 1, :, :] = P[..., 1 : top - k + 1, :, :] @ P[..., k : k + 1, :, :]
+        w = top - k
+        # Φ^{k+i} = Φ^i Φ^k for i = 1..w: the w left factors stacked as one
+        # (w n, n) matrix per design, one product each (not w small ones)
+        left = P[..., 1 : w + 1, :, :].reshape(phi.shape[:-2] + (w * n, n))
+        P[..., k + 1 : top + 1, :, :] = (left @ P[..., k, :, :]).reshape(phi.shape[:-2] + (w, n, n))
         k = top
     return P
 
