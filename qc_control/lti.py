@@ -416,7 +416,7 @@ class OutputStream:
         obs = C[:, None] @ P[:, :L]  # C Φ^j: (m, L, p, n)
         self._obs = obs
         # the carries' product: (m, p L, n) @ V (m, n, S) -> (m, p, L, S)
-        self._obs_mat = np.ascontiguousarray(obs.transpose(0, 2, 1, 3)).reshape(m, p * L, n)
+        self._obs_mat: np.ndarray | None = None  # built when first streamed (`_observation`)
         self._forced = U is not None
         self._k = 0
         if self._forced:
@@ -534,7 +534,15 @@ class OutputStream:
         """``(m, L, S)``: streamed output ``row`` over the blocks whose start states are
         ``carries`` ``(m, n, S)``: sample ``j`` of each block (free response only)."""
         L = self.L
-        return np.matmul(self._obs_mat[:, row * L : (row + 1) * L], carries)
+        return np.matmul(self._observation()[:, row * L : (row + 1) * L], carries)
+
+    def _observation(self) -> np.ndarray:
+        """``(m, p L, n)``: the streamed rows of ``C Φ^j``, row (output, j)."""
+        if self._obs_mat is None:
+            self._obs_mat = np.ascontiguousarray(self._obs.transpose(0, 2, 1, 3)).reshape(
+                self.m, self.p * self.L, self.n
+            )
+        return self._obs_mat
 
     def keep_rows(self, rows) -> None:
         """Stream only these output rows (`final` keeps them all)."""
@@ -586,6 +594,7 @@ class OutputStream:
         under Dask's workers, whose ``MALLOC_TRIM_THRESHOLD_`` is set).
         """
         p, L, N = self.p, self.L, self.N
+        obs = self._observation()
         full = np.empty((self.m, p * L, self.step))
         extra = np.empty_like(full) if self._forced else None
         for i, r0 in enumerate(range(0, self.nb, self.run)):
@@ -595,7 +604,7 @@ class OutputStream:
                 b1 = min(b0 + self.step, r1)
                 S = b1 - b0
                 buf = full if S == self.step else np.empty((self.m, p * L, S))
-                out = np.matmul(self._obs_mat, V[:, :, b0 - r0 : b1 - r0], out=buf)  # (m, p L, S)
+                out = np.matmul(obs, V[:, :, b0 - r0 : b1 - r0], out=buf)  # (m, p L, S)
                 if self._forced:
                     add = extra if S == self.step else np.empty_like(buf)
                     out += np.matmul(self._G_mat, self._window(b0, b1), out=add)
