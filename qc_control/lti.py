@@ -40,6 +40,7 @@ __all__ = [
     "OutputStream",
     "lti_trajectory",
     "lti_solve",
+    "lti_states",
     "memo",
     "array_key",
     "TailBound",
@@ -774,20 +775,35 @@ def lti_solve(method, A, B, T, U, x0, substeps: int = 1, *, uniform: bool = Fals
         T = check_time_grid(T, "T")
         if uniform_step(T) is None:
             raise ValueError("the LTI engine needs a uniformly spaced T (see uniform_step)")
+    x, message = lti_states(tab, A, B, T, U, x0, substeps, stacklevel=3)
+    steps = (T.size - 1) * substeps  # the engine computes every interval at once
+    status = "diverged" if message else "success"
+    n_keep = x.shape[-1]
+    return Solution(T[:n_keep], x, tab.stages * steps, steps, tab, status, message)
+
+
+def lti_states(
+    tab: ButcherTableau, A, B, T, U, x0, substeps: int = 1, *, stacklevel: int = 2
+) -> tuple[np.ndarray, str]:
+    """`lti_solve`'s states and message without the `Solution` (for the responses).
+
+    ``(x, message)``: ``x`` of shape ``(n, N')``, cut before the first
+    non-finite sample (``N' < N``, with a `DivergenceWarning` and the
+    ``message`` saying where; ``''`` when nothing was cut). ``tab``,
+    ``substeps`` and the uniform ``T`` are checked by the caller.
+    """
     x = lti_trajectory(tab, A, B, T, U, np.asarray(x0, dtype=float), substeps)
-    n_keep, status, message = T.size, "success", ""
     # one pass on a good run: a NaN or inf makes the sum non-finite (an overflow
     # of the sum alone sends it to the sample-by-sample check, which finds none)
     with np.errstate(over="ignore", invalid="ignore"):
         suspect = not np.isfinite(x.sum())
     finite = np.isfinite(x).all(axis=0) if suspect else None
-    if finite is not None and not finite.all():
-        n_keep = int(np.argmin(finite))
-        status = "diverged"
-        message = (
-            f"{tab.name}: the state became non-finite after t = {T[n_keep - 1]:.6g}; "
-            f"stopped after {n_keep - 1} of {T.size - 1} intervals"
-        )
-        warnings.warn(message, DivergenceWarning, stacklevel=2)
-    steps = (T.size - 1) * substeps  # the engine computes every interval at once
-    return Solution(T[:n_keep], x[:, :n_keep], tab.stages * steps, steps, tab, status, message)
+    if finite is None or finite.all():
+        return x, ""
+    n_keep = int(np.argmin(finite))
+    message = (
+        f"{tab.name}: the state became non-finite after t = {T[n_keep - 1]:.6g}; "
+        f"stopped after {n_keep - 1} of {T.size - 1} intervals"
+    )
+    warnings.warn(message, DivergenceWarning, stacklevel=stacklevel)
+    return x[:, :n_keep], message

@@ -58,7 +58,7 @@ from .integrate import (
 )
 from .interconnect import compile_interconnect
 from .limits import check_memory
-from .lti import array_key, lti_solve, memo
+from .lti import array_key, lti_states, memo
 from .methods import METHODS, ButcherTableau, get_method
 from .stability import max_stable_step, stability_coefficients, step_is_stable
 
@@ -415,19 +415,24 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
     if opts.engine == "lti" and not uniform:
         raise ValueError("engine='lti' needs a uniformly spaced T")
     if opts.engine == "lti" or (opts.engine == "auto" and uniform and success):
-        with warnings.catch_warnings():
-            if not success:  # the step-size warning already told the user
+        if success:
+            x, cut = lti_states(tab, A, B, T, u_samples, x0, substeps)
+        else:
+            with warnings.catch_warnings():  # the step-size warning already told the user
                 warnings.simplefilter("ignore", DivergenceWarning)
-            sol = lti_solve(tab, A, B, T, u_samples, x0, substeps, uniform=True)
+                x, cut = lti_states(tab, A, B, T, u_samples, x0, substeps)
+        steps = (T.size - 1) * substeps  # the engine computes every interval at once
+        t, nfev, ok = T[: x.shape[-1]], tab.stages * steps, not cut
     else:
         sol = _generic(A, B, T, u_samples, x0, tab, substeps, warn=success)
-    if not sol.success:
-        success, message = False, "; ".join(filter(None, [message, sol.message]))
-    N = sol.t.size
-    x, u = sol.x, u_samples[:, :N]
+        t, x, steps, nfev, cut, ok = sol.t, sol.x, sol.steps, sol.nfev, sol.message, sol.success
+    if not ok:
+        success, message = False, "; ".join(filter(None, [message, cut]))
+    N = t.size
+    u = u_samples[:, :N]
     with np.errstate(over="ignore", invalid="ignore"):
         y = C @ x + D @ u if np.any(u) else C @ x
-    meta.update(t=sol.t, x=x, y=y, u=u, steps=sol.steps, nfev=sol.nfev)
+    meta.update(t=t, x=x, y=y, u=u, steps=steps, nfev=nfev)
     meta.update(success=success, message=message, note=None)
     return meta
 
