@@ -542,7 +542,8 @@ def sweep(
     if U is None and streamed and len(good) > VECTOR_DESIGNS:
         # a free chunk stops once its slowest design has decayed past what its
         # metrics can see (TailBound): chunk designs of like decay together,
-        # slowest mode first (results go back by index, so the order is free)
+        # by their slowest mode's decay rate, fastest first (results go back by
+        # index, so the order is free)
         with np.errstate(invalid="ignore"):
             abscissa = np.linalg.eigvals(batch.A).real.max(axis=-1)
         order = np.argsort(np.nan_to_num(abscissa, nan=np.inf), kind="stable")
