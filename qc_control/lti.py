@@ -22,7 +22,11 @@ over steps or blocks, only over the log2 rounds of the scans.
 from __future__ import annotations
 
 import math
+import threading
 import warnings
+from collections import OrderedDict
+from collections.abc import Callable, Hashable
+from typing import Any
 
 import numpy as np
 
@@ -30,7 +34,52 @@ from .integrate import DivergenceWarning, Solution, check_substeps, check_time_g
 from .methods import ButcherTableau, get_method
 from .stability import stability_coefficients
 
-__all__ = ["step_matrices", "affine_scan", "OutputStream", "lti_trajectory", "lti_solve"]
+__all__ = [
+    "step_matrices",
+    "affine_scan",
+    "OutputStream",
+    "lti_trajectory",
+    "lti_solve",
+    "lti_states",
+    "memo",
+    "array_key",
+    "TailBound",
+]
+
+#: How many step maps (and free-response power tables, eigenvalues) `memo` keeps.
+MEMO_SIZE = 32
+_memo_store: OrderedDict = OrderedDict()
+_memo_lock = threading.Lock()
+
+
+def array_key(a: np.ndarray) -> tuple:
+    """A hashable key for an array's dtype, shape and values (for `memo`)."""
+    a = np.asarray(a)
+    return (a.dtype.str, a.shape, a.tobytes())
+
+
+def memo(key: Hashable, build: Callable[[], Any]) -> Any:
+    """``build()``, remembered under ``key`` (the `MEMO_SIZE` most recent keys).
+
+    Single responses call the engine again and again on one system and grid
+    (a study, a plot, a benchmark); what depends only on ``(A, B, h,
+    method)`` - the step map, the eigenvalues, the free response's power
+    tables - is built once. Arrays built here are made read-only, so a
+    caller cannot change what the next call reads.
+    """
+    with _memo_lock:
+        if key in _memo_store:
+            _memo_store.move_to_end(key)
+            return _memo_store[key]
+    value = build()
+    for v in value if isinstance(value, tuple) else (value,):
+        if isinstance(v, np.ndarray):
+            v.flags.writeable = False
+    with _memo_lock:
+        _memo_store[key] = value
+        while len(_memo_store) > MEMO_SIZE:
+            _memo_store.popitem(last=False)
+    return value
 
 
 def step_matrices(
@@ -86,7 +135,11 @@ def _powers(phi: np.ndarray, L: int) -> np.ndarray:
     k = 1
     while k < L:
         top = min(2 * k, L)
-        P[..., k + 1 : top + 1, :, :] = P[..., 1 : top - k + 1, :, :] @ P[..., k : k + 1, :, :]
+        w = top - k
+        # Φ^{k+i} = Φ^i Φ^k for i = 1..w: the w left factors stacked as one
+        # (w n, n) matrix per design, one product each (not w small ones)
+        left = P[..., 1 : w + 1, :, :].reshape(phi.shape[:-2] + (w * n, n))
+        P[..., k + 1 : top + 1, :, :] = (left @ P[..., k, :, :]).reshape(phi.shape[:-2] + (w, n, n))
         k = top
     return P
 
@@ -100,19 +153,28 @@ def _scan(V: np.ndarray, Q: np.ndarray) -> None:
         d *= 2
 
 
-def _free_response(phi, x0, N, C, time_last):
-    """``x_k = Φ^k x0`` with no recurrence: ``x_{j·nb+b} = (Φ^nb)^j Φ^b x0``.
-
-    Two power tables of ~√N entries and one product, whose result is laid
-    out (signal, j, b), i.e. time-last in time order.
-    """
-    n = phi.shape[-1]
-    batch = phi.shape[:-2]
+def _free_tables(phi: np.ndarray, N: int) -> tuple[np.ndarray, np.ndarray]:
+    """`_free_response`'s power tables: ``Φ^b`` for ``b < nb`` and ``(Φ^nb)^j``
+    for ``j < L`` (``nb ≈ √N``), which depend only on ``Φ`` and ``N``."""
     nb = max(1, math.ceil(math.sqrt(N)))
     L = math.ceil(N / nb)
     Pb = _powers(phi, nb)
-    xb = (Pb[..., :nb, :, :] @ x0[..., None, :, None])[..., 0]  # (..., b, a): Φ^b x0
     Pj = _powers(Pb[..., nb, :, :], L - 1)  # (Φ^nb)^j
+    return Pb[..., :nb, :, :], Pj
+
+
+def _free_response(phi, x0, N, C, time_last, tables=None):
+    """``x_k = Φ^k x0`` with no recurrence: ``x_{j·nb+b} = (Φ^nb)^j Φ^b x0``.
+
+    Two power tables of ~√N entries (`_free_tables`, or ``tables`` built
+    before) and one product, whose result is laid out (signal, j, b), i.e.
+    time-last in time order.
+    """
+    n = phi.shape[-1]
+    batch = phi.shape[:-2]
+    Pb, Pj = _free_tables(phi, N) if tables is None else tables
+    nb, L = Pb.shape[-3], Pj.shape[-3]
+    xb = (Pb @ x0[..., None, :, None])[..., 0]  # (..., b, a): Φ^b x0
     obs = Pj if C is None else C[..., None, :, :] @ Pj  # (..., j, r, a)
     p = obs.shape[-2]
     lhs = np.swapaxes(obs, -3, -2).reshape(batch + (p * L, n))  # rows (r, j)
@@ -120,19 +182,11 @@ def _free_response(phi, x0, N, C, time_last):
     return out if time_last else np.swapaxes(out, -1, -2)
 
 
-def _input_offsets(P, g0, g1, U, N: int, L: int, nb: int) -> np.ndarray:
-    """``Y[b, q] = Σ_{i<=q} Φ^{q-i} (Γ₀ u_{bL+i} + Γ₁ u_{bL+i+1})`` from the input samples.
-
-    With ``k`` inputs (fewer than the ``n`` states) one product of each
-    block's window ``u_{bL} .. u_{bL+L}`` with the ``((L+1)k, L n)`` matrix of
-    ``Φ^{q-r}Γ₀ [r<=q] + Φ^{q+1-r}Γ₁ [1<=r<=q+1]``: ``2(L+1)kn`` flops per step
-    instead of the ``2L n²`` of the Toeplitz product with ``W``.
-    """
-    n, k = P.shape[-1], U.shape[0]
+def _input_matrix(P, g0, g1, L: int) -> np.ndarray:
+    """`_input_offsets`' ``((L+1)k, L n)`` matrix of ``Φ^{q-r}Γ₀ [r<=q] +
+    Φ^{q+1-r}Γ₁ [1<=r<=q+1]``: rows (r, input), columns (q, state)."""
+    n, k = P.shape[-1], g0.shape[-1]
     batch = P.shape[:-3]
-    padded = np.zeros((nb * L + 1, k))
-    padded[:N] = U.T
-    windows = padded[np.arange(nb)[:, None] * L + np.arange(L + 1)].reshape(nb, (L + 1) * k)
     PG0 = P[..., :L, :, :] @ g0[..., None, :, :]  # Φ^i Γ₀: (..., L, n, k)
     PG1 = P[..., :L, :, :] @ g1[..., None, :, :]
     q, r = np.meshgrid(np.arange(L), np.arange(L + 1), indexing="ij")
@@ -140,9 +194,23 @@ def _input_offsets(P, g0, g1, U, N: int, L: int, nb: int) -> np.ndarray:
     lo, hi = r <= q, (r >= 1) & (r <= q + 1)
     E[..., q[lo], r[lo], :, :] += PG0[..., (q - r)[lo], :, :]
     E[..., q[hi], r[hi], :, :] += PG1[..., (q + 1 - r)[hi], :, :]
-    # rows (r, input), columns (q, state)
-    E = np.moveaxis(E, (-4, -3, -2, -1), (-2, -4, -1, -3)).reshape(batch + ((L + 1) * k, L * n))
-    return (windows @ E).reshape(batch + (nb, L, n))
+    return np.moveaxis(E, (-4, -3, -2, -1), (-2, -4, -1, -3)).reshape(batch + ((L + 1) * k, L * n))
+
+
+def _input_offsets(E, U, N: int, L: int, nb: int) -> np.ndarray:
+    """``Y[b, q] = Σ_{i<=q} Φ^{q-i} (Γ₀ u_{bL+i} + Γ₁ u_{bL+i+1})`` from the input samples.
+
+    With ``k`` inputs (fewer than the ``n`` states) one product of each
+    block's window ``u_{bL} .. u_{bL+L}`` with the ``((L+1)k, L n)`` matrix
+    ``E`` (`_input_matrix`): ``2(L+1)kn`` flops per step instead of the
+    ``2L n²`` of the Toeplitz product with ``W``.
+    """
+    k = U.shape[0]
+    n = E.shape[-1] // L
+    padded = np.zeros((nb * L + 1, k))
+    padded[:N] = U.T
+    windows = padded[np.arange(nb)[:, None] * L + np.arange(L + 1)].reshape(nb, (L + 1) * k)
+    return (windows @ E).reshape(E.shape[:-2] + (nb, L, n))
 
 
 def affine_scan(
@@ -153,6 +221,7 @@ def affine_scan(
     block: int = 16,
     C: np.ndarray | None = None,
     time_last: bool = False,
+    tables: tuple | None = None,
 ) -> np.ndarray:
     r"""Solve ``x_0 = x0``, ``x_{k+1} = Φ x_k + W_k`` for k < N-1; return x or C x.
 
@@ -174,6 +243,10 @@ def affine_scan(
     time_last : bool, default False
         Return ``(..., p, N)`` (time last, contiguous per signal) instead
         of ``(..., N, p)``, without a separate transposing copy.
+    tables : tuple, optional
+        ``(P, E)`` built before for this ``Φ`` (and ``Γ``'s) and block
+        length: the powers ``Φ^0 .. Φ^L`` (`_powers`) and, for a tuple
+        ``W``, the input matrix (`_input_matrix`; else None).
 
     Returns
     -------
@@ -204,10 +277,11 @@ def affine_scan(
         return _free_response(phi, x0, N, C, time_last)
     L = max(1, min(block, N - 1))
     nb = -(-(N - 1) // L)
-    P = _powers(phi, L)
+    P, E = tables if tables is not None else (_powers(phi, L), None)
     if isinstance(W, tuple):  # (Γ₀, Γ₁, U): the input's samples, not W = Γ₀u + Γ₁u⁺
         g0, g1, U = W
-        Y = _input_offsets(P, g0, g1, U, N, L, nb)
+        E = _input_matrix(P, g0, g1, L) if E is None else E
+        Y = _input_offsets(E, U, N, L, nb)
     else:
         # Y_{b, q+1} for every block: one product with the block-Toeplitz matrix
         # M[(i, a), (q, c)] = (Φ^{q-i})[c, a] for i <= q (row block i feeds Y_{b, q+1})
@@ -343,7 +417,7 @@ class OutputStream:
         obs = C[:, None] @ P[:, :L]  # C Φ^j: (m, L, p, n)
         self._obs = obs
         # the carries' product: (m, p L, n) @ V (m, n, S) -> (m, p, L, S)
-        self._obs_mat = np.ascontiguousarray(obs.transpose(0, 2, 1, 3)).reshape(m, p * L, n)
+        self._obs_mat: np.ndarray | None = None  # built when first streamed (`_observation`)
         self._forced = U is not None
         self._k = 0
         if self._forced:
@@ -373,6 +447,8 @@ class OutputStream:
                 m, p * L, (L + 1) * k
             )
         self._Q = P[:, L]
+        #: while iterating: the state where the next segment starts (its first block's carry)
+        self.carry: np.ndarray | None = None
         # first pass: the carries segment by segment, keeping only where each
         # segment starts (memory: designs × n × segments, not × blocks)
         starts = np.empty((m, n, -(-nb // self.run) + 1))
@@ -380,9 +456,13 @@ class OutputStream:
         self._gram_K = np.zeros((m, n, n))  # Σ c_b c_bᵀ over the whole blocks b < nb - 1
         b_last, jl = divmod(N - 1, L)
         carry_last = None
+        # with one run, its carries are kept (no second scan while streaming)
+        self._one_run: np.ndarray | None = None
         for i, b0 in enumerate(range(0, nb, self.run)):
             starts[:, :, i] = c
             V = self._carries(c, b0, min(b0 + self.run, nb))
+            if self.run >= nb:
+                self._one_run = V
             upto = min(V.shape[-1] - 1, nb - 1 - b0)
             if upto > 0:
                 self._gram_K += V[:, :, :upto] @ np.swapaxes(V[:, :, :upto], -1, -2)
@@ -417,6 +497,12 @@ class OutputStream:
         )
         return view.reshape((L + 1) * k, b1 - b0)
 
+    def _run_carries(self, i: int, b0: int, b1: int) -> np.ndarray:
+        """Run ``i``'s carries (blocks ``b0 .. b1``), kept or scanned again."""
+        if self._one_run is not None:
+            return self._one_run
+        return self._carries(self._starts[:, :, i], b0, b1)
+
     def _carries(self, c: np.ndarray, b0: int, b1: int) -> np.ndarray:
         """``(m, n, b1 - b0 + 1)``: the carries ``c_{b0} .. c_{b1}`` from ``c = c_{b0}``.
 
@@ -428,12 +514,36 @@ class OutputStream:
         V[:, :, 0] = c
         if self._forced:
             V[:, :, 1:] = np.matmul(self._E_mat, self._window(b0, b1))
-        Q, d = self._Q, 1
-        while d < V.shape[-1]:
-            V[:, :, d:] += Q @ V[:, :, :-d]
+        Q, d, total = self._Q, 1, V.shape[-1]
+        tmp = np.empty_like(V)  # one buffer for every round's product (no fresh pages per round)
+        while d < total:
+            V[:, :, d:] += np.matmul(Q, V[:, :, :-d], out=tmp[:, :, : total - d])
             Q = Q @ Q
             d *= 2
         return V
+
+    def block_carries(self) -> np.ndarray:
+        """``(m, n, nb + 1)``: the state where every block starts (and the last
+        block's end), from the stored run starts (memory: designs × n × blocks)."""
+        out = np.empty((self.m, self.n, self.nb + 1))
+        for i, r0 in enumerate(range(0, self.nb, self.run)):
+            r1 = min(r0 + self.run, self.nb)
+            out[:, :, r0 : r1 + 1] = self._run_carries(i, r0, r1)
+        return out
+
+    def free_samples(self, row: int, carries: np.ndarray) -> np.ndarray:
+        """``(m, L, S)``: streamed output ``row`` over the blocks whose start states are
+        ``carries`` ``(m, n, S)``: sample ``j`` of each block (free response only)."""
+        L = self.L
+        return np.matmul(self._observation()[:, row * L : (row + 1) * L], carries)
+
+    def _observation(self) -> np.ndarray:
+        """``(m, p L, n)``: the streamed rows of ``C Φ^j``, row (output, j)."""
+        if self._obs_mat is None:
+            self._obs_mat = np.ascontiguousarray(self._obs.transpose(0, 2, 1, 3)).reshape(
+                self.m, self.p * self.L, self.n
+            )
+        return self._obs_mat
 
     def keep_rows(self, rows) -> None:
         """Stream only these output rows (`final` keeps them all)."""
@@ -463,34 +573,113 @@ class OutputStream:
         if self._forced:
             raise ValueError("sum_squares is the free response's: this stream has an input")
         L, nb, N = self.L, self.nb, self.N
-        obs = self._obs  # (m, L, p, n): C Φ^j
-        gram = np.einsum("mjra,mjrb->mrab", obs, obs)  # (m, p, n, n)
-        total = np.einsum("mrab,mab->mr", gram, self._gram_K)
+        obs = np.swapaxes(self._obs, 1, 2)  # (m, p, L, n): C Φ^j
+        gram = np.swapaxes(obs, -1, -2) @ obs  # (m, p, n, n)
+        total = (gram * self._gram_K[:, None]).sum(axis=(-2, -1))
         J = (N - 1) - (nb - 1) * L  # samples of the last block before sample N - 1
-        part = np.einsum("mjra,mjrb->mrab", obs[:, :J], obs[:, :J])
+        part = np.swapaxes(obs[:, :, :J], -1, -2) @ obs[:, :, :J]
         c = self._c_partial
-        total += np.einsum("mrab,ma,mb->mr", part, c, c)
+        total += ((part @ c[:, None, :, None])[..., 0] * c[:, None, :]).sum(axis=-1)
         final = self.final.reshape(self.m, -1)
         total += final * final
         return total.reshape(self.batch + (final.shape[-1],))
 
     def __iter__(self):
+        """Yield ``(index, y)`` segment by segment.
+
+        ``y`` is a view of a buffer that the next segment overwrites: reduce it
+        (or copy it) before asking for the next. Reusing the buffers, rather
+        than allocating a segment's outputs (about 1 MB) anew each time, spares
+        the page faults of fresh memory, which cost as much as the products
+        where the allocator hands large blocks back to the system at once (as
+        under Dask's workers, whose ``MALLOC_TRIM_THRESHOLD_`` is set).
+        """
         p, L, N = self.p, self.L, self.N
+        obs = self._observation()
+        full = np.empty((self.m, p * L, self.step))
+        extra = np.empty_like(full) if self._forced else None
         for i, r0 in enumerate(range(0, self.nb, self.run)):
             r1 = min(r0 + self.run, self.nb)
-            V = self._carries(self._starts[:, :, i], r0, r1)
+            V = self._run_carries(i, r0, r1)
             for b0 in range(r0, r1, self.step):
                 b1 = min(b0 + self.step, r1)
                 S = b1 - b0
-                out = np.matmul(self._obs_mat, V[:, :, b0 - r0 : b1 - r0])  # (m, p L, S)
+                buf = full if S == self.step else np.empty((self.m, p * L, S))
+                out = np.matmul(obs, V[:, :, b0 - r0 : b1 - r0], out=buf)  # (m, p L, S)
                 if self._forced:
-                    out += np.matmul(self._G_mat, self._window(b0, b1))
+                    add = extra if S == self.step else np.empty_like(buf)
+                    out += np.matmul(self._G_mat, self._window(b0, b1), out=add)
+                self.carry = V[:, :, b1 - r0]  # the state at sample b1 L
                 index = np.arange(b0, b1)[None, :] * L + np.arange(L)[:, None]  # (L, S)
                 y = out.reshape(self.batch + (p, L, S))
                 if b1 * L > N - 1:  # the last segment: drop the padding past sample N - 2
                     keep = index < N - 1
                     index, y = index[keep], y[..., keep]
                 yield index, y
+
+
+class TailBound:
+    r"""Bounds on every later output of a free recurrence ``x_{k+1} = Φ x_k``.
+
+    With ``Φ = V Λ V⁻¹`` and every ``|λ_i| < 1``,
+
+    .. math::
+
+        y_{K+j,r} = \sum_i (C V)_{ri}\, λ_i^j\, (V^{-1} x_K)_i
+        \;\Rightarrow\;
+        |y_{K+j,r}| \le β_r(x_K) = \sum_i |(C V)_{ri}|\,|(V^{-1} x_K)_i|
+        \quad (j \ge 0),
+
+    the modal expansion of the free response (Kailath, *Linear Systems*,
+    1980, §2.2) with ``|λ_i|^j <= 1``. A mode that decays keeps the bound
+    tight (one lightly damped pair: β is its envelope). The returned bound
+    carries a margin for rounding, ``β (1 + 1e-6) + 1e-12 κ(V) ‖C_r‖₁ ‖x‖∞``
+    (``κ`` the 1-norm condition number of ``V``); a design whose ``Φ`` has an
+    eigenvalue on or outside the unit circle, or whose ``V`` is
+    ill-conditioned (``κ > 1e8``, near-defective), gets ``inf``.
+
+    Parameters
+    ----------
+    phi : array, shape (m, n, n)
+    C : array, shape (m, p, n)
+    """
+
+    def __init__(self, phi: np.ndarray, C: np.ndarray):
+        phi, C = np.asarray(phi, dtype=float), np.asarray(C, dtype=float)
+        m, n = phi.shape[0], phi.shape[-1]
+        ok = np.all(np.isfinite(phi), axis=(-2, -1))
+        lam, V = np.linalg.eig(np.where(ok[:, None, None], phi, 0.0))
+        ok &= np.abs(lam).max(axis=-1) < 1.0
+        with np.errstate(all="ignore"):
+            W = np.linalg.inv(np.where(ok[:, None, None], V, np.eye(n)))
+            # κ₁(V) = ‖V‖₁‖V⁻¹‖₁, the largest column sums
+            cond = np.abs(V).sum(axis=-2).max(axis=-1) * np.abs(W).sum(axis=-2).max(axis=-1)
+        ok &= np.isfinite(cond) & (cond < 1e8)
+        V = np.where(ok[:, None, None], V, np.eye(n))
+        self._W = np.where(ok[:, None, None], W, np.eye(n))
+        # V⁻¹ as real rows [Re; Im], for products with real states
+        self._W_ri = np.concatenate([self._W.real, self._W.imag], axis=1)  # (m, 2n, n)
+        self._a = np.abs(C @ V)  # (m, p, n)
+        self._abs = 1e-12 * np.where(ok, cond, 0.0)[:, None] * np.abs(C).sum(axis=-1)
+        self._ok = ok
+        self.m = m
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """Bounds on ``|y_{k,r}|`` for all ``k >= K`` from ``x = x_K``: ``(m, n)`` gives
+        ``(m, p)``; ``(m, n, S)`` (S states per design) gives ``(m, p, S)``."""
+        n = x.shape[1]
+        if x.ndim == 2:  # one state per design: broadcasting beats m tiny matmuls
+            ri = (self._W_ri * x[:, None, :]).sum(axis=-1)  # (m, 2n)
+            z = np.sqrt(ri[:, :n] ** 2 + ri[:, n:] ** 2)  # |V⁻¹ x| (np.hypot is slower)
+            beta = (self._a * z[:, None, :]).sum(axis=-1) * (1 + 1e-6)
+            beta += self._abs * np.abs(x).max(axis=-1)[:, None]
+            return np.where(self._ok[:, None], beta, np.inf)
+        ri = self._W_ri @ x  # (m, 2n, S)
+        ri *= ri
+        z = np.sqrt(ri[:, :n] + ri[:, n:])
+        beta = (self._a @ z) * (1 + 1e-6)
+        beta += self._abs[..., None] * np.abs(x).max(axis=-2)[:, None, :]
+        return np.where(self._ok[:, None, None], beta, np.inf)
 
 
 def lti_trajectory(
@@ -512,17 +701,35 @@ def lti_trajectory(
     Past the method's stability limit the states overflow to inf or nan
     without a RuntimeWarning; `lti_solve` cuts them off and warns.
     """
-    H = (T[-1] - T[0]) / (T.size - 1)
+    H = float((T[-1] - T[0]) / (T.size - 1))
+    A, B = np.asarray(A, dtype=float), np.asarray(B, dtype=float)
+    key = ("step", method, substeps, H, array_key(A), array_key(B))
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        phi, g_lo, g_hi = step_matrices(method, A, B, H, substeps)
-        W = None
-        if U is not None and U.size and np.any(U):
-            n, k = phi.shape[-1], U.shape[0]
-            # fewer inputs than states: the windows of U carry the input, not W
-            W = (g_lo, g_hi, U) if k < n else U[:, :-1].T @ g_lo.T + U[:, 1:].T @ g_hi.T
-        # Without input there is no block-Toeplitz product, so longer blocks
-        # (fewer scan rounds) win; with input, 16 keeps that product small.
-        return affine_scan(phi, x0, W, T.size, block=16 if W is not None else 32, time_last=True)
+        phi, g_lo, g_hi = memo(key, lambda: step_matrices(method, A, B, H, substeps))
+        if U is None or not U.size or not np.any(U):
+            # the free response: its power tables depend on Φ and N only
+            tables = memo(key + ("free", T.size), lambda: _free_tables(phi, T.size))
+            x0 = np.asarray(x0, dtype=float)
+            if T.size == 1:
+                return x0[:, None].copy()
+            return _free_response(phi, x0, T.size, None, True, tables)
+        n, k = phi.shape[-1], U.shape[0]
+        # with input, blocks of 16 keep the block-Toeplitz product small
+        L = max(1, min(16, T.size - 1))
+        if k < n:  # fewer inputs than states: the windows of U carry the input, not W
+            W: tuple | np.ndarray = (g_lo, g_hi, U)
+
+            def build():
+                P = _powers(phi, L)
+                return P, _input_matrix(P, g_lo, g_hi, L)
+        else:
+            W = U[:, :-1].T @ g_lo.T + U[:, 1:].T @ g_hi.T
+
+            def build():
+                return _powers(phi, L), None
+
+        tables = memo(key + ("forced", L, k < n), build)
+        return affine_scan(phi, x0, W, T.size, block=L, time_last=True, tables=tables)
 
 
 def lti_solve(method, A, B, T, U, x0, substeps: int = 1, *, uniform: bool = False) -> Solution:
@@ -568,16 +775,35 @@ def lti_solve(method, A, B, T, U, x0, substeps: int = 1, *, uniform: bool = Fals
         T = check_time_grid(T, "T")
         if uniform_step(T) is None:
             raise ValueError("the LTI engine needs a uniformly spaced T (see uniform_step)")
-    x = lti_trajectory(tab, A, B, T, U, np.asarray(x0, dtype=float), substeps)
-    finite = np.isfinite(x).all(axis=0)
-    n_keep, status, message = T.size, "success", ""
-    if not finite.all():
-        n_keep = int(np.argmin(finite))
-        status = "diverged"
-        message = (
-            f"{tab.name}: the state became non-finite after t = {T[n_keep - 1]:.6g}; "
-            f"stopped after {n_keep - 1} of {T.size - 1} intervals"
-        )
-        warnings.warn(message, DivergenceWarning, stacklevel=2)
+    x, message = lti_states(tab, A, B, T, U, x0, substeps, stacklevel=3)
     steps = (T.size - 1) * substeps  # the engine computes every interval at once
-    return Solution(T[:n_keep], x[:, :n_keep], tab.stages * steps, steps, tab, status, message)
+    status = "diverged" if message else "success"
+    n_keep = x.shape[-1]
+    return Solution(T[:n_keep], x, tab.stages * steps, steps, tab, status, message)
+
+
+def lti_states(
+    tab: ButcherTableau, A, B, T, U, x0, substeps: int = 1, *, stacklevel: int = 2
+) -> tuple[np.ndarray, str]:
+    """`lti_solve`'s states and message without the `Solution` (for the responses).
+
+    ``(x, message)``: ``x`` of shape ``(n, N')``, cut before the first
+    non-finite sample (``N' < N``, with a `DivergenceWarning` and the
+    ``message`` saying where; ``''`` when nothing was cut). ``tab``,
+    ``substeps`` and the uniform ``T`` are checked by the caller.
+    """
+    x = lti_trajectory(tab, A, B, T, U, np.asarray(x0, dtype=float), substeps)
+    # one pass on a good run: a NaN or inf makes the sum non-finite (an overflow
+    # of the sum alone sends it to the sample-by-sample check, which finds none)
+    with np.errstate(over="ignore", invalid="ignore"):
+        suspect = not np.isfinite(x.sum())
+    finite = np.isfinite(x).all(axis=0) if suspect else None
+    if finite is None or finite.all():
+        return x, ""
+    n_keep = int(np.argmin(finite))
+    message = (
+        f"{tab.name}: the state became non-finite after t = {T[n_keep - 1]:.6g}; "
+        f"stopped after {n_keep - 1} of {T.size - 1} intervals"
+    )
+    warnings.warn(message, DivergenceWarning, stacklevel=stacklevel)
+    return x[:, :n_keep], message

@@ -381,6 +381,16 @@ class MetricStream:
         self.labels = tuple(sorted(str(x) for x in labels - {WEIGHTED_ACC}))
         self._acc: dict = {}
         self._given: set = set()
+        self._scratch: dict = {}
+
+    def _buffer(self, shape, dtype=float) -> np.ndarray:
+        """A scratch array, reused from piece to piece: fresh memory for every
+        piece's temporaries costs page faults comparable to the arithmetic."""
+        key = (tuple(shape), np.dtype(dtype).str)
+        buf = self._scratch.get(key)
+        if buf is None:
+            buf = self._scratch[key] = np.empty(shape, dtype)
+        return buf
 
     @staticmethod
     def supports(items, roles: SignalRoles) -> bool:
@@ -396,14 +406,56 @@ class MetricStream:
             return False
         return True
 
-    def only_mean_square(self, label: str) -> bool:
-        """Whether the metrics read ``label`` only through its mean square."""
-        kinds = {
+    def kinds(self, label: str) -> set[str]:
+        """The reductions the metrics read of ``label`` (``'sumsq'``, ``'peak'``, ...)."""
+        return {
             kind
             for kind, key in self.needs
             if (self.roles.corners[key].tire_defl if isinstance(key, int) else key) == label
         }
-        return kinds == {"sumsq"}
+
+    def only_mean_square(self, label: str) -> bool:
+        """Whether the metrics read ``label`` only through its mean square."""
+        return self.kinds(label) == {"sumsq"}
+
+    def settled(self, bound: Mapping[str, np.ndarray], *, band: bool = True) -> np.ndarray:
+        """Per design, ``(m,)``: whether no later sample can change a reduction,
+        given that every later sample of each streamed label satisfies
+        ``|v| <= bound[label]`` (e.g. `qc_control.lti.TailBound`).
+
+        A peak stays when ``bound <= peak``; a lift-off count when ``bound <=``
+        the threshold (no later ``v`` exceeds it); the settling time when
+        ``(bound + |final|)(1 + 1e-12) <= 0.02 M`` with ``M`` the largest
+        excursion from the final value so far (no later deviation is outside
+        the band, and ``M`` does not grow; the factor covers the rounding of
+        ``v - final``); with ``band=False`` only ``M`` must be final
+        (``(bound + |final|)(1 + 1e-12) <= M``), the last sample outside the
+        band being found otherwise (`settling_state`, `set_last_outside`).
+        Sums of squares and fourth powers need every sample,
+        unless given in closed form (`start`'s ``sums``). Call after the
+        first `update`.
+        """
+        acc = self._acc
+        m = len(next(iter(self._final.values()))) if self._final else 0
+        ok = np.ones(m, dtype=bool)
+        for kind, key in self.needs:
+            label = self.roles.corners[key].tire_defl if isinstance(key, int) else str(key)
+            if kind == "sumsq" and label in self._given:
+                continue
+            if kind in ("sumsq", "quartic"):
+                return np.zeros(m, dtype=bool)
+            b = bound[label]
+            if kind == "peak":
+                here = b <= acc[("peak", key)]
+            elif kind == "lifted" and isinstance(key, int):
+                here = b <= _lift_threshold(self, key)
+            elif kind == "settle":
+                reach = (b + np.abs(self._final[label])) * (1 + 1e-12)
+                here = reach <= (0.02 if band else 1.0) * acc[("settle_max", label)]
+            else:  # pragma: no cover - every kind is listed above
+                raise AssertionError(kind)
+            ok &= here
+        return ok
 
     def start(self, final: Mapping[str, np.ndarray], sums=None) -> None:
         """Begin: each signal's last sample; optionally ``{label: (Σ v², v_0)}``
@@ -436,13 +488,15 @@ class MetricStream:
             if kind == "sumsq":
                 acc[(kind, key)] = acc.get((kind, key), 0.0) + np.vecdot(v, v)
             elif kind == "quartic":
-                v2 = v * v
+                v2 = np.multiply(v, v, out=self._buffer(v.shape))
                 acc[(kind, key)] = acc.get((kind, key), 0.0) + np.vecdot(v2, v2)
             elif kind == "peak":
                 top = np.maximum(v.max(axis=-1), -v.min(axis=-1))
                 acc[(kind, key)] = np.maximum(acc[(kind, key)], top) if (kind, key) in acc else top
             elif kind == "lifted" and isinstance(key, int):
-                over = v > _lift_threshold(self, key)[..., None]
+                over = np.greater(
+                    v, _lift_threshold(self, key)[..., None], out=self._buffer(v.shape, bool)
+                )
                 acc[(kind, key)] = acc.get((kind, key), 0) + np.count_nonzero(over, axis=-1)
 
     def _settle(self, label: str, v: np.ndarray, index: np.ndarray) -> None:
@@ -452,7 +506,10 @@ class MetricStream:
         occurs is itself outside, and after it the threshold no longer moves."""
         acc = self._acc
         final = self._final[label]
-        dev = np.abs(v - final.reshape(final.shape + (1,) * index.ndim))
+        dev = np.subtract(
+            v, final.reshape(final.shape + (1,) * index.ndim), out=self._buffer(v.shape)
+        )
+        np.abs(dev, out=dev)
         m = dev.shape[0]
         if index.ndim == 2:  # (L, S) blocks: find the last block column outside, then the sample
             cols = dev.max(axis=-2)  # (m, S)
@@ -474,6 +531,15 @@ class MetricStream:
         prev = acc.get(("settle", label), np.full(M.shape, -1))
         acc[("settle_max", label)] = M
         acc[("settle", label)] = np.maximum(prev, last)
+
+    def settling_state(self, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """``(final, M)``: the final value and the largest excursion from it so far."""
+        return self._final[label], self._acc[("settle_max", label)]
+
+    def set_last_outside(self, label: str, last: np.ndarray) -> None:
+        """Set the settling time's last sample outside the band (-1: none), found
+        by a search of its own (`qc_control.sweeps`' backward search)."""
+        self._acc[("settle", label)] = np.asarray(last)
 
     def _ends(self, label):
         return self._acc[("first", label)], self._final[label]

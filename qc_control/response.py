@@ -59,7 +59,7 @@ from .integrate import (
 )
 from .interconnect import compile_interconnect
 from .limits import check_memory
-from .lti import lti_solve
+from .lti import array_key, lti_states, memo
 from .methods import METHODS, ButcherTableau, get_method
 from .stability import max_stable_step, stability_coefficients, step_is_stable
 
@@ -380,7 +380,11 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
     H = float(np.diff(T).max())
     # eigenvalues as computed: the stability functions settle those that rounding
     # moved off the imaginary axis (qc_control.stability, MARGINAL_RTOL)
-    eig = np.linalg.eigvals(A) if A.size else np.empty(0, complex)
+    eig = (
+        memo(("eig", array_key(A)), lambda: np.linalg.eigvals(A))
+        if A.size
+        else np.empty(0, complex)
+    )
     substeps, step_rule = opts.substeps, None
     if auto:
         h_rule, step_rule = auto_step(tab, eig)
@@ -399,7 +403,8 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
     success, message = True, ""
     # The trajectory grows iff the step map R(hA) amplifies a mode; the full
     # root-finding for h_max runs only to word the warning (or when asked).
-    if not step_is_stable(tab, h, eig):
+    stable = memo(("stable", tab, h, array_key(A)), lambda: step_is_stable(tab, h, eig))
+    if not stable:
         h_max = max_stable_step(tab, eig)
         success = False
         message = (
@@ -411,19 +416,24 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
     if opts.engine == "lti" and not uniform:
         raise ValueError("engine='lti' needs a uniformly spaced T")
     if opts.engine == "lti" or (opts.engine == "auto" and uniform and success):
-        with warnings.catch_warnings():
-            if not success:  # the step-size warning already told the user
+        if success:
+            x, cut = lti_states(tab, A, B, T, u_samples, x0, substeps)
+        else:
+            with warnings.catch_warnings():  # the step-size warning already told the user
                 warnings.simplefilter("ignore", DivergenceWarning)
-            sol = lti_solve(tab, A, B, T, u_samples, x0, substeps, uniform=True)
+                x, cut = lti_states(tab, A, B, T, u_samples, x0, substeps)
+        steps = (T.size - 1) * substeps  # the engine computes every interval at once
+        t, nfev, ok = T[: x.shape[-1]], tab.stages * steps, not cut
     else:
         sol = _generic(A, B, T, u_samples, x0, tab, substeps, warn=success)
-    if not sol.success:
-        success, message = False, "; ".join(filter(None, [message, sol.message]))
-    N = sol.t.size
-    x, u = sol.x, u_samples[:, :N]
+        t, x, steps, nfev, cut, ok = sol.t, sol.x, sol.steps, sol.nfev, sol.message, sol.success
+    if not ok:
+        success, message = False, "; ".join(filter(None, [message, cut]))
+    N = t.size
+    u = u_samples[:, :N]
     with np.errstate(over="ignore", invalid="ignore"):
         y = C @ x + D @ u if np.any(u) else C @ x
-    meta.update(t=sol.t, x=x, y=y, u=u, steps=sol.steps, nfev=sol.nfev)
+    meta.update(t=t, x=x, y=y, u=u, steps=steps, nfev=nfev)
     meta.update(success=success, message=message, note=None)
     return meta
 
@@ -599,27 +609,7 @@ def _forced(
                 stacklevel=_stacklevel(),
             )
     ss = _as_statespace(sys)
-    if T is None:
-        raise ValueError("Parameter `T` is mandatory for continuous time systems.")
-    T = np.asarray(T)
-    if transpose:
-        T = T.T
-    if T.ndim == 2 and 1 in T.shape:
-        T = T.reshape(-1)
-    T = check_time_grid(T, "T")
-    # states, outputs and inputs over T, with the engines' working copies
-    n, p, m = ss.nstates, ss.noutputs, ss.ninputs
-    check_memory(
-        8.0 * T.size * (3 * n + 2 * p + m + 2),
-        f"a fixed-step response of {ss.name!r} on {T.size} samples",
-        "use fewer samples (a coarser T; substeps refine the step without storing it)",
-    )
-    x0 = check_initial_state(X0, ss.nstates)
-    u = np.asarray(0.0 if U is None else U)
-    if transpose and u.ndim == 2:
-        u = u.T
-    u = check_input_samples(u, ss.ninputs, T.size)
-    run = _simulate(ss, T, u, x0, opts, auto)
+    run = _linear_run(ss, T, U, X0, transpose, opts, auto)
     resp = FixedStepResponse(
         run["t"],
         run["y"],
@@ -642,6 +632,32 @@ def _forced(
     )
     resp = _set_meta(resp, run)
     return resp if inner else _finalise(resp)
+
+
+def _linear_run(ss, T, U, X0, transpose, opts, auto) -> dict:
+    """Check ``T``, ``U`` and ``X0`` for a continuous-time StateSpace and simulate it
+    (`_simulate`): the run's record, which the responses wrap."""
+    if T is None:
+        raise ValueError("Parameter `T` is mandatory for continuous time systems.")
+    T = np.asarray(T)
+    if transpose:
+        T = T.T
+    if T.ndim == 2 and 1 in T.shape:
+        T = T.reshape(-1)
+    T = check_time_grid(T, "T")
+    # states, outputs and inputs over T, with the engines' working copies
+    n, p, m = ss.nstates, ss.noutputs, ss.ninputs
+    check_memory(
+        8.0 * T.size * (3 * n + 2 * p + m + 2),
+        f"a fixed-step response of {ss.name!r} on {T.size} samples",
+        "use fewer samples (a coarser T; substeps refine the step without storing it)",
+    )
+    x0 = check_initial_state(X0, ss.nstates)
+    u = np.asarray(0.0 if U is None else U)
+    if transpose and u.ndim == 2:
+        u = u.T
+    u = check_input_samples(u, ss.ninputs, T.size)
+    return _simulate(ss, T, u, x0, opts, auto)
 
 
 def _title(kind: str, name: str) -> str:
@@ -900,14 +916,28 @@ def initial_response(
 
 
 def _initial(sys, T, auto, X0, output, params, transpose, return_x, squeeze, opts):
-    response = _forced(sys, T, 0, X0, False, params, False, None, None, opts, auto, inner=True)
+    if isinstance(sys, control.StateSpace) and control.isctime(sys, strict=True):
+        # the fast path: the run's arrays go into one response, not two
+        run = _linear_run(sys, T, 0, X0, False, opts, auto)
+        t, y, x = run["t"], run["y"], run["x"]
+        success, message = run["success"], run["message"] or None
+    else:
+        response = _forced(sys, T, 0, X0, False, params, False, None, None, opts, auto, inner=True)
+        t, y, x, success, message = (
+            response.t,
+            response.y,
+            response.x,
+            response.success,
+            response.message,
+        )
+        run = _meta_of(response)
     issiso = sys.issiso() or output is not None
-    yout = response.y if output is None else response.y[output]
+    yout = y if output is None else y[output]
     output_labels = sys.output_labels if output is None else sys.output_labels[output]
     resp = FixedStepResponse(
-        response.t,
+        t,
         yout,
-        response.x,
+        x,
         None,
         params=params,
         issiso=issiso,
@@ -920,14 +950,10 @@ def _initial(sys, T, auto, X0, output, params, transpose, return_x, squeeze, opt
         transpose=transpose,
         return_x=return_x,
         squeeze=squeeze,
-        success=response.success,
-        message=response.message,
+        success=success,
+        message=message,
     )
-    resp.__dict__.update({k: getattr(response, k) for k in _META})
-    return _finalise(resp)
-
-
-_META = ("method", "h", "substeps", "steps", "nfev", "step_rule", "note", "_eigenvalues")
+    return _finalise(_set_meta(resp, run))
 
 
 def _single_index(index, what: str):

@@ -16,7 +16,7 @@ from tqdm.auto import tqdm
 from .integrate import check_substeps, check_time_grid, uniform_step
 from .iso2631 import wk_discrete
 from .limits import check_memory
-from .lti import OutputStream, affine_scan, step_matrices
+from .lti import OutputStream, TailBound, affine_scan, step_matrices
 from .methods import ButcherTableau, get_method
 from .metrics import (
     METRICS,
@@ -32,7 +32,25 @@ from .spectral import SPECTRAL_METRICS, ISO8608Road, spectral_metrics
 from .stability import step_is_stable
 from .vehicle import BatchedModel, SignalRoles, VehicleModel
 
-__all__ = ["sweep", "SweepResult", "SweepChunk", "METRICS", "DEFAULT_METRICS", "design_grid"]
+__all__ = [
+    "sweep",
+    "SweepResult",
+    "SweepChunk",
+    "METRICS",
+    "DEFAULT_METRICS",
+    "design_grid",
+    "DASK_WORKER_ENV",
+]
+
+#: Environment for Dask workers that run sweeps (glibc's allocator). Dask's
+#: nanny sets ``MALLOC_TRIM_THRESHOLD_=65536``, which also fixes the size above
+#: which blocks are mapped afresh at 128 kB: every chunk's megabyte-sized
+#: arrays then come back as new pages, and their page faults doubled a road
+#: sweep's CPU time (benchmarks/RESULTS.md). These keep blocks below 32 MB in
+#: the heap and return memory to the system past 128 MB free. Give them to a
+#: `LocalCluster` with ``dask.config.set({"distributed.nanny.pre-spawn-environ":
+#: {**default, **DASK_WORKER_ENV}})``, or to any worker's environment.
+DASK_WORKER_ENV = {"MALLOC_TRIM_THRESHOLD_": 2**27, "MALLOC_MMAP_THRESHOLD_": 2**25}
 
 #: The columns a sweep of the quarter car computes unless told otherwise
 #: (`qc_control.metrics.SWEEP_METRICS`).
@@ -265,12 +283,12 @@ def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps
         g1 = np.pad(g1, ((0, 0), (0, nw), (0, 0)))
         read.append(WEIGHTED_ACC)
     with np.errstate(over="ignore", invalid="ignore"):
-        sums = None
+        sums, tail = None, None
         if U is None:  # longer blocks: no input Toeplitz to pay for, fewer scan rounds
             out = OutputStream(phi, x0, T.size, C, block=64)
-            # a signal read only through its mean square needs no samples: its
-            # sum of squares is the block Gram form (OutputStream.sum_squares)
-            gram = [i for i, label in enumerate(read) if stream.only_mean_square(label)]
+            # every sum of squares of the free response is the block Gram form
+            # (OutputStream.sum_squares): no samples needed for it
+            gram = [i for i, label in enumerate(read) if "sumsq" in stream.kinds(label)]
             if gram:
                 total = out.sum_squares()
                 first = np.einsum("mra,ma->mr", C, x0)  # y_0 = C x0
@@ -279,17 +297,75 @@ def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps
             out = OutputStream(phi, x0, T.size, C, D=D, g0=g0, g1=g1, U=U, block=16)
         final = {label: out.final[:, i] for i, label in enumerate(read)}
         stream.start(final, sums)
-        rows = [i for i, label in enumerate(read) if sums is None or label not in sums]
+        rows = [
+            i
+            for i, label in enumerate(read)
+            if stream.kinds(label) - ({"sumsq"} if sums and label in sums else set())
+        ]
         if len(rows) < len(read):
             out.keep_rows(rows)
         streamed = [read[i] for i in rows]
+        if U is None and streamed:
+            # the free response decays: once no later sample can move a peak, a
+            # lift-off count or the settling time (TailBound, the modal bound on
+            # every later output), the rest of the samples are not needed
+            tail = TailBound(phi, C[:, rows])
+        cut = False
         for index, y in out:
             stream.update(index, {label: y[:, i] for i, label in enumerate(streamed)})
+            if tail is not None and out.carry is not None:
+                bound = tail(out.carry)
+                done = stream.settled(
+                    {label: bound[:, i] for i, label in enumerate(streamed)}, band=False
+                )
+                if done.all():
+                    cut = True
+                    break
+        if cut and tail is not None:
+            settling = [i for i, label in enumerate(streamed) if "settle" in stream.kinds(label)]
+            if settling:
+                carries = out.block_carries()
+                for i in settling:
+                    end, M = stream.settling_state(streamed[i])
+                    last = _last_outside(out, tail, carries, i, end, 0.02 * M, T.size)
+                    stream.set_last_outside(streamed[i], last)
         stream.update(np.array([T.size - 1]), {k: v[:, None] for k, v in final.items()})
         result = {"stable": step_is_stable(method, H / substeps, np.linalg.eigvals(A))}
         for column, values in stream.result().items():
             result[column] = values
     return result
+
+
+def _last_outside(out: OutputStream, tail: TailBound, carries, row, final, band, N, width=8):
+    """Per design, the last sample ``k < N - 1`` with ``|y_k - final| > band``
+    (-1 if none) of a free response's streamed output ``row``, searched
+    backwards: from the first block after which `TailBound` proves every
+    sample inside the band, ``width`` blocks at a time towards the start.
+    The same samples, from the same block carries and products, as the
+    forward stream (`qc_control.metrics.MetricStream` finds the same index
+    going forwards; the test suite checks both against whole trajectories).
+    """
+    m, L = carries.shape[0], out.L
+    nb = carries.shape[-1] - 1
+    reach = (tail(carries)[:, row] + np.abs(final)[:, None]) * (1 + 1e-12)  # (m, nb + 1)
+    quiet = reach <= band[:, None]  # nothing outside from this block's start on
+    hi = np.where(quiet.any(axis=-1), np.argmax(quiet, axis=-1), nb)  # blocks < hi to search
+    last = np.full(m, -1)
+    todo = hi > 0
+    designs = np.arange(m)[:, None]
+    while todo.any():
+        lo = hi - width
+        blocks = lo[:, None] + np.arange(width)  # (m, width), some before block 0
+        c = carries[designs, :, np.clip(blocks, 0, nb)]  # (m, width, n)
+        y = out.free_samples(row, np.swapaxes(c, -1, -2))  # (m, L, width)
+        k = blocks[:, None, :] * L + np.arange(L)[None, :, None]  # sample numbers
+        dev = np.abs(y - final[:, None, None])
+        outside = (dev > band[:, None, None]) & (blocks[:, None, :] >= 0) & (k < N - 1)
+        found = todo & outside.any(axis=(1, 2))
+        last[found] = np.where(outside, k, -1).max(axis=(1, 2))[found]
+        todo &= ~found & (lo > 0)
+        hi = lo
+    return last
 
 
 def _outputs_read(metric_items, roles: SignalRoles, labels: tuple[str, ...]) -> tuple[str, ...]:
@@ -483,8 +559,17 @@ def sweep(
         if good
         else BatchedModel(*(np.zeros((0, 1, 1)),) * 4, (), ())
     )
+    order = np.arange(len(good))
+    if U is None and streamed and len(good) > VECTOR_DESIGNS:
+        # a free chunk stops once its slowest design has decayed past what its
+        # metrics can see (TailBound): chunk designs of like decay together,
+        # by their slowest mode's decay rate, fastest first (results go back by
+        # index, so the order is free)
+        with np.errstate(invalid="ignore"):
+            abscissa = np.linalg.eigvals(batch.A).real.max(axis=-1)
+        order = np.argsort(np.nan_to_num(abscissa, nan=np.inf), kind="stable")
     chunks = [
-        (good[s : s + chunk_size], slice(s, s + chunk_size))
+        ([good[i] for i in order[s : s + chunk_size]], order[s : s + chunk_size])
         for s in range(0, len(good), chunk_size)
     ]
     args = (tuple(sys_.output_labels), model.roles, T, X0, U, tab, substeps, metric_items, states)

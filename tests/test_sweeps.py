@@ -8,6 +8,8 @@ import pytest
 
 import qc_control as qc
 from qc_control import road
+from qc_control.lti import OutputStream, TailBound, step_matrices
+from qc_control.methods import get_method
 from qc_control.ride import ride_metrics
 from qc_control.sweeps import DEFAULT_METRICS, METRICS, design_grid, sweep
 
@@ -269,3 +271,72 @@ def test_a_chunk_larger_than_the_vector_unit_is_split_and_reassembled():
     np.testing.assert_allclose(big.metrics[cols], small.metrics[cols], rtol=1e-13)
     streamed = sweep(grid, Ts, X0, chunk_size=100, progress=False).metrics
     np.testing.assert_allclose(streamed[cols], small.metrics[cols], rtol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "X0, names",
+    [
+        ((0.0, 0.0, 0.05, 0.0), None),
+        ((0.0, 0.0, 0.3, -0.05), None),
+        # the Wk filter's state rides in the scan: the bound covers it too (no VDV:
+        # a sum of fourth powers needs every sample, so that sweep is not cut)
+        ((0.0, 0.0, 0.3, -0.05), [n for n in METRICS if n != "vdv"]),
+    ],
+)
+def test_free_sweep_cut_short_equals_materialised(X0, names, monkeypatch):
+    """A free sweep stops streaming once `TailBound` proves no later sample can
+    move a peak, a lift-off count or the largest excursion, and finds the
+    settling time's last sample outside the band by a backward search. On a
+    grid from barely damped (still ringing at 10 s) to overdamped, and a
+    release from 30 cm that lifts the wheel: the default metrics equal those
+    of the whole trajectories (states=True) to 1e-12 relative (regrouped sums
+    of squares), and the settling time and lift-off duration exactly (the
+    same samples, compared with the same thresholds)."""
+    grid = {"ks": [1.5e4, 4.5e4], "zeta": [0.02, 0.1, 0.3, 0.6, 1.5], "mu": [30.0, 60.0]}
+    T10 = np.linspace(0, 10, 10001)
+    whole = sweep(grid, T10, X0, metrics=names, states=True, progress=False).metrics
+    searched = []  # chunks cut short: their settling time comes from the backward search
+    carries = OutputStream.block_carries
+    monkeypatch.setattr(
+        OutputStream, "block_carries", lambda self: searched.append(1) or carries(self)
+    )
+    streamed = sweep(grid, T10, X0, metrics=names, chunk_size=4, progress=False).metrics
+    assert searched
+    for column in whole.columns[7:-1]:
+        expected = whole[column].to_numpy(float)
+        np.testing.assert_allclose(streamed[column].to_numpy(float), expected, rtol=1e-12)
+    for column in ("settling_time [s]", "lift_off_duration [s]"):
+        assert (streamed[column] == whole[column]).all(), column
+    # the cases this covers: designs settled early and late, and lift-off
+    settle = whole["settling_time [s]"]
+    assert settle.min() < 2.0 and settle.max() > 8.0
+    if X0[2] > 0.1:
+        assert (whole["lift_off_duration [s]"] > 0).any()
+
+
+def test_tail_bound_bounds_every_later_output():
+    """`TailBound`'s modal bound against the outputs themselves: for stable step
+    maps (the car's RK4 map, and random ones with |λ| < 1), every later
+    |y_k| is at most the bound from x_K, and the bound is finite; a map with
+    |λ| >= 1 gets inf (no claim)."""
+    rng = np.random.default_rng(3)
+    phis = []
+    for params in (qc.QuarterCarParams(), qc.QuarterCarParams(ks=4.5e4, zeta=0.05)):
+        A = np.asarray(qc.quarter_car(params).A)
+        phis.append(step_matrices(get_method("rk4"), A, np.zeros((4, 1)), 1e-3)[0])
+    for _ in range(4):
+        Q = rng.standard_normal((4, 4))
+        phis.append(0.97 * Q / np.max(np.abs(np.linalg.eigvals(Q))))
+    phis.append(np.diag([1.0, 0.5, 0.2, 0.1]))  # a mode that does not decay
+    phi = np.array(phis)
+    C = rng.standard_normal((len(phis), 3, 4))
+    bound = TailBound(phi, C)
+    x = rng.standard_normal((len(phis), 4))
+    K = 0
+    for k in range(3000):
+        if k % 500 == 0:
+            beta, K = bound(x), k
+        y = np.abs((C @ x[..., None])[..., 0])
+        assert np.all(y[:-1] <= beta[:-1]), (k, K)
+        x = (phi @ x[..., None])[..., 0]
+    assert np.all(np.isfinite(beta[:-1])) and np.all(np.isinf(beta[-1]))
