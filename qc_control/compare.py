@@ -1004,6 +1004,13 @@ class NonlinearStudy:
     t_events, event_labels
         Where the reference's switching functions changed sign [s] and
         which (e.g. ``'contact'``: the wheel leaving or regaining the road).
+    event_signs : tuple of int
+        The sign each switching function has just after its event (+1 or
+        -1): for ``'contact'`` -1 is contact lost, +1 regained; for a stop
+        -1 is engaged, +1 released.
+    airborne : tuple of (float, float)
+        The reference's flights: each ``(contact lost, contact regained)``
+        [s], the second NaN when the wheel is still in the air at the end.
     method_events : dict
         Per method, ``(t_events, event_labels)`` of its run at h with events.
     convergence : pandas.DataFrame
@@ -1039,6 +1046,8 @@ class NonlinearStudy:
     switching_labels: tuple[str, ...]
     t_events: np.ndarray
     event_labels: tuple[str, ...]
+    event_signs: tuple[int, ...]
+    airborne: tuple[tuple[float, float], ...]
     method_events: dict
     convergence: pd.DataFrame
     orders: pd.DataFrame
@@ -1133,6 +1142,28 @@ def _linearization(sys, params) -> tuple[control.StateSpace, ModalAnalysis, str]
             "so the modes named are the passive car's."
         )
     return lin, modes, note
+
+
+def _event_signs(sys, T, X0, U, ref: NonlinearReference, switching) -> tuple:
+    """Each event's new sign (from the signs at T[0], flipped per crossing), and flights."""
+    if not switching:
+        return (), ()
+    u0 = np.zeros(sys.ninputs) if U is None else U[:, 0]
+    start = np.sign(np.atleast_1d(sys.switching(T[0], X0, u0, getattr(sys, "params", {}))))
+    sign = {label: int(v) or 1 for label, v in zip(switching, start)}
+    signs, flights, lost = [], [], math.nan
+    for t, label in zip(ref.t_events, ref.event_labels):
+        sign[label] = -sign.get(label, 1)
+        signs.append(sign[label])
+        if label == "contact":
+            if sign[label] < 0:
+                lost = float(t)
+            elif not math.isnan(lost):
+                flights.append((lost, float(t)))
+                lost = math.nan
+    if not math.isnan(lost):
+        flights.append((lost, math.nan))
+    return tuple(signs), tuple(flights)
 
 
 def _run_nonlinear(sys, T, X0, U, tab, substeps, events: bool):
@@ -1352,11 +1383,14 @@ def _compare_nonlinear(
     if U is not None and roads and list(sys.input_labels) == roads:
         ride, ride_error = ride_comparison(reference, responses, model)
     parting, gap = _parting(responses, sys, model, T)
+    signs, flights = _event_signs(sys, T, X0, U, ref, switching)
     study = NonlinearStudy(
         events=events,
         switching_labels=switching,
         t_events=ref.t_events,
         event_labels=ref.event_labels,
+        event_signs=signs,
+        airborne=flights,
         method_events=method_events,
         convergence=long,
         orders=order_frame,

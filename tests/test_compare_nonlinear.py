@@ -228,3 +228,41 @@ def test_nonlinear_reference_names_its_events():
     assert ref.event_labels == ("contact", "contact")
     assert ref.state_accuracy.shape == (4,)
     assert np.max(ref.state_accuracy) == pytest.approx(ref.accuracy * np.max(np.abs(ref.x)))
+
+
+# ---------------------------------------------------------------- the report
+
+
+def test_report_has_the_nonlinear_section(lift_off):
+    from qc_control.report import build_blocks, figure_specs
+    from qc_control.report.document import fmt, to_markdown
+
+    md = to_markdown("t", build_blocks(lift_off))
+    nl = lift_off.nonlinear
+    assert "Nonlinear system: events and order" in md
+    # the contact times, the orders both ways, the reference's own accuracy, the parting
+    for t in nl.t_events:
+        assert fmt(t) in md
+    assert "contact lost (the wheel leaves the road)" in md
+    assert fmt(nl.orders.loc["rk4", "with events"]) in md
+    assert fmt(nl.orders.loc["rk4", "without events"]) in md
+    assert f"by at most {fmt(lift_off.reference_error)} m in displacement" in md
+    assert f"They part at t = {fmt(nl.parting['from [s]'])} s" in md
+    assert "linearisation at the static equilibrium" in md
+    # the section's figures have labelled axes with SI units
+    specs = {spec.name: spec for spec in figure_specs(lift_off)}
+    for name in ("events_convergence.png", "parting.png"):
+        fig = specs[name].make()
+        axes = [ax for ax in fig.axes if ax.get_ylabel()]
+        assert axes and all("[" in ax.get_ylabel() for ax in axes), name
+        assert "[s]" in fig.axes[-1].get_xlabel()
+
+
+@pytest.mark.slow
+def test_write_report_of_a_nonlinear_comparison(lift_off, tmp_path):
+    out = qc.write_report(lift_off, tmp_path / "report", formats=("md", "html", "csv"))
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert "Nonlinear system: events and order" in html and "contact regained" in html
+    events = (out / "events.csv").read_text().splitlines()
+    assert len(events) == 3 and "contact" in events[1]
+    assert (out / "parting.png").exists() and (out / "events_convergence.png").exists()
