@@ -59,7 +59,8 @@ def _spans(ax, study) -> None:
 
 
 def event_convergence_figure(cmp) -> Figure:
-    """Max |body error| against h, with events (solid) and without (dashed), log-log."""
+    """The largest body-displacement error against h, with events (solid) and without
+    (dashed), log-log."""
     study = cmp.nonlinear
     conv = study.convergence
     fig = Figure(figsize=(7.5, 4.6), layout="constrained")
@@ -102,7 +103,7 @@ def event_convergence_figure(cmp) -> Figure:
 
 
 def parting_figure(cmp) -> Figure:
-    """The reference's displacements, and |Midpoint − Heun| against time (log)."""
+    """The reference's displacements, and the Midpoint-Heun difference against time (log)."""
     study = cmp.nonlinear
     ref = cmp.reference
     fig = Figure(figsize=(8, 5.2), layout="constrained")
