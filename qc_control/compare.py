@@ -27,8 +27,8 @@ from .integrate import DivergenceWarning, check_time_grid, uniform_step
 from .limits import check_memory
 from .methods import ButcherTableau, get_method
 from .modal import ModalAnalysis, modal_analysis
-from .model import OUTPUTS, SEED_X0, STATES, UNITS, QuarterCarParams, as_params, quarter_car_model
-from .nonlinear import NONLINEAR_OUTPUTS, NONLINEAR_UNITS
+from .model import OUTPUTS, SEED_X0, STATES, QuarterCarParams, as_params, quarter_car_model
+from .nonlinear import NONLINEAR_OUTPUTS, nonlinear_quarter_car_model
 from .response import (
     check_initial_state,
     check_input_samples,
@@ -39,7 +39,7 @@ from .response import (
 )
 from .ride import Transmissibility, ride_metrics, transmissibility
 from .stability import max_stable_step, numerical_modes
-from .vehicle import STANDARD_GRAVITY, Corner, SignalRoles, VehicleModel
+from .vehicle import VehicleModel
 
 __all__ = [
     "MethodComparison",
@@ -1083,9 +1083,9 @@ def _nonlinear_model(sys, params) -> VehicleModel | None:
     outputs = list(sys.output_labels)
     road = "zr" in sys.input_labels
     if outputs == list(NONLINEAR_OUTPUTS):
-        units: dict[str, str] = dict(NONLINEAR_UNITS)
+        build: Callable[..., VehicleModel] = nonlinear_quarter_car_model
     elif outputs in (list(OUTPUTS), [*OUTPUTS, "fa"]):  # the quarter car, or its closed loop
-        units = {**UNITS, "fa": "N"}
+        build = quarter_car_model
     else:
         return None
     if list(sys.state_labels[:4]) != list(STATES):
@@ -1094,23 +1094,11 @@ def _nonlinear_model(sys, params) -> VehicleModel | None:
         own = getattr(sys, "params", None) or {}
         params = {k: own[k] for k in ("ms", "mu", "ks", "ku", "cs") if k in own} or None
     p = as_params(params)
+    like = build(p, road=road)  # the car whose labels these are: its roles and units
+    units = {**like.units, "fa": "N"}
     units.update({s: units.get(s, "-") for s in sys.state_labels})
     units.update({u: units.get(u, "-") for u in sys.input_labels})
-    corner = Corner(
-        "",
-        "susp_travel",
-        "tire_defl",
-        "zr" if road else None,
-        p.ku,
-        (p.ms + p.mu) * STANDARD_GRAVITY,
-    )
-    return VehicleModel(
-        sys,
-        p,
-        units,
-        SignalRoles("body_acc", "xs", (corner,)),
-        functools.partial(_bare_rebuild, sys.name),
-    )
+    return VehicleModel(sys, p, units, like.roles, functools.partial(_bare_rebuild, sys.name))
 
 
 def _linearization(sys, params) -> tuple[control.StateSpace, ModalAnalysis, str]:

@@ -883,25 +883,16 @@ class Scenario:
         """
         T = self.time_grid()
         U, description = self.road_input(T)
+        extra: dict[str, Any] = {}
         if self.model == "nonlinear":
-            model = self.vehicle_model(road=U is not None)
-            if U is not None and "zr" not in model.system.input_labels:
+            vehicle: Any = self.vehicle_model(road=U is not None)
+            if U is not None and "zr" not in vehicle.system.input_labels:
                 U, description = None, description + " (the road as a function of time)"
-            cmp = compare_methods(
-                model,
-                T,
-                np.asarray(self.x0),
-                U=U,
-                methods=self.methods,
-                progress=progress,
-                input_description=description,
-                events=None if self.events else False,
-            )
-            cmp.scenario = self
-            return cmp
-        vehicle = (
-            self.vehicle if self.model == "quarter" else self.vehicle_model(road=U is not None)
-        )
+            extra["events"] = None if self.events else False
+        elif self.model == "quarter":
+            vehicle = self.vehicle
+        else:
+            vehicle = self.vehicle_model(road=U is not None)
         cmp = compare_methods(
             vehicle,
             T,
@@ -910,6 +901,7 @@ class Scenario:
             methods=self.methods,
             progress=progress,
             input_description=description,
+            **extra,
         )
         cmp.scenario = self
         return cmp
