@@ -34,7 +34,20 @@ __all__ = ["run", "build_parser", "scenario_from_args", "summarise_warnings", "U
 
 _PROG = "qc-control"
 #: The run's options of ``report``, as fields of `qc_control.Scenario`.
-_RUN_OPTIONS = ("model", "t_end", "h", "x0", "methods", "max_steps")
+_RUN_OPTIONS = (
+    "model",
+    "t_end",
+    "h",
+    "x0",
+    "methods",
+    "max_steps",
+    "tire",
+    "bump_stop",
+    "events",
+)
+#: ``--bump-height`` and ``--bump-length``: the nonlinear car's words for the bump road's
+#: ``--road-height`` and ``--road-length`` (the same fields of the Scenario's road).
+_BUMP_ALIASES = {"bump_height": "height", "bump_length": "length"}
 
 
 class UsageError(Exception):
@@ -128,6 +141,38 @@ def _add_road(parser: argparse.ArgumentParser) -> None:
         )
 
 
+def _add_nonlinear(parser: argparse.ArgumentParser) -> None:
+    """The nonlinear car's options (--model nonlinear)."""
+    group = parser.add_argument_group(
+        "nonlinear car (--model nonlinear: gravity and a unilateral tire, so the wheel can "
+        "leave the road)",
+        "Default: the lift-off case, a 20 cm high, 8 m long 1 - cos bump at 20 m/s met at "
+        "0.1 s, over 0-0.8 s at h = 2 ms; --road none for the free response.",
+    )
+    group.add_argument("--tire", metavar="unilateral|linear", help="the tire (default unilateral)")
+    group.add_argument(
+        "--bump-stop",
+        type=_floats,
+        metavar="CLEARANCE,STIFFNESS",
+        help="a bump stop: travel in compression before it touches [m], stiffness [N/m] "
+        "(default none)",
+    )
+    group.add_argument(
+        "--no-events",
+        dest="events",
+        action="store_false",
+        default=None,
+        help="step across the contact events instead of to them (the convergence study "
+        "runs both ways regardless)",
+    )
+    group.add_argument(
+        "--bump-height", type=float, metavar="M", help="the bump's height [m] (default 0.2)"
+    )
+    group.add_argument(
+        "--bump-length", type=float, metavar="M", help="the bump's length [m] (default 8)"
+    )
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``qc-control``."""
     parser = _Parser(
@@ -160,10 +205,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--h",
         type=float,
         metavar="S",
-        help="step size [s] (default 0.01; under an ISO 8608 road, the largest of "
-        "10, 5, 2, 1, 0.5, ... ms that samples the road)",
+        help="step size [s] (default 0.01, 0.002 for --model nonlinear; under an ISO 8608 "
+        "road, the largest of 10, 5, 2, 1, 0.5, ... ms that samples the road)",
     )
-    sc.add_argument("--t-end", type=float, metavar="S", help="end time [s] (default 10)")
+    sc.add_argument(
+        "--t-end", type=float, metavar="S", help="end time [s] (default 10; 0.8 nonlinear)"
+    )
     sc.add_argument(
         "--x0",
         metavar="VS,VU,XS,XU",
@@ -179,6 +226,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="refuse a run of more than N steps t_end/h per method (default 100000)",
     )
     _add_road(report)
+    _add_nonlinear(report)
     report.add_argument(
         "--out",
         default="report",
@@ -236,6 +284,17 @@ def scenario_from_args(args: argparse.Namespace):
             value = getattr(args, f"road_{f.name}", None)
             if value is not None:
                 road[f.name] = value
+    for alias, name in _BUMP_ALIASES.items():
+        value = getattr(args, alias, None)
+        if value is None:
+            continue
+        option = "--" + alias.replace("_", "-")
+        if name in road:
+            raise UsageError(f"{option} and --road-{name} are the same value: give one")
+        if road.get("kind", "bump") != "bump":
+            raise UsageError(f"{option} applies to a bump road, not --road {road['kind']}")
+        road[name] = value
+        road.setdefault("kind", "bump")
     if road:
         run["road"] = road
     if run:
@@ -256,7 +315,7 @@ def _in_options(exc, doc: dict) -> str:
     if section is None and key in doc and key != "scenario":
         option = f"--{key}"
     elif section == "scenario" and key in run:
-        option = "--" + key.replace("_", "-")
+        option = "--no-events" if key == "events" else "--" + key.replace("_", "-")
     elif section == "scenario.road" and key in run.get("road", {}):
         option = (
             "--road"

@@ -6,6 +6,8 @@ report writers in `qc_control.report` only format them.
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 import time
 import warnings
@@ -16,6 +18,7 @@ from typing import Any
 import control
 import numpy as np
 import pandas as pd
+import scipy
 import scipy.signal
 from scipy.integrate import solve_ivp
 
@@ -24,12 +27,14 @@ from .integrate import DivergenceWarning, check_time_grid, uniform_step
 from .limits import check_memory
 from .methods import ButcherTableau, get_method
 from .modal import ModalAnalysis, modal_analysis
-from .model import SEED_X0, QuarterCarParams, as_params, quarter_car_model
+from .model import OUTPUTS, SEED_X0, STATES, QuarterCarParams, as_params, quarter_car_model
+from .nonlinear import NONLINEAR_OUTPUTS, nonlinear_quarter_car_model
 from .response import (
     check_initial_state,
     check_input_samples,
     forced_response,
     initial_response,
+    input_output_response,
     linear_input,
 )
 from .ride import Transmissibility, ride_metrics, transmissibility
@@ -57,6 +62,8 @@ __all__ = [
     "TOLERANCES",
     "NonlinearReference",
     "nonlinear_reference",
+    "NonlinearStudy",
+    "NONLINEAR_LEVELS",
 ]
 
 #: The default scenario: the seed's vehicle, body released from 5 cm, 0-10 s, h = 0.01 s.
@@ -117,9 +124,12 @@ class MethodComparison:
     scenario : Scenario or None
         The run this comparison came from, when it came from one
         (`qc_control.scenario.Scenario.run`); the report saves it.
+    nonlinear : NonlinearStudy or None
+        On a nonlinear system: events, the order with and without them,
+        where Midpoint and Heun part, the linearisation behind ``modes``.
     """
 
-    system: control.StateSpace
+    system: control.NonlinearIOSystem
     params: QuarterCarParams | None
     model: VehicleModel | None
     T: np.ndarray
@@ -147,6 +157,7 @@ class MethodComparison:
     ride_error: pd.DataFrame | None = None
     transmissibility: Transmissibility | None = None
     scenario: Any = None
+    nonlinear: NonlinearStudy | None = None
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""
@@ -216,9 +227,9 @@ def _exact(sys, T, X0, U):
     return control.forced_response(sys, T, U, X0)
 
 
-def _observed_order(hs, errors) -> float:
+def _observed_order(hs, errors, floor: float = _ROUNDING_FLOOR) -> float:
     hs, errors = np.asarray(hs), np.asarray(errors)
-    ok = np.isfinite(errors) & (errors > _ROUNDING_FLOOR)
+    ok = np.isfinite(errors) & (errors > floor)
     if ok.sum() < 2:
         return math.nan
     return float(np.polyfit(np.log(hs[ok]), np.log(errors[ok]), 1)[0])
@@ -545,10 +556,13 @@ def method_timings(
     return pd.DataFrame.from_dict(rows, orient="index")
 
 
-def _as_model(sys, U, params) -> tuple[control.StateSpace, VehicleModel | None, Any]:
+def _as_model(sys, U, params) -> tuple[control.NonlinearIOSystem, VehicleModel | None, Any]:
     """(system, model, params) from a system, parameters, a model, or None."""
     if isinstance(sys, VehicleModel):
         return sys.system, sys, sys.params
+    if _is_nonlinear(sys):
+        model = _nonlinear_model(sys, params)
+        return sys, model, None if model is None else model.params
     if isinstance(sys, (HalfCarParams, FullCarParams)):
         model = sys.model(road=U is not None)
         return model.system, model, model.params
@@ -557,8 +571,8 @@ def _as_model(sys, U, params) -> tuple[control.StateSpace, VehicleModel | None, 
         return model.system, model, model.params
     if not isinstance(sys, control.StateSpace):
         raise TypeError(
-            f"sys must be a control.StateSpace, a VehicleModel or QuarterCarParams, "
-            f"got {type(sys).__name__}"
+            f"sys must be a control.StateSpace, a control.NonlinearIOSystem, a VehicleModel "
+            f"or QuarterCarParams, got {type(sys).__name__}"
         )
     if params is not None:
         model = quarter_car_model(
@@ -587,6 +601,8 @@ def compare_methods(
     progress: Callable[[str], None] | None = None,
     input_description: str = "",
     params: QuarterCarParams | None = None,
+    events: bool | None = None,
+    levels: int | None = None,
 ) -> MethodComparison:
     """Compare fixed-step methods with python-control's exact response.
 
@@ -597,10 +613,16 @@ def compare_methods(
 
     Parameters
     ----------
-    sys : control.StateSpace, VehicleModel, QuarterCarParams, HalfCarParams or FullCarParams
-        The vehicle. Parameters build their model with the road inputs when
+    sys : control.StateSpace, control.NonlinearIOSystem, VehicleModel, or parameters
+        The vehicle. Parameters (`QuarterCarParams`, `HalfCarParams`,
+        `FullCarParams`) build their model with the road inputs when
         ``U`` is given (``quarter_car_model(params, road=U is not None)``);
-        a half or full car then needs ``X0`` of its 8 or 14 states.
+        a half or full car then needs ``X0`` of its 8 or 14 states. A
+        `VehicleModel` whose ``system`` is a `control.NonlinearIOSystem`
+        (`qc_control.nonlinear_quarter_car_model`, or `closed_loop` with a
+        semi-active controller), or a bare NonlinearIOSystem with the
+        nonlinear car's or the quarter car's labels, is compared against a
+        tight ``solve_ivp`` (see Notes).
     T : array_like, optional
         Uniform output grid [s]; default 0-10 s at 0.01 s.
     X0 : array_like, default ``(0, 0, 0.05, 0)``
@@ -627,6 +649,15 @@ def compare_methods(
     params : QuarterCarParams, optional
         The vehicle behind ``sys`` when ``sys`` is a quarter-car system: the
         ride metrics need its masses for the static wheel load.
+    events : bool, optional
+        Nonlinear systems only: whether the methods step to each switching
+        time (``qc.input_output_response(..., events=True)``). Default: when
+        the system has switching functions (``sys.switching``). The
+        convergence study runs both ways regardless.
+    levels : int, optional
+        Nonlinear systems only: refinements h, h/2, ..., h/2**levels of the
+        convergence study (default `NONLINEAR_LEVELS`, 2; a linear
+        comparison always refines 5 times).
 
     Returns
     -------
@@ -644,6 +675,20 @@ def compare_methods(
     ``numerical_modes`` at the chosen h. Under a road input the comparison
     also holds `qc_control.ride_metrics` of the reference and of each
     method, and the transmissibility.
+
+    **Nonlinear systems.** There is no exact solution: the reference is
+    `nonlinear_reference` (DOP853 at rtol 1e-12, restarted at each
+    switching event), computed once on the finest grid, with its own error
+    estimated against a solve at 100x tighter tolerances. The methods run
+    through `qc_control.input_output_response` (with ``events=True`` when
+    the system has switching functions). The convergence study runs every
+    method with and without events over h, h/2, ..., h/2**levels and fits
+    an observed order to each (``table`` columns ``observed order
+    (events)`` and ``(no events)``), leaving out errors within 10x of the
+    reference's own. Modes, step limits and numerical modes are those of
+    the linearisation at the static equilibrium (`control.linearize`).
+    Wall times are one run each (no LTI engine); ``nonlinear`` holds the
+    event times, the orders and where Midpoint and Heun part.
     """
     sys, model, params = _as_model(sys, U, params)
     if model is None:
@@ -674,6 +719,28 @@ def compare_methods(
         f"a method comparison over {T.size - 1} steps (refined down to h/{2**_LEVELS})",
         "use a shorter run or a larger step",
     )
+    if _is_nonlinear(sys):
+        return _compare_nonlinear(
+            sys,
+            model,
+            params,
+            T,
+            X0,
+            U,
+            tabs,
+            h,
+            substeps,
+            events=events,
+            levels=levels,
+            timing=timing,
+            progress=progress,
+            input_description=input_description,
+        )
+    if events is not None or levels is not None:
+        raise ValueError(
+            "events and levels apply to nonlinear systems only: a linear comparison has "
+            "no switching and always refines h five times"
+        )
     modes = modal_analysis(sys)
     eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
     metres = [label for label in sys.output_labels if model.unit(label) == "m"]
@@ -769,6 +836,12 @@ class NonlinearReference:
     rtol : float
     atol : ndarray (n,)
     nfev : int
+    event_labels : tuple of str
+        Which switching function changed sign at each of ``t_events``
+        (``sys.switching_labels`` for ``events=True``, else ``'event k'``).
+    state_accuracy : ndarray (n,)
+        Per state, the largest difference from the tighter solution, in the
+        state's unit (e.g. m for a displacement).
     """
 
     t: np.ndarray
@@ -778,10 +851,17 @@ class NonlinearReference:
     rtol: float
     atol: np.ndarray
     nfev: int
+    event_labels: tuple[str, ...] = ()
+    state_accuracy: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0))
 
 
-def _piecewise_ivp(rhs, switching, T, x0, rtol, atol):
-    """DOP853 from event to event: no step straddles a kink of the right-hand side."""
+def _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks=()):
+    """DOP853 from event to event: no step straddles a kink of the right-hand side.
+
+    ``breaks``: times where the input's slope jumps (samples of a piecewise-linear
+    input); each is a restart too, so no step straddles one or steps over an input
+    that starts after a quiet stretch.
+    """
     span = float(T[-1] - T[0])
     nudge = 1e-10 * span
     n_ev = 0 if switching is None else int(np.size(switching(float(T[0]), x0)))
@@ -796,24 +876,33 @@ def _piecewise_ivp(rhs, switching, T, x0, rtol, atol):
     t, x = float(T[0]), np.asarray(x0, dtype=float)
     out = np.empty((x.size, T.size))
     events: list[float] = []
+    which: list[int] = []
     nfev = 0
     kw = dict(method="DOP853", rtol=rtol, atol=atol, dense_output=True)
-    while True:
-        sol = solve_ivp(rhs, (t, float(T[-1])), x, events=funcs or None, **kw)
-        nfev += sol.nfev
-        if not sol.success and sol.status != 1:
-            raise RuntimeError(f"the reference solve_ivp failed at t = {t:.6g} s: {sol.message}")
-        t_end = float(sol.t[-1])
-        inside = (T >= t) & (T <= t_end)
-        out[:, inside] = sol.sol(T[inside])
-        if sol.status != 1 or t_end >= T[-1]:
-            break
-        events.append(t_end)
-        # past the root, where the switching function has its new sign
-        step = solve_ivp(rhs, (t_end, t_end + nudge), sol.y[:, -1], **kw)
-        nfev += step.nfev
-        t, x = float(step.t[-1]), step.y[:, -1]
-    return out, np.array(events), nfev
+    stops = sorted({float(b) for b in breaks if T[0] < b < T[-1]} | {float(T[-1])})
+    for t_stop in stops:
+        while t < t_stop:
+            sol = solve_ivp(rhs, (t, t_stop), x, events=funcs or None, **kw)
+            nfev += sol.nfev
+            if not sol.success and sol.status != 1:
+                raise RuntimeError(
+                    f"the reference solve_ivp failed at t = {t:.6g} s: {sol.message}"
+                )
+            t_end = float(sol.t[-1])
+            inside = (T >= t) & (T <= t_end)
+            out[:, inside] = sol.sol(T[inside])
+            if sol.status != 1 or t_end >= t_stop:
+                t, x = t_end, sol.y[:, -1]
+                break
+            events.append(t_end)
+            fired = [k for k, te in enumerate(sol.t_events) if te.size and te[-1] == t_end]
+            which.append(fired[0] if fired else -1)
+            # past the root, where the switching function has its new sign
+            past = min(t_end + nudge, t_stop)
+            step = solve_ivp(rhs, (t_end, past), sol.y[:, -1], **kw)
+            nfev += step.nfev
+            t, x = float(step.t[-1]), step.y[:, -1]
+    return out, np.array(events), nfev, which
 
 
 def nonlinear_reference(
@@ -827,9 +916,11 @@ def nonlinear_reference(
     every sign change of the switching functions (``events``, as in
     `qc_control.input_output_response`) and restarted just past it, so that
     no step straddles a kink. The input is python-control's: linear between
-    the samples. Its own accuracy is estimated, as the matrix exponential's
+    the samples; the solve also restarts at each sample where the input's
+    slope changes (a kink in time, and no first step that leaps over a
+    bump after a quiet stretch). Its own accuracy is estimated, as the matrix exponential's
     is for linear systems, against a second solve at ``rtol / 100`` and
-    ``atol / 100``.
+    ``atol / 100`` (scipy raises an rtol below 100·eps, 2.2e-14, to it).
 
     Parameters
     ----------
@@ -866,10 +957,467 @@ def nonlinear_reference(
         return sys._rhs(t, x, u_of_t(t))
 
     switching = None if g is None else (lambda t, x: np.atleast_1d(g(t, x, u_of_t(t), current)))
-    rough, _, _ = _piecewise_ivp(rhs, switching, T, x0, 1e-6, 1e-9)
+    # the input is linear between samples: its slope jumps where its second difference is
+    # not 0 (beyond rounding: a grid refined by interpolation adds no kinks)
+    tiny = 64 * np.finfo(float).eps * np.max(np.abs(u), axis=1, initial=0.0)[:, None]
+    kinks = np.flatnonzero(np.any(np.abs(np.diff(u, 2, axis=1)) > tiny, axis=0)) + 1
+    breaks = T[kinks]
+    rough, _, _, _ = _piecewise_ivp(rhs, switching, T, x0, 1e-6, 1e-9, breaks)
     scale = np.maximum(np.max(np.abs(rough), axis=1), 1e-12)
     atol = rtol * scale
-    x, t_events, nfev = _piecewise_ivp(rhs, switching, T, x0, rtol, atol)
-    tighter, _, _ = _piecewise_ivp(rhs, switching, T, x0, rtol / 100, atol / 100)
-    accuracy = float(np.max(np.abs(x - tighter)) / np.max(np.abs(tighter)))
-    return NonlinearReference(T, x, t_events, accuracy, rtol, atol, nfev)
+    x, t_events, nfev, which = _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks)
+    with warnings.catch_warnings():
+        # scipy raises an rtol below 100·eps (2.2e-14) to it, and says so
+        warnings.filterwarnings("ignore", "At least one element of `rtol` is too small")
+        tighter, _, _, _ = _piecewise_ivp(rhs, switching, T, x0, rtol / 100, atol / 100, breaks)
+    per_state = np.max(np.abs(x - tighter), axis=1)
+    accuracy = float(np.max(per_state) / np.max(np.abs(tighter)))
+    names = tuple(getattr(sys, "switching_labels", ())) if events is True else ()
+    labels = tuple(
+        names[k] if 0 <= k < len(names) else (f"event {k}" if k >= 0 else "event") for k in which
+    )
+    return NonlinearReference(T, x, t_events, accuracy, rtol, atol, nfev, labels, per_state)
+
+
+# ------------------------------------------------- method comparison on a nonlinear system
+
+#: Refinements h, h/2, ..., h/2**levels of a nonlinear comparison (each a solve per method
+#: with and without events; the observed order is fitted over these three).
+NONLINEAR_LEVELS = 2
+#: Errors within this factor of the reference's own are not fitted for an order.
+_REFERENCE_MARGIN = 10.0
+#: Midpoint and Heun "part" where their displacements first differ by more than this [m].
+_PARTING = 1e-12
+
+
+@dataclass(frozen=True, eq=False)
+class NonlinearStudy:
+    """What a comparison on a nonlinear system adds. See `compare_methods`.
+
+    Attributes
+    ----------
+    events : bool
+        Whether the methods' responses (``MethodComparison.responses``,
+        ``.table``, ``.convergence``) located the switching times
+        (``qc.input_output_response(..., events=True)``).
+    switching_labels : tuple of str
+        The system's switching functions (``sys.switching_labels``); empty
+        when it has none (then the study with and without events is one).
+    t_events, event_labels
+        Where the reference's switching functions changed sign [s] and
+        which (e.g. ``'contact'``: the wheel leaving or regaining the road).
+    event_signs : tuple of int
+        The sign each switching function has just after its event (+1 or
+        -1): for ``'contact'`` -1 is contact lost, +1 regained; for a stop
+        -1 is engaged, +1 released.
+    airborne : tuple of (float, float)
+        The reference's flights: each ``(contact lost, contact regained)``
+        [s], the second NaN when the wheel is still in the air at the end.
+    method_events : dict
+        Per method, ``(t_events, event_labels)`` of its run at h with events.
+    convergence : pandas.DataFrame
+        Long form over both modes: method, events, level, h, steps, nfev,
+        time, error (the largest absolute body-displacement error [m]), stable.
+    orders : pandas.DataFrame
+        Per method (index): ``with events`` and ``without events``, the
+        least-squares slope of log error against log h over h, h/2, h/4
+        (NaN without switching functions, or where the errors are within
+        ``error_floor`` of the reference).
+    parting : dict
+        Where Midpoint and Heun part (when both ran): ``max [m]`` (their
+        largest displacement difference), ``at [s]`` (its time), ``from [s]``
+        (the first sample where they differ by more than 1e-12 m; NaN when
+        they never do).
+    parting_gap : ndarray or None
+        Their displacement difference [m] at every sample of ``T``.
+    reference : NonlinearReference
+        The DOP853 reference on the finest grid (``T`` refined ``2**levels``
+        times).
+    error_floor : float
+        Errors below this [m] (10x the reference's own error) are not used
+        in an order fit.
+    linearization : control.StateSpace
+        The system linearised at the static equilibrium (``x = 0``,
+        ``u = 0``; `control.linearize`): its modes and eigenvalues are the
+        comparison's ``modes``, step limits and numerical modes.
+    linearization_note : str
+        What the linearisation is and where it does not hold.
+    """
+
+    events: bool
+    switching_labels: tuple[str, ...]
+    t_events: np.ndarray
+    event_labels: tuple[str, ...]
+    event_signs: tuple[int, ...]
+    airborne: tuple[tuple[float, float], ...]
+    method_events: dict
+    convergence: pd.DataFrame
+    orders: pd.DataFrame
+    parting: dict
+    parting_gap: np.ndarray | None
+    reference: NonlinearReference
+    error_floor: float
+    linearization: control.StateSpace
+    linearization_note: str
+
+
+def _is_nonlinear(sys) -> bool:
+    return isinstance(sys, control.NonlinearIOSystem) and not isinstance(sys, control.StateSpace)
+
+
+def _switching_labels(sys) -> tuple[str, ...]:
+    if getattr(sys, "switching", None) is None:
+        return ()
+    return tuple(getattr(sys, "switching_labels", ()))
+
+
+def _bare_rebuild(name: str, params) -> VehicleModel:
+    raise ValueError(
+        f"system {name!r} was passed bare: build it as a VehicleModel "
+        "(qc.nonlinear_quarter_car_model, qc.closed_loop) to rebuild it from other parameters"
+    )
+
+
+def _nonlinear_model(sys, params) -> VehicleModel | None:
+    """Roles for a bare NonlinearIOSystem with the nonlinear car's or the quarter car's labels."""
+    outputs = list(sys.output_labels)
+    road = "zr" in sys.input_labels
+    if outputs == list(NONLINEAR_OUTPUTS):
+        build: Callable[..., VehicleModel] = nonlinear_quarter_car_model
+    elif outputs in (list(OUTPUTS), [*OUTPUTS, "fa"]):  # the quarter car, or its closed loop
+        build = quarter_car_model
+    else:
+        return None
+    if list(sys.state_labels[:4]) != list(STATES):
+        return None
+    if params is None:
+        own = getattr(sys, "params", None) or {}
+        params = {k: own[k] for k in ("ms", "mu", "ks", "ku", "cs") if k in own} or None
+    p = as_params(params)
+    like = build(p, road=road)  # the car whose labels these are: its roles and units
+    units = {**like.units, "fa": "N"}
+    units.update({s: units.get(s, "-") for s in sys.state_labels})
+    units.update({u: units.get(u, "-") for u in sys.input_labels})
+    return VehicleModel(sys, p, units, like.roles, functools.partial(_bare_rebuild, sys.name))
+
+
+def _linearization(sys, params) -> tuple[control.StateSpace, ModalAnalysis, str]:
+    """The system linearised at its static equilibrium, its modes, and what they are."""
+    lin = control.linearize(sys, np.zeros(sys.nstates), np.zeros(sys.ninputs))
+    lin = control.ss(
+        lin.A,
+        lin.B,
+        lin.C,
+        lin.D,
+        states=list(sys.state_labels),
+        inputs=list(sys.input_labels),
+        outputs=list(sys.output_labels),
+        name=f"{sys.name} (linearised)",
+    )
+    note = (
+        "Modes, eigenvalues and step limits are those of the linearisation at the static "
+        "equilibrium (x = 0, u = 0; control.linearize, a finite-difference Jacobian). They "
+        "hold near that point only: a wheel in the air, a stop engaged or a clipped damper "
+        "changes the local dynamics, and where a kink sits at the equilibrium (a semi-active "
+        "law at zero velocity) the difference takes one side of it."
+    )
+    try:
+        modes = modal_analysis(lin)
+    except ValueError:
+        if params is None:
+            raise
+        modes = modal_analysis(params)
+        note += (
+            " The linearisation is not in vehicle form (it has the controller's states), "
+            "so the modes named are the passive car's."
+        )
+    return lin, modes, note
+
+
+def _event_signs(sys, T, X0, U, ref: NonlinearReference, switching) -> tuple:
+    """Each event's new sign (from the signs at T[0], flipped per crossing), and flights."""
+    if not switching:
+        return (), ()
+    u0 = np.zeros(sys.ninputs) if U is None else U[:, 0]
+    start = np.sign(np.atleast_1d(sys.switching(T[0], X0, u0, getattr(sys, "params", {}))))
+    sign = {label: int(v) or 1 for label, v in zip(switching, start)}
+    signs, flights, lost = [], [], math.nan
+    for t, label in zip(ref.t_events, ref.event_labels):
+        sign[label] = -sign.get(label, 1)
+        signs.append(sign[label])
+        if label == "contact":
+            if sign[label] < 0:
+                lost = float(t)
+            elif not math.isnan(lost):
+                flights.append((lost, float(t)))
+                lost = math.nan
+    if not math.isnan(lost):
+        flights.append((lost, math.nan))
+    return tuple(signs), tuple(flights)
+
+
+def _run_nonlinear(sys, T, X0, U, tab, substeps, events: bool):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DivergenceWarning)
+        return input_output_response(
+            sys,
+            T,
+            0.0 if U is None else U,
+            X0,
+            method=tab,
+            substeps=substeps,
+            events=True if events else None,
+        )
+
+
+def _outputs_along(sys, T, x, U) -> np.ndarray:
+    """The system's outputs ``(noutputs, N)`` at the states ``x (n, N)`` and inputs on ``T``."""
+    u = np.zeros((sys.ninputs, T.size)) if U is None else U
+    return np.column_stack([sys.output(t, x[:, k], u[:, k]) for k, t in enumerate(T)])
+
+
+def _parting(cmp_responses: dict, sys, model: VehicleModel, T) -> tuple[dict, np.ndarray | None]:
+    """Where Midpoint and Heun part: their largest displacement difference and when."""
+    if not {"midpoint", "heun"} <= set(cmp_responses):
+        return {}, None
+    metres = [i for i, label in enumerate(sys.output_labels) if model.unit(label) == "m"]
+    a = _outputs(cmp_responses["midpoint"], T.size)[metres]
+    b = _outputs(cmp_responses["heun"], T.size)[metres]
+    with np.errstate(invalid="ignore"):
+        gap = np.nan_to_num(np.max(np.abs(a - b), axis=0), nan=np.inf)
+    apart = np.flatnonzero(gap > _PARTING)
+    return {
+        "pair": ("midpoint", "heun"),
+        "max [m]": float(gap.max()),
+        "at [s]": float(T[int(np.argmax(gap))]),
+        "from [s]": float(T[apart[0]]) if apart.size else math.nan,
+    }, gap
+
+
+def _compare_nonlinear(
+    sys,
+    model: VehicleModel,
+    params,
+    T,
+    X0,
+    U,
+    tabs: tuple[ButcherTableau, ...],
+    h: float,
+    substeps: int,
+    *,
+    events,
+    levels,
+    timing: bool,
+    progress,
+    input_description: str,
+) -> MethodComparison:
+    """`compare_methods` on a `control.NonlinearIOSystem` (see its Notes)."""
+    switching = _switching_labels(sys)
+    if events is None:
+        events = bool(switching)
+    if not isinstance(events, bool):
+        raise TypeError(f"events must be None, True or False, got {events!r}")
+    if events and not switching:
+        raise ValueError(
+            f"events=True needs switching functions; system {sys.name!r} has none "
+            "(sys.switching, as qc.nonlinear_quarter_car gives)"
+        )
+    levels = NONLINEAR_LEVELS if levels is None else levels
+    if isinstance(levels, bool) or not isinstance(levels, int) or not 1 <= levels <= 6:
+        raise ValueError(f"levels must be an integer from 1 to 6, got {levels!r}")
+    lin, modes, note = _linearization(sys, params)
+    eig = np.linalg.eigvals(np.asarray(lin.A, dtype=float))
+
+    if progress:
+        progress("reference: solve_ivp DOP853 at rtol 1e-12 (and 1e-14 for its own accuracy)")
+    fine_T, fine_U = _refined(T, levels), _refined_input(T, U, levels)
+    start = time.perf_counter()
+    ref = nonlinear_reference(
+        sys, fine_T, 0.0 if fine_U is None else fine_U, X0, events=True if switching else None
+    )
+    ref_time = time.perf_counter() - start
+    # its own error on the displacements [m], which the errors below are measured on
+    metre_states = [i for i, s in enumerate(sys.state_labels) if model.unit(s) == "m"]
+    ref_error = (
+        float(np.max(ref.state_accuracy[metre_states]))
+        if metre_states
+        else ref.accuracy * float(np.max(np.abs(ref.x)))
+    )
+    floor = max(_ROUNDING_FLOOR, _REFERENCE_MARGIN * ref_error)
+    every = 2**levels
+    x_ref = ref.x[:, ::every]
+    u_ref = None if U is None else U
+    response = control.TimeResponseData(
+        T,
+        _outputs_along(sys, T, x_ref, u_ref),
+        x_ref,
+        u_ref if u_ref is not None else np.zeros((sys.ninputs, T.size)),
+        output_labels=list(sys.output_labels),
+        state_labels=list(sys.state_labels),
+        input_labels=list(sys.input_labels),
+        sysname=sys.name,
+        title=f"DOP853 reference for {sys.name}",
+        issiso=sys.ninputs == 1 and sys.noutputs == 1,
+    )
+    name = (
+        "scipy.integrate.solve_ivp (DOP853, rtol 1e-12, atol 1e-12·max|x_i| per state, "
+        f"restarted at every switching event; scipy {scipy.__version__})"
+    )
+    reference = Reference(
+        response,
+        ref_error,
+        "the same solve at rtol and atol 100x tighter",
+        name,
+        ref_time,
+    )
+    body = list(sys.output_labels).index(model.body_disp)
+    body_ref = _outputs_along(sys, fine_T, ref.x, fine_U)[body]
+
+    modes_run = (True, False) if switching else (False,)
+    responses: dict = {}
+    method_events: dict = {}
+    rows = []
+    for tab in tabs:
+        h_max = max_stable_step(tab, eig)
+        for ev in modes_run:
+            if progress:
+                progress(
+                    f"{tab.name}{' with events' if ev else ''}: h = {h:g} s and {levels} halvings"
+                )
+            for lvl in range(levels + 1):
+                Tl, Ul = _refined(T, lvl), _refined_input(T, U, lvl)
+                start = time.perf_counter()
+                r = _run_nonlinear(sys, Tl, X0, Ul, tab, substeps, ev)
+                elapsed = time.perf_counter() - start
+                if lvl == 0 and ev == events:
+                    responses[tab.name] = r
+                if lvl == 0 and ev:
+                    method_events[tab.name] = (r.t_events, r.event_labels)
+                y = np.asarray(r.outputs)[body]
+                exact = body_ref[:: 2 ** (levels - lvl)]
+                with np.errstate(invalid="ignore", over="ignore"):
+                    error = float(np.max(np.abs(y - exact))) if y.size == Tl.size else math.inf
+                rows.append(
+                    {
+                        "method": tab.name,
+                        "events": ev,
+                        "level": lvl,
+                        "h": h / 2**lvl,
+                        "steps": r.steps,
+                        "nfev": r.nfev,
+                        "time": elapsed if timing else math.nan,
+                        "error": error if math.isfinite(error) else math.inf,
+                        "stable": h / 2**lvl <= h_max,
+                    }
+                )
+        if not switching:
+            method_events[tab.name] = (np.empty(0), ())
+    long = pd.DataFrame(rows)
+    orders = {}
+    for tab in tabs:
+        row = {}
+        for ev, col in ((True, "with events"), (False, "without events")):
+            mine = long[(long["method"] == tab.name) & (long["events"] == ev)]
+            row[col] = (
+                _observed_order(mine["h"], mine["error"], floor)
+                if len(mine) and mine["stable"].all()
+                else math.nan
+            )
+        orders[tab.name] = row
+    order_frame = pd.DataFrame.from_dict(orders, orient="index")
+    order_frame.index.name = "method"
+    convergence = long[long["events"] == events].drop(columns="events").reset_index(drop=True)
+
+    names = [t.name for t in tabs]
+    errors = error_table(responses, reference, model)
+    nm, stability = mode_errors(tabs, h, lin, modes)
+    cost, cost_kind = cost_to_reach(
+        convergence, tabs, float(T[-1] - T[0]), stability["h_max [s]"].to_dict()
+    )
+    level0 = convergence[convergence["level"] == 0].set_index("method")
+    times = pd.DataFrame(
+        {
+            "wall time [ms]": 1e3 * level0["time"].reindex(names),
+            "LTI engine [ms]": math.nan,
+            "time / control": math.nan,
+        },
+        index=names,
+    )
+    cost_cols = pd.DataFrame(
+        {
+            "order": [t.order for t in tabs],
+            "stages": [t.stages for t in tabs],
+            "h [s]": h,
+            "steps": [responses[n].steps for n in names],
+            "RHS evals": [responses[n].nfev for n in names],
+        },
+        index=names,
+    )
+    main = "with events" if events else "without events"
+    table = pd.concat(
+        [
+            cost_cols,
+            times,
+            errors,
+            order_frame[main].rename("observed order"),
+            order_frame["with events"].rename("observed order (events)"),
+            order_frame["without events"].rename("observed order (no events)"),
+            stability,
+        ],
+        axis=1,
+    )
+    table.index.name = "method"
+
+    ride, ride_error = None, None
+    roads = model.road_inputs()
+    if U is not None and roads and list(sys.input_labels) == roads:
+        ride, ride_error = ride_comparison(reference, responses, model)
+    parting, gap = _parting(responses, sys, model, T)
+    signs, flights = _event_signs(sys, T, X0, U, ref, switching)
+    study = NonlinearStudy(
+        events=events,
+        switching_labels=switching,
+        t_events=ref.t_events,
+        event_labels=ref.event_labels,
+        event_signs=signs,
+        airborne=flights,
+        method_events=method_events,
+        convergence=long,
+        orders=order_frame,
+        parting=parting,
+        parting_gap=gap,
+        reference=ref,
+        error_floor=floor,
+        linearization=lin,
+        linearization_note=note,
+    )
+    return MethodComparison(
+        system=sys,
+        params=params,
+        model=model,
+        T=T,
+        X0=X0,
+        U=U,
+        h=h,
+        substeps=substeps,
+        methods=tabs,
+        table=table,
+        modes=modes,
+        numerical_modes=nm,
+        convergence=convergence,
+        cost=cost,
+        cost_kind=cost_kind,
+        coincident=_coincident(responses),
+        reference=reference.response,
+        reference_error=reference.error,
+        reference_time=reference.time,
+        reference_description=reference.description,
+        reference_name=reference.name,
+        responses=responses,
+        eigenvalues=eig,
+        input_description=input_description,
+        ride=ride,
+        ride_error=ride_error,
+        transmissibility=None,
+        nonlinear=study,
+    )

@@ -20,6 +20,9 @@ The TOML layout (every key optional)::
     x0 = [0.0, 0.0, 0.05, 0.0]          # [vs, vu, xs, xu] in m/s, m/s, m, m
     methods = ["euler", "midpoint", "heun", "rk4"]
     max_steps = 100000    # refuse a run of more steps t_end/h than this
+    tire = "unilateral"   # model = "nonlinear" only: or "linear"
+    bump_stop = [0.05, 1e5]   # nonlinear only: clearance [m], stiffness [N/m] (default none)
+    events = true         # nonlinear only: step to each contact event (default true)
 
     [scenario.road]       # none, step, bump, sine or iso8608
     kind = "bump"
@@ -28,12 +31,20 @@ The TOML layout (every key optional)::
     speed = 15.0          # [m/s]
     t0 = 0.5              # [s], when the car meets it
 
+With ``model = "nonlinear"`` (`qc_control.nonlinear_quarter_car_model`:
+gravity, a unilateral tire, an optional bump stop) the defaults are the
+lift-off case: a 1 − cos bump 20 cm high and 8 m long at 20 m/s, met at
+0.1 s, over 0-0.8 s at h = 2 ms (`NONLINEAR_ROAD`, `NONLINEAR_T_END`,
+`NONLINEAR_H`); the road is then a function of time (a closed form at
+every stage), except an ISO 8608 road, which is sampled.
+
 The flat keys of earlier versions, ``road = "iso8608"``, ``road_class``,
 ``speed`` and ``seed`` in ``[scenario]``, are still read.
 """
 
 from __future__ import annotations
 
+import functools
 import inspect
 import json
 import math
@@ -58,6 +69,7 @@ from .compare import (
 from .halfcar import FullCarParams, HalfCarParams, full_car_model, half_car_model
 from .methods import METHODS, get_method
 from .model import QuarterCarParams, quarter_car_model
+from .nonlinear import BumpStop, nonlinear_quarter_car_model
 from .vehicle import VehicleModel
 
 if sys.version_info >= (3, 11):
@@ -81,6 +93,9 @@ __all__ = [
     "road_from_mapping",
     "MODELS",
     "ModelKind",
+    "NONLINEAR_ROAD",
+    "NONLINEAR_T_END",
+    "NONLINEAR_H",
 ]
 
 #: The default limit on ``t_end / h``, the steps each method takes at h. The
@@ -420,7 +435,20 @@ MODELS: dict[str, ModelKind] = {
     "quarter": ModelKind(QuarterCarParams, quarter_car_model, "the seed's quarter car"),
     "half": ModelKind(HalfCarParams, half_car_model, "the bounce-pitch half car"),
     "full": ModelKind(FullCarParams, full_car_model, "the heave-pitch-roll full car"),
+    "nonlinear": ModelKind(
+        QuarterCarParams,
+        nonlinear_quarter_car_model,
+        "the quarter car with gravity and a unilateral tire (wheel lift-off), optionally a "
+        "bump stop; by default over a 20 cm, 8 m bump at 20 m/s",
+    ),
 }
+
+#: The nonlinear car's default road: the lift-off bump (the wheel is airborne
+#: 0.4356-0.5213 s), with its default run 0-0.8 s at h = 2 ms.
+NONLINEAR_ROAD = BumpRoad(height=0.2, length=8.0, speed=20.0, t0=0.1)
+NONLINEAR_T_END = 0.8
+NONLINEAR_H = 0.002
+_TIRES = ("unilateral", "linear")
 
 
 def vehicle_keys() -> tuple[str, ...]:
@@ -428,7 +456,9 @@ def vehicle_keys() -> tuple[str, ...]:
     return tuple(dict.fromkeys(f.name for kind in MODELS.values() for f in fields(kind.params)))
 
 
-_RUN_KEYS = ("t_end", "h", "x0", "methods", "max_steps", "model")
+_RUN_KEYS = ("t_end", "h", "x0", "methods", "max_steps", "model", "tire", "bump_stop", "events")
+#: The keys that apply to ``model = "nonlinear"`` only.
+_NONLINEAR_KEYS = ("tire", "bump_stop", "events")
 #: The flat road keys of the ``[scenario]`` table of earlier versions.
 _LEGACY_ROAD_KEYS = ("road", "road_class", "speed", "seed")
 
@@ -534,8 +564,10 @@ class Scenario:
         ``[vs, vu, xs, xu]`` [m/s, m/s, m, m]). Default: the car at rest
         under a road, else the body released from 5 cm (the quarter car's
         `qc_control.compare.DEFAULT_X0`).
-    t_end : float, default `qc_control.compare.DEFAULT_T_END`
-        End time [s]; a whole number (at least 2) of steps ``h``.
+    t_end : float, optional
+        End time [s]; a whole number (at least 2) of steps ``h``. Default
+        `qc_control.compare.DEFAULT_T_END` (`NONLINEAR_T_END` for the
+        nonlinear car).
     h : float, optional
         Step [s]. Default `qc_control.compare.DEFAULT_H`; where the road
         needs a finer step (an ISO 8608 road, whose band must be sampled:
@@ -556,6 +588,19 @@ class Scenario:
         road must have a speed (a bump or an ISO 8608 road); a full car's
         ISO 8608 road has correlated left and right tracks
         (`qc_control.road.iso8608_tracks`, ``track_front`` apart).
+        ``'nonlinear'``: the quarter car's parameters, with gravity and a
+        unilateral tire; its default road is `NONLINEAR_ROAD` (give
+        ``road='none'`` for its free response), and a bump's parameters not
+        given are that bump's.
+    tire : {'unilateral', 'linear'}, optional
+        The nonlinear car's tire (default ``'unilateral'``).
+    bump_stop : (clearance, stiffness), optional
+        The nonlinear car's bump stop: the travel in compression before it
+        touches [m] (>= 0) and its stiffness [N/m] (> 0), a
+        `qc_control.BumpStop`. Default none.
+    events : bool, optional
+        Whether the nonlinear car's methods step to each switching time
+        (default True; the convergence study runs both ways regardless).
 
     Examples
     --------
@@ -569,23 +614,34 @@ class Scenario:
     """
 
     vehicle: Any = None
-    road: Road = field(default_factory=NoRoad)
+    road: Road = None  # type: ignore[assignment]  # resolved: NoRoad, or the nonlinear default
     # None resolves to the default in __post_init__: the attribute is always set
     x0: tuple[float, ...] = None  # type: ignore[assignment]
-    t_end: float = DEFAULT_T_END
+    t_end: float = None  # type: ignore[assignment]
     h: float = None  # type: ignore[assignment]
     methods: tuple[str, ...] = DEFAULT_METHODS
     max_steps: int = MAX_STEPS
     model: str = None  # type: ignore[assignment]
+    tire: str | None = None
+    bump_stop: tuple[float, float] | None = None
+    events: bool | None = None
 
     def __post_init__(self):
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
         put("model", _model_name(self.model, self.vehicle))
         put("vehicle", _vehicle(self.vehicle, self.model))
+        nonlinear = self.model == "nonlinear"
         road: Any = self.road
-        if road is None or isinstance(road, str):
-            road = {"kind": road or "none"}
+        if isinstance(road, Mapping) and not road:
+            road = None
+        if road is None:
+            road = NONLINEAR_ROAD if nonlinear else NoRoad()
+        if isinstance(road, str):
+            road = {"kind": road}
         if isinstance(road, Mapping):
+            if nonlinear and road.get("kind", NONLINEAR_ROAD.kind) == NONLINEAR_ROAD.kind:
+                # the nonlinear car's bump is the lift-off bump, changed where given
+                road = {"kind": NONLINEAR_ROAD.kind, **NONLINEAR_ROAD.params(), **road}
             road = road_from_mapping(road)
         if not isinstance(road, Road):
             raise ScenarioError(
@@ -596,11 +652,14 @@ class Scenario:
             )
         put("road", road)
         put("methods", self._methods(self.methods))
+        if self.t_end is None:
+            put("t_end", NONLINEAR_T_END if nonlinear else DEFAULT_T_END)
         put("t_end", _number("scenario", "t_end", self.t_end, "s", positive=True))
         limit = road.largest_step()
         chosen = self.h is None
         if chosen:
-            put("h", DEFAULT_H if DEFAULT_H <= limit else _iso_step(limit))
+            default = NONLINEAR_H if nonlinear else DEFAULT_H
+            put("h", default if default <= limit else _iso_step(limit))
         else:
             put("h", _number("scenario", "h", self.h, "s", positive=True))
         m = self.max_steps
@@ -618,8 +677,53 @@ class Scenario:
                 "h",
             )
         put("x0", self._x0(self.x0))
-        if self.model != "quarter" and not isinstance(road, NoRoad):
+        if self.model in ("half", "full") and not isinstance(road, NoRoad):
             self._check_speed()
+        self._nonlinear_options()
+
+    def _nonlinear_options(self) -> None:
+        """Check (and default) the keys that apply to the nonlinear car only."""
+        put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
+        if self.model != "nonlinear":
+            for key in _NONLINEAR_KEYS:
+                value = getattr(self, key)
+                if value is not None:
+                    raise ScenarioError(
+                        f"{key} = {value!r} applies to the nonlinear car only: choose it "
+                        "(model = 'nonlinear' in [scenario], --model nonlinear)",
+                        "scenario",
+                        key,
+                    )
+            return
+        tire = "unilateral" if self.tire is None else self.tire
+        if tire not in _TIRES:
+            raise ScenarioError(
+                f"tire must be 'unilateral' or 'linear', got {tire!r}", "scenario", "tire"
+            )
+        put("tire", tire)
+        events = True if self.events is None else self.events
+        if not isinstance(events, (bool, np.bool_)):
+            raise ScenarioError(
+                f"events must be true or false, got {events!r}", "scenario", "events"
+            )
+        put("events", bool(events))
+        if self.bump_stop is not None:
+            values = _sequence(self.bump_stop)
+            if values is not None and all(isinstance(v, str) for v in values):
+                try:
+                    values = [float(v) for v in values]
+                except ValueError:
+                    values = None
+            ok = values is not None and len(values) == 2
+            ok = ok and all(_is_number(v) and math.isfinite(v) for v in values or ())
+            if not ok or not (values[0] >= 0 and values[1] > 0):  # type: ignore[index]
+                raise ScenarioError(
+                    "bump_stop must be CLEARANCE,STIFFNESS: a clearance >= 0 m and a stiffness "
+                    f"> 0 N/m, finite, got {self.bump_stop!r}",
+                    "scenario",
+                    "bump_stop",
+                )
+            put("bump_stop", (float(values[0]), float(values[1])))  # type: ignore[index]
 
     def _check_speed(self) -> None:
         if getattr(self.road, "speed", None) is None:
@@ -737,7 +841,7 @@ class Scenario:
         """
         T = self.time_grid() if T is None else T
         zr, description = self.road.samples(T), self.road.describe()
-        if zr is None or self.model == "quarter":
+        if zr is None or self.model in ("quarter", "nonlinear"):
             return zr, description
         v, speed = self.vehicle, float(cast(Any, self.road).speed)
         wheelbase = v.a + v.b
@@ -755,8 +859,21 @@ class Scenario:
         return roads.corner_inputs(T, left, right, wheelbase, speed), description + late
 
     def vehicle_model(self, *, road: bool = False) -> VehicleModel:
-        """The `VehicleModel` this scenario runs."""
-        return MODELS[self.model].build(self.vehicle, road=road)
+        """The `VehicleModel` this scenario runs.
+
+        The nonlinear car carries this scenario's tire and bump stop; with
+        ``road=True`` its road is this scenario's, as a function of time
+        (an ISO 8608 road, which has no closed form, as the input ``zr``).
+        """
+        if self.model != "nonlinear":
+            return MODELS[self.model].build(self.vehicle, road=road)
+        profile: Any = bool(road)
+        if road and not isinstance(self.road, (NoRoad, ISO8608Road)):
+            profile = functools.partial(_road_at, self.road)
+        stop = None if self.bump_stop is None else BumpStop(*self.bump_stop)
+        return nonlinear_quarter_car_model(
+            self.vehicle, tire=self.tire, bump_stop=stop, road=profile
+        )
 
     def run(self, progress: Callable[[str], None] | None = None) -> MethodComparison:
         """Run the comparison: `qc_control.compare_methods` on this scenario.
@@ -766,9 +883,16 @@ class Scenario:
         """
         T = self.time_grid()
         U, description = self.road_input(T)
-        vehicle = (
-            self.vehicle if self.model == "quarter" else self.vehicle_model(road=U is not None)
-        )
+        extra: dict[str, Any] = {}
+        if self.model == "nonlinear":
+            vehicle: Any = self.vehicle_model(road=U is not None)
+            if U is not None and "zr" not in vehicle.system.input_labels:
+                U, description = None, description + " (the road as a function of time)"
+            extra["events"] = None if self.events else False
+        elif self.model == "quarter":
+            vehicle = self.vehicle
+        else:
+            vehicle = self.vehicle_model(road=U is not None)
         cmp = compare_methods(
             vehicle,
             T,
@@ -777,6 +901,7 @@ class Scenario:
             methods=self.methods,
             progress=progress,
             input_description=description,
+            **extra,
         )
         cmp.scenario = self
         return cmp
@@ -899,7 +1024,15 @@ class Scenario:
         ]
         if self.max_steps != MAX_STEPS:
             lines.append(f"max_steps = {self.max_steps}")
-        if not isinstance(self.road, NoRoad):
+        if self.model == "nonlinear":
+            lines.append(f"tire = {_toml_value(self.tire)}")
+            if self.bump_stop is not None:
+                lines.append(f"bump_stop = {_toml_value(self.bump_stop)}")
+            lines.append(f"events = {_toml_value(self.events)}")
+        if self.model == "nonlinear" and isinstance(self.road, NoRoad):
+            # no road is not the nonlinear car's default (the lift-off bump): say so
+            lines += ["", f"[{_ROAD_SECTION}]", f"kind = {_toml_value(NoRoad.kind)}"]
+        elif not isinstance(self.road, NoRoad):
             lines += ["", f"[{_ROAD_SECTION}]", f"kind = {_toml_value(self.road.kind)}"]
             lines += [f"{k} = {_toml_value(v)}" for k, v in self.road.params().items()]
         return "\n".join(lines) + "\n"
@@ -932,6 +1065,14 @@ class Scenario:
             args += _option("--methods", ",".join(self.methods))
             if self.max_steps != MAX_STEPS:
                 args += _option("--max-steps", str(self.max_steps))
+            if self.model == "nonlinear":
+                args += _option("--tire", str(self.tire))
+                if self.bump_stop is not None:
+                    args += _option("--bump-stop", ",".join(map(repr, self.bump_stop)))
+                if not self.events:
+                    args.append("--no-events")
+                if isinstance(self.road, NoRoad):
+                    args += _option("--road", NoRoad.kind)
             if not isinstance(self.road, NoRoad):
                 args += _option("--road", self.road.kind)
                 for f in fields(self.road):
@@ -947,6 +1088,12 @@ class Scenario:
         if out is not None:
             args += _option("--out", str(out))
         return shlex.join(args)
+
+
+def _road_at(road: Road, t: float) -> float:
+    """A road's height [m] at one time ``t`` [s], from its own function of time
+    (`qc_control.road`'s functions take a grid of at least two times)."""
+    return float(np.asarray(road.samples(np.array([t, t + 1.0])))[0])
 
 
 def _option(name: str, value: str) -> list[str]:

@@ -111,6 +111,18 @@ BAD = [
     (["report", "--out", "foreign/notes.txt"], "is a file, not a report directory"),
     (["report", "--out", "foreign"], "refusing to overwrite 'foreign'"),
     (["report", "--t-e", "3"], "unrecognized arguments: --t-e"),  # no abbreviations
+    # the nonlinear car's options (issue 11 item 6)
+    (["report", "--model", "nonlinear", "--tire", "soft"], "--tire must be 'unilateral' or"),
+    (["report", "--model", "nonlinear", "--bump-stop", "0.05"], "--bump-stop must be CLEARANCE,"),
+    (["report", "--model", "nonlinear", "--bump-stop=-1,5"], "a clearance >= 0 m and a stiff"),
+    (["report", "--model", "nonlinear", "--bump-stop", "a,b"], "expected comma-separated num"),
+    (["report", "--model", "nonlinear", "--bump-height", "x"], "--bump-height: invalid float"),
+    (["report", "--model", "nonlinear", "--bump-length", "0"], "--road-length must be a finite"),
+    (["report", "--tire", "linear"], "--tire 'linear' applies to the nonlinear car only"),
+    (["report", "--no-events"], "--no-events False applies to the nonlinear car only"),
+    (["report", "--bump-stop", "0.05,1e5"], "--bump-stop [0.05, 100000.0] applies to the non"),
+    (["report", "--bump-height", "0.1", "--road-height", "0.1"], "are the same value: give one"),
+    (["report", "--bump-height", "0.1", "--road", "sine"], "applies to a bump road, not --road"),
 ]
 
 
@@ -332,3 +344,39 @@ def test_cli_prints_a_warning_summary_not_a_flood(monkeypatch, capsys, tmp_path)
     assert cli.run(["modes"]) == 0
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and err[0].startswith("qc-control: warning: 44 floating-point")
+
+
+# --- issue 11 item 6: the nonlinear car on the command line --------------------
+
+
+def test_nonlinear_options_make_the_scenario(files):
+    """--model nonlinear: the lift-off bump by default; the options land in the Scenario."""
+    parse = lambda *words: scenario_from_args(build_parser().parse_args(["report", *words]))  # noqa: E731
+    sc = parse("--model", "nonlinear")
+    assert sc.road == BumpRoad(height=0.2, length=8.0, speed=20.0, t0=0.1)
+    assert (sc.t_end, sc.h, sc.tire, sc.bump_stop, sc.events) == (
+        0.8,
+        0.002,
+        "unilateral",
+        None,
+        True,
+    )
+    sc = parse(
+        "--model", "nonlinear", "--bump-height", "0.3", "--bump-length", "6", "--speed", "25"
+    )
+    assert sc.road == BumpRoad(height=0.3, length=6.0, speed=25.0, t0=0.1)
+    sc = parse("--model", "nonlinear", "--tire", "linear", "--bump-stop", "0.05,1e5", "--no-events")
+    assert (sc.tire, sc.bump_stop, sc.events) == ("linear", (0.05, 1e5), False)
+    # the command and the TOML give the same scenario back, a free response included
+    for each in (sc, parse("--model", "nonlinear", "--road", "none")):
+        again = scenario_from_args(build_parser().parse_args(shlex.split(each.command())[1:]))
+        assert again == each == Scenario.from_toml_string(each.to_toml())
+    assert parse("--model", "nonlinear", "--road", "none").road.kind == "none"
+
+
+@pytest.mark.slow
+def test_nonlinear_report_from_the_command_line(files, capsys):
+    assert main(["report", "--model", "nonlinear", "--quiet", "--out", "NL"]) == 0
+    report = (files / "NL" / "report.md").read_text(encoding="utf-8")
+    assert "Nonlinear system: events and order" in report and "contact regained" in report
+    assert 'model = "nonlinear"' in (files / "NL" / "scenario.toml").read_text()

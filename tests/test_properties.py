@@ -153,7 +153,7 @@ VEHICLE = {
     "--ku": (["29530", "3e5", "1e7"], BAD_NUMBERS),
     "--zeta": (["0.3", "1", "2", "0"], BAD_NUMBERS),
     "--cs": (["3000", "500", "0"], BAD_NUMBERS),
-    "--model": (["quarter", "half", "full"], ["bicycle", ""]),
+    "--model": (["quarter", "half", "full", "nonlinear"], ["bicycle", ""]),
     "--a": (["1.2", "1.5"], BAD_NUMBERS),
     "--ks-front": (["30000"], BAD_NUMBERS),
     "--arb-rear": (["8000", "0"], BAD_NUMBERS),
@@ -174,8 +174,13 @@ REPORT = {
     "--road-class": (["A", "C", "H"], ["Z", "c", ""]),
     "--seed": (["0", "7"], ["-1", "x", "1.5"]),
     "--road-band": (["0.011,2.83", "0.05,1"], ["2.83,0.011", "0,1", "a,b", "1"]),
+    # the nonlinear car's (issue 11 item 6); refused with another --model
+    "--tire": (["unilateral", "linear"], ["soft", ""]),
+    "--bump-stop": (["0.05,1e5", "0,2e5"], ["0.05", "-1,5", "a,b", "0.05,0", "0.05,inf"]),
+    "--bump-height": (["0.2", "0.05"], BAD_NUMBERS),
+    "--bump-length": (["8", "0.5"], BAD_NUMBERS),
 }
-FLAGS = ["--quiet", "--bogus", "-x"]
+FLAGS = ["--quiet", "--bogus", "-x", "--no-events"]
 
 
 def value(option_values):

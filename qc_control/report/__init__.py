@@ -42,6 +42,7 @@ from .figures import (
     work_precision_figure,
 )
 from .findings import findings
+from .nonlinear import nonlinear_blocks, nonlinear_figures, nonlinear_tables, reference_text
 from .pdf import to_pdf
 
 if TYPE_CHECKING:
@@ -138,11 +139,17 @@ def figure_specs(cmp) -> list[FigureSpec]:
     numbers (Euler 3, Midpoint 4, RK4 5, Heun 6) and the other figures
     count on from 7; otherwise figures are numbered in order.
     """
+    nonlinear = getattr(cmp, "nonlinear", None) is not None
     drafts: list[tuple[str, str, Callable[[], Any], int | None]] = [
         (
             "reference.png",
-            "The exact response the methods are measured against: python-control's "
-            "matrix exponential"
+            (
+                "The reference the methods are measured against: solve_ivp (DOP853, rtol "
+                "1e-12, restarted at every event)"
+                if nonlinear
+                else "The exact response the methods are measured against: python-control's "
+                "matrix exponential"
+            )
             + (f", under {cmp.input_description}" if getattr(cmp, "input_description", "") else ""),
             lambda: reference_figure(cmp),
             None,
@@ -192,6 +199,7 @@ def figure_specs(cmp) -> list[FigureSpec]:
             None,
         ),
     ]
+    drafts += [(name, caption, make, None) for name, caption, make in nonlinear_figures(cmp)]
     if cmp.ride is not None and getattr(cmp, "transmissibility", None) is not None:
         drafts.append(
             (
@@ -283,25 +291,37 @@ def build_blocks(cmp, command: str | None = None) -> list:
     if cmp.params is not None:
         frame = pd.DataFrame(cmp.params.table(), columns=["symbol", "quantity", "value", "unit"])
         blocks.append(Table(frame.set_index("symbol"), "Vehicle parameters"))
-    blocks.append(Code(_matrix("A", cmp.system.A) + "\n\n" + _matrix("B", cmp.system.B)))
+    study = getattr(cmp, "nonlinear", None)
+    linear = cmp.system if study is None else study.linearization
+    if study is not None:
+        blocks.append(
+            Paragraph(
+                f"The system is nonlinear ({cmp.system.name}); A and B below are its "
+                "linearisation at the static equilibrium (x = 0, u = 0)."
+            )
+        )
+    blocks.append(Code(_matrix("A", linear.A) + "\n\n" + _matrix("B", linear.B)))
     modes = cmp.modes.to_frame()
     blocks.append(
         Table(
             modes,
-            "Modes from the eigenvalues of A (eigenvalue, natural and damped "
-            "frequency, modal and nominal damping, mode shape)",
+            f"Modes from the eigenvalues of {'A' if study is None else 'the linearised A'} "
+            "(eigenvalue, natural and damped frequency, modal and nominal damping, mode shape)",
         )
     )
     if cmp.modes.note:
         blocks.append(Paragraph(cmp.modes.note))
-    blocks.append(
-        Paragraph(
-            f"Reference: {cmp.reference_name}, the exact solution for an input linear between "
-            f"samples (matrix exponential). Its own accuracy: it differs from "
-            f"{cmp.reference_description} by at most {fmt(cmp.reference_error)} m. "
-            f"It took {fmt(cmp.reference_time * 1e3)} ms."
+    if study is None:
+        blocks.append(
+            Paragraph(
+                f"Reference: {cmp.reference_name}, the exact solution for an input linear "
+                f"between samples (matrix exponential). Its own accuracy: it differs from "
+                f"{cmp.reference_description} by at most {fmt(cmp.reference_error)} m. "
+                f"It took {fmt(cmp.reference_time * 1e3)} ms."
+            )
         )
-    )
+    else:
+        blocks.append(Paragraph(reference_text(cmp)))
     blocks.append(figs["reference.png"])
 
     blocks += [Heading("All methods against the reference"), figs["overlay.png"]]
@@ -332,7 +352,8 @@ def build_blocks(cmp, command: str | None = None) -> list:
     conv = cmp.convergence.pivot(index="h", columns="method", values="error")
     conv = conv.sort_index(ascending=False)[[t.name for t in cmp.methods]]
     conv.index.name = "h [s]"
-    blocks.append(Table(conv, f"Max |{_body(cmp)} error| [m] at h, h/2, …, h/32"))
+    finest = 2 ** int(cmp.convergence["level"].max())
+    blocks.append(Table(conv, f"Max |{_body(cmp)} error| [m] at h, h/2, …, h/{finest}"))
     blocks.append(
         Table(
             table[["order", "observed order"]],
@@ -349,15 +370,25 @@ def build_blocks(cmp, command: str | None = None) -> list:
         "LTI engine [ms]",
         "time / control",
     ]
-    blocks.append(
-        Table(
-            table[cost_cols],
-            f"Cost at h = {fmt(cmp.h)} s (best of several runs; wall times depend on the "
-            "machine): wall time of the step-by-step loop, as the seed runs it, and of "
-            "qc_control's LTI engine, which computes the same trajectory; control's exact "
-            f"response took {fmt(cmp.reference_time * 1e3)} ms",
+    if study is None:
+        blocks.append(
+            Table(
+                table[cost_cols],
+                f"Cost at h = {fmt(cmp.h)} s (best of several runs; wall times depend on the "
+                "machine): wall time of the step-by-step loop, as the seed runs it, and of "
+                "qc_control's LTI engine, which computes the same trajectory; control's exact "
+                f"response took {fmt(cmp.reference_time * 1e3)} ms",
+            )
         )
-    )
+    else:
+        blocks.append(
+            Table(
+                table[cost_cols[:4]],
+                f"Cost at h = {fmt(cmp.h)} s: wall time of one run through "
+                "qc.input_output_response (depends on the machine; a nonlinear system has "
+                "no LTI engine); steps include those ending at events",
+            )
+        )
     reach = cmp.cost.T.copy()
     reach.columns = [f"to {fmt(t)} m" for t in cmp.cost.index]
     kinds = cmp.cost_kind.T
@@ -398,6 +429,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
             ),
             Table(cmp.ride_error, "Each method's ride metrics against the reference [%]"),
         ]
+    blocks += nonlinear_blocks(cmp, figs)
     blocks.append(Heading("Findings"))
     blocks += [Paragraph(text) for text in findings(cmp)]
 
@@ -425,6 +457,7 @@ def _csv_tables(cmp) -> dict[str, pd.DataFrame]:
         "cost_to_reach.csv": cost,
         "modes.csv": cmp.modes.to_frame(),
         "numerical_modes.csv": nm,
+        **nonlinear_tables(cmp),
     }
 
 
