@@ -299,6 +299,10 @@ def _mode_numbers(lams) -> tuple[complex, float, float, float]:
     if len(lams) == 2:
         l1, l2 = (float(x.real) for x in lams)
         wn = math.sqrt(l1 * l2)
+        if wn == 0.0:
+            # the slower root settled to 0 (below rounding against the faster one):
+            # ζ = -(λ₁+λ₂)/(2√(λ₁λ₂)) -> +inf as λ₁ -> 0⁻, and 0 when both are 0
+            return complex(max(l1, l2)), 0.0, math.inf if l1 + l2 < 0 else 0.0, 0.0
         return complex(max(l1, l2)), wn, -(l1 + l2) / (2 * wn), 0.0
     lam = complex(lams[0])
     if lam.imag > 0:

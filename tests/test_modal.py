@@ -9,6 +9,7 @@ from conftest import valid_params
 from hypothesis import given, settings
 
 from qc_control import QuarterCarParams, modal_analysis, quarter_car
+from qc_control.stability import MARGINAL_RTOL
 
 
 def undamped_closed_form(p):
@@ -120,3 +121,21 @@ def test_modal_rejects_other_systems():
         modal_analysis(control.c2d(quarter_car(road=True), 0.01))
     with pytest.raises(TypeError, match="got str"):
         modal_analysis("seed")
+
+
+def test_overdamped_mode_whose_slow_root_is_below_rounding():
+    """Found by the property suite: ms = 562 t on a 100 N/m spring at ζ = 10.
+
+    The body mode's slow root, about -ks/cs = -1e-4/s, lies below
+    MARGINAL_RTOL times the wheel's -8.4e4/s and is settled to 0; its damping
+    ratio is then the limit of -(λ₁+λ₂)/(2√(λ₁λ₂)) as λ₁ -> 0⁻, +inf, and not
+    a division by zero.
+    """
+    p = QuarterCarParams(ms=10.0**5.75, mu=0.1 * 10.0**1.25, ks=100.0, ku=1000.0, zeta=10.0)
+    lam = np.linalg.eigvals(np.asarray(p.system.A))
+    slow = lam[np.argmin(np.abs(lam))]
+    assert abs(slow) <= MARGINAL_RTOL * np.max(np.abs(lam))  # the premise
+    modes = modal_analysis(p).modes
+    assert all(m.zeta >= 0 for m in modes)
+    body = [m for m in modes if m.wn == 0.0]
+    assert len(body) == 1 and body[0].zeta == np.inf
