@@ -341,3 +341,25 @@ def test_hinf_without_slycot_says_how_to_install(monkeypatch):
 def test_bad_input_names_the_parameter(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+@pytest.mark.parametrize("mode", ["on-off", "continuous"])
+def test_semi_active_coefficient_one_sample_equals_the_definition(mode):
+    """The float path (one stage of a run) against the law written out, and the array path.
+
+    The law (Karnopp et al. 1974, clipped): c = cmax (on-off) or
+    clip(-f/v, cmin, cmax) (continuous) where f·v < 0, else cmin. Equality is
+    exact: the same comparisons and one division.
+    """
+    rng = np.random.default_rng(3)
+    f = np.concatenate([rng.normal(scale=3e3, size=200), [0.0, 1.0, -1.0, np.nan]])
+    v = np.concatenate([rng.normal(scale=1.0, size=200), [1.0, 0.0, -0.0, 0.5]])
+    cmin, cmax = 300.0, 4000.0
+    arrays = C.semi_active_coefficient(f, v, cmin, cmax, mode)
+    for fi, vi, ca in zip(f, v, arrays):
+        if fi * vi < 0:
+            want = cmax if mode == "on-off" else min(max(-fi / vi, cmin), cmax)
+        else:
+            want = cmin
+        got = C.semi_active_coefficient(float(fi), float(vi), cmin, cmax, mode)
+        assert got == want == ca
