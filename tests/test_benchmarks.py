@@ -77,8 +77,10 @@ def test_ratios_are_numbers(results):
     assert {row["workload"] for row in sweep} == {"free (released from 5 cm)", "5 cm road step"}
     ratios = [float(row["× control.initial_response"]) for row in rows]
     ratios += [float(row["ratio"].split()[0]) for row in sweep]  # "median (min–max)"
-    ratios += [float(row["time slope"]) for row in _table(results, "time slope")]
     assert all(math.isfinite(r) and r > 0 for r in ratios), ratios
+    # a fitted log-log slope: finite; its sign in the smoke mode's tiny sizes is noise
+    slopes = [float(row["time slope"]) for row in _table(results, "time slope")]
+    assert slopes and all(math.isfinite(s) for s in slopes), slopes
 
 
 def test_spectral_sweep_agrees_with_single_designs(results):
