@@ -162,20 +162,32 @@ def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
     times_list = ts.tolist()
     K = np.empty((tab.stages, n, m))  # the stages' slopes, written in place
     flat = K.reshape(tab.stages, n * m)  # a view: Σ_i w_i K_i as one vector-matrix product
+    xi = np.empty((n, m))  # a stage's state, written in place (rhs reads it before the next)
+    xi_flat = xi.reshape(n * m)
+    # per stage: (0, ·) the step's start; (1, j, h a_ij) one non-zero a_ij (RK4's);
+    # (2, row) a row of h a_ij summed with the stored slopes in one product
+    plan = [
+        (0, 0, 0.0) if rows is None else (1, *rows) if isinstance(rows, tuple) else (2, rows, 0.0)
+        for rows in single
+    ]
+    multiply, add, matmul = np.multiply, np.add, np.matmul
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         for sample in range(1, T.size):
             for _ in range(substeps):
                 times = times_list[step]
                 us = stage_u[step]
-                for i, rows in enumerate(single):
-                    if rows is None:
-                        xi = x
-                    elif isinstance(rows, tuple):  # one non-zero a_ij
-                        xi = x + rows[1] * K[rows[0]]
+                for i, (kind, j, a) in enumerate(plan):
+                    if kind == 0:
+                        rhs(times[i], x, us[i], K[i])
+                        continue
+                    if kind == 1:
+                        multiply(K[j], a, out=xi)
                     else:
-                        xi = x + (rows @ flat[: rows.size]).reshape(n, m)
+                        matmul(j, flat[: j.size], out=xi_flat)
+                    add(xi, x, out=xi)
                     rhs(times[i], xi, us[i], K[i])
-                x_new = x + (weights @ flat).reshape(n, m)
+                x_new = matmul(weights, flat).reshape(n, m)
+                add(x_new, x, out=x_new)
                 if events:
                     tb = float(ends[step])
                     ub = u_of(tb) if k else none

@@ -225,9 +225,9 @@ class BumpStop:
 
     def forces(self, d: np.ndarray):
         """`force` over an array of extensions (elementwise), as
-        ``F = q (k + k3 q²)`` with ``q`` the signed penetration (``min(d +
-        c_b, 0)`` in bound, ``max(d - c_r, 0)`` in rebound): the same values
-        to a few ulps, in fewer operations.
+        ``F = q (k + k3 q²)`` with ``q = d - clip(d, -c_b, c_r)`` the signed
+        penetration (``d + c_b`` in bound, ``d - c_r`` in rebound, 0 between):
+        the same values to a few ulps, in fewer operations.
 
         Returns the float 0.0 when no element of ``d`` is past a clearance
         (the common case, skipped at the cost of one comparison per stop; a
@@ -237,12 +237,14 @@ class BumpStop:
         cb, cr = self.clearance_bound, self.clearance_rebound
         bound = math.isfinite(cb) and np.fmin.reduce(d, axis=None) < -cb
         rebound = math.isfinite(cr) and np.fmax.reduce(d, axis=None) > cr
-        if bound and rebound:  # one of the two is 0 at each element
-            q = np.minimum(d + cb, 0.0) + np.maximum(d - cr, 0.0)
+        # the signed penetration as d less d clipped to the clearances: d + c_b in
+        # bound, d - c_r in rebound (the same roundings), exactly 0 in between
+        if bound and rebound:
+            q = d - np.minimum(np.maximum(d, -cb), cr)
         elif bound:
-            q = np.minimum(d + cb, 0.0)
+            q = d - np.maximum(d, -cb)
         elif rebound:
-            q = np.maximum(d - cr, 0.0)
+            q = d - np.minimum(d, cr)
         else:
             return 0.0
         return q * (k + k3 * (q * q)) if k3 else k * q
@@ -623,6 +625,8 @@ class NonlinearQuarterCarBatch:
         piecewise = isinstance(damper, PiecewiseDamper)
         unilateral, iz, ia, profile = self._unilateral, self._iz, self._ia, self._profile
         maximum, multiply = np.maximum, np.multiply
+        if spring is None and k3 is None and damper is None:
+            return self._linear_elements_rhs()
 
         def rhs(t: float, x: np.ndarray, u, out: np.ndarray | None = None) -> np.ndarray:
             """``dx/dt`` ``(4, m)`` of every design at the states ``x`` ``(4, m)``,
@@ -659,6 +663,53 @@ class NonlinearQuarterCarBatch:
                 fa = u[ia]
                 multiply(f - fa, neg_inv_ms, out=out[0])
                 multiply(f - fa + tire, inv_mu, out=out[1])
+            out[2:] = x[:2]
+            return out
+
+        return rhs
+
+    def _linear_elements_rhs(self):
+        """`rhs` when the spring and the damper are linear: the same sums, fused.
+
+        ``[vs - vu, xs - xu]`` is one subtraction of the state's even and odd
+        rows, ``[cs v, ks d]`` one product with a stacked coefficient array, and
+        both accelerations one product with ``[-1/ms, 1/mu]``: 11 NumPy calls a
+        stage (with a stop, 13 when it touches) instead of 17, on the same
+        operands, so each design's value equals the single car's to rounding
+        (the stops add their force to ``F`` as in `force`).
+        """
+        p = self.params
+        m = p["ms"].size
+        coef = np.stack([p["cs"], p["ks"]])  # (2, m): [cs, ks]
+        scale = np.stack([-1.0 / p["ms"], 1.0 / p["mu"]])  # (2, m)
+        ku, neg_static = p["ku"], -p["static"]
+        stop, unilateral = self._stop, self._unilateral
+        iz, ia, profile = self._iz, self._ia, self._profile
+        dv = np.empty((2, m))
+        force = np.empty((2, m))  # [F, F + F_t - ku δ0] (F less fa with an actuator)
+        tire = np.empty(m)
+        subtract, multiply, add, maximum = np.subtract, np.multiply, np.add, np.maximum
+
+        def rhs(t: float, x: np.ndarray, u, out: np.ndarray | None = None) -> np.ndarray:
+            """``dx/dt`` ``(4, m)`` of every design at the states ``x`` ``(4, m)``."""
+            if x.ndim != 2:
+                return self._block_rhs(t, x, u, out)
+            subtract(x[0::2], x[1::2], out=dv)  # [v, d]
+            fb = 0.0 if stop is None else stop.forces(dv[1])
+            multiply(dv, coef, out=dv)  # [cs v, ks d]
+            f = add(dv[0], dv[1], out=force[0])
+            if isinstance(fb, np.ndarray):
+                add(f, fb, out=f)
+            if ia is not None:
+                subtract(f, u[ia], out=f)
+            zr = u[iz] if iz is not None else (0.0 if profile is None else float(profile(t)))
+            subtract(zr, x[3], out=tire)
+            multiply(tire, ku, out=tire)  # F_t - k_u δ0
+            if unilateral:
+                maximum(tire, neg_static, out=tire)
+            add(f, tire, out=force[1])
+            out = np.empty_like(x) if out is None else out
+            multiply(force, scale, out=out[:2])
             out[2:] = x[:2]
             return out
 
