@@ -172,15 +172,29 @@ def uniform_step(T) -> float | None:
     >>> uniform_step(T) is None
     True
     """
-    T = check_time_grid(T, "T")
+    return checked_uniform_step(check_time_grid(T, "T"))
+
+
+def checked_uniform_step(T: np.ndarray) -> float | None:
+    """`uniform_step` of a grid that `check_time_grid` has already passed."""
     N = T.size
     dt = (T[-1] - T[0]) / (N - 1)
     tol = UNIFORM_RTOL * np.finfo(float).eps * max(abs(T[0]), abs(T[-1]))
+    if N <= _CHUNK:  # the line T0 + k·dt of a grid of this size, built once
+        return float(dt) if np.max(np.abs(T - _line(float(T[0]), float(dt), N))) <= tol else None
     for lo in range(0, N, _CHUNK):  # in chunks: a 10**8-point grid needs no 800 MB copy
         k = np.arange(lo, min(lo + _CHUNK, N), dtype=float)
         if np.max(np.abs(T[lo : lo + k.size] - (T[0] + k * dt))) > tol:
             return None
     return float(dt)
+
+
+@functools.lru_cache(maxsize=8)
+def _line(t0: float, dt: float, n: int) -> np.ndarray:
+    """``t0 + k·dt`` for k = 0 … n-1 (read-only: shared between calls)."""
+    line = t0 + np.arange(n, dtype=float) * dt
+    line.flags.writeable = False
+    return line
 
 
 @functools.lru_cache(maxsize=64)

@@ -10,6 +10,7 @@ be raised for one run.
 
 from __future__ import annotations
 
+import functools
 import os
 
 __all__ = ["ResourceLimitError", "memory_limit", "check_memory", "format_bytes", "ENV_VAR"]
@@ -51,6 +52,12 @@ def memory_limit() -> tuple[int, str]:
                 f"{ENV_VAR}={os.environ[ENV_VAR]!r} is not a size; use bytes or e.g. '12G'"
             ) from None
         return int(value), f"{ENV_VAR}={os.environ[ENV_VAR]}"
+    return _default_limit()
+
+
+@functools.lru_cache(maxsize=1)
+def _default_limit() -> tuple[int, str]:
+    """Half the physical memory (read once: it does not change while we run)."""
     total = _physical_memory()
     if total is None:  # pragma: no cover
         return 2**63, "no limit known"

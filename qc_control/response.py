@@ -52,6 +52,7 @@ from .integrate import (
     DivergenceWarning,
     check_substeps,
     check_time_grid,
+    checked_uniform_step,
     integrate,
     integrate_stepper,
     stage_times,
@@ -377,7 +378,8 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
     tab = opts.tab
     A, B = np.asarray(ss.A, dtype=float), np.asarray(ss.B, dtype=float)
     C, D = np.asarray(ss.C, dtype=float), np.asarray(ss.D, dtype=float)
-    H = float(np.diff(T).max())
+    dt = checked_uniform_step(T)  # T passed check_time_grid in the caller
+    H = dt if dt is not None else float(np.diff(T).max())
     # eigenvalues as computed: the stability functions settle those that rounding
     # moved off the imaginary axis (qc_control.stability, MARGINAL_RTOL)
     eig = (
@@ -412,7 +414,7 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
             f"{tab.name} for system {ss.name!r}: the response grows"
         )
         warnings.warn(message, DivergenceWarning, stacklevel=_stacklevel())
-    uniform = uniform_step(T) is not None
+    uniform = dt is not None
     if opts.engine == "lti" and not uniform:
         raise ValueError("engine='lti' needs a uniformly spaced T")
     if opts.engine == "lti" or (opts.engine == "auto" and uniform and success):
@@ -442,7 +444,11 @@ def _all_finite(v: np.ndarray) -> bool:
     """No NaN or inf in ``v``: its min and max propagate both, without a mask array."""
     if v.size == 0 or v.dtype == object:
         return True
-    return bool(np.isfinite(v.min()) and np.isfinite(v.max()))
+    # one pass: a NaN or an inf makes the sum non-finite; a finite sum proves
+    # every element finite, and only an overflowing sum needs the exact test
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = v.sum()
+    return bool(np.isfinite(total) or (np.isfinite(v.min()) and np.isfinite(v.max())))
 
 
 def _finalise(resp: FixedStepResponse) -> FixedStepResponse:

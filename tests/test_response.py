@@ -25,6 +25,7 @@ import pytest
 import qc_control as qc
 from qc_control import METHODS, DivergenceWarning
 from qc_control import response as qr
+from qc_control.integrate import uniform_step
 
 X0 = [0.0, 0.0, 0.05, 0.0]  # the default scenario: body released from 5 cm
 ORDERS = {"euler": 1, "midpoint": 2, "heun": 2, "rk4": 4}
@@ -572,3 +573,28 @@ def test_step_just_inside_the_limit_does_not_warn():
 def test_bad_input(call, error, words):
     with pytest.raises(error, match=words):
         call(qc.quarter_car())
+
+
+def test_outputs_whose_sum_overflows_are_still_finite():
+    """The finiteness check sums first (one pass); a sum that overflows on finite
+    outputs (here ~5e306 on 10,001 samples) must fall back to the exact test,
+    not call the run failed."""
+    car = qc.quarter_car()
+    # the body displacement alone, scaled: 5e306 at the release, finite on every sample
+    big = control.ss(car.A, np.zeros((4, 1)), 1e308 * np.asarray(car.C)[[0]], 0.0)
+    T = np.linspace(0, 10, 10001)
+    r = qc.initial_response(big, T, [0, 0, 0.05, 0])
+    with np.errstate(over="ignore"):  # the premise: the sum overflows
+        assert np.all(np.isfinite(r.outputs)) and not np.isfinite(np.sum(r.outputs))
+    assert r.success
+
+
+def test_uniform_step_of_a_grid_is_unchanged_by_the_cached_line():
+    """Checking a grid against the shared line t0 + k·dt must neither change the
+    verdict for a jittered grid nor let a caller alter the line."""
+    T = np.linspace(0, 1, 101)
+    assert uniform_step(T) == pytest.approx(0.01, rel=1e-15)
+    T2 = T.copy()
+    T2[50] += 1e-9
+    assert uniform_step(T2) is None
+    assert uniform_step(T) is not None  # the first grid, again
