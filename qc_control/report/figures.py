@@ -39,6 +39,7 @@ __all__ = [
     "stability_figure",
     "transmissibility_figure",
     "coincidence_note",
+    "step_ticks",
 ]
 
 _MM = 1e3
@@ -275,10 +276,7 @@ def convergence_figure(cmp) -> Figure:
                 tab.order,
                 colors[tab.name],
             )
-    # ticks at the steps themselves: log-axis minor labels crowd a 1.5-decade range
-    hs = np.sort(conv["h"].unique())[::-1]
-    ax.set_xticks(hs, [f"{h:.3g}" for h in hs], fontsize="small")
-    ax.xaxis.set_minor_formatter(NullFormatter())
+    step_ticks(ax, conv["h"])
     ax.set(
         xlabel="step h [s]",
         ylabel=f"max |{_body_wheel(cmp)[0]} error| [m]",
@@ -287,6 +285,14 @@ def convergence_figure(cmp) -> Figure:
     ax.grid(alpha=0.3, which="both")
     _legend(fig, coincidence_note(cmp))
     return fig
+
+
+def step_ticks(ax, steps) -> None:
+    """Ticks of a log step axis at the steps themselves, labelled ``3 s.f.``:
+    log-axis minor labels crowd the 1.5 decades of a convergence study."""
+    hs = np.sort(np.unique(np.asarray(steps, dtype=float)))[::-1]
+    ax.set_xticks(hs, [f"{h:.3g}" for h in hs], fontsize="small")
+    ax.xaxis.set_minor_formatter(NullFormatter())
 
 
 def work_precision_figure(cmp) -> Figure:

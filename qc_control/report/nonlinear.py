@@ -13,10 +13,10 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
-from matplotlib.ticker import NullFormatter
 
 from ..plotting import output_signal
 from .document import Heading, Image, Paragraph, Table, fmt
+from .figures import step_ticks
 
 __all__ = [
     "nonlinear_figures",
@@ -89,9 +89,7 @@ def event_convergence_figure(cmp) -> Figure:
         ls=":",
         label="10x the reference's own error (not fitted below)",
     )
-    hs = np.sort(conv["h"].unique())[::-1]
-    ax.set_xticks(hs, [f"{h:.3g}" for h in hs], fontsize="small")
-    ax.xaxis.set_minor_formatter(NullFormatter())
+    step_ticks(ax, conv["h"])
     ax.set(
         xlabel="step h [s]",
         ylabel=f"max |{_body(cmp)} error| [m]",
