@@ -116,9 +116,15 @@ def _validate(designs, params_type) -> tuple[list, list]:
     """(params or None per design, [(index, value, message)])."""
     out: list = []
     errors: list = []
-    for i, d in enumerate(designs):
+    # the whole list checked at once where the type can (QuarterCarParams.from_mappings);
+    # the rest, one by one: their errors come from the constructor itself
+    many = getattr(params_type, "from_mappings", None)
+    checked = many(designs) if many is not None else [None] * len(designs)
+    for i, (d, p) in enumerate(zip(designs, checked)):
         try:
-            if isinstance(d, params_type):
+            if p is not None:
+                out.append(p)
+            elif isinstance(d, params_type):
                 out.append(d)
             elif isinstance(d, Mapping):
                 out.append(params_type.from_mapping(d))

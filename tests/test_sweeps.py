@@ -340,3 +340,22 @@ def test_tail_bound_bounds_every_later_output():
         assert np.all(y[:-1] <= beta[:-1]), (k, K)
         x = (phi @ x[..., None])[..., 0]
     assert np.all(np.isfinite(beta[:-1])) and np.all(np.isinf(beta[-1]))
+
+
+def test_rejected_designs_carry_the_constructors_messages():
+    """sweep checks a grid of dicts in arrays (QuarterCarParams.from_mappings);
+    its rejected designs and their messages must be those of the one-by-one
+    constructor (the reference), index by index."""
+    grid = {"ks": [3e4, -1.0, np.nan], "zeta": [0.2, -0.5]}
+    designs = qc.sweeps.design_grid(grid)
+    expected = []
+    for i, d in enumerate(designs):
+        try:
+            qc.QuarterCarParams.from_mapping(d)
+        except ValueError as exc:
+            expected.append((i, str(exc)))
+    T = np.linspace(0, 1, 101)
+    with pytest.warns(RuntimeWarning, match="5 of 6 designs were rejected"):
+        res = qc.sweep(grid, T, progress=False)
+    assert list(zip(res.errors["index"], res.errors["error"])) == expected
+    assert res.metrics["error"].ne("").tolist() == [i != 0 for i in range(6)]
