@@ -262,9 +262,9 @@ class QuarterCarParams:
             except OverflowError:  # an int beyond float's range
                 return out
         m = len(designs)
-        default = {f.name: f.default for f in fields(cls)}
+        seed = cls()  # the defaults of the fields not in the grid
         ms, mu, ks, ku = (
-            columns[k] if k in columns else np.full(m, float(default[k])) for k in names[:4]
+            columns[k] if k in columns else np.full(m, getattr(seed, k)) for k in names[:4]
         )
         zeta, cs = columns.get("zeta", np.nan), columns.get("cs", np.nan)
         has_zeta, has_cs = "zeta" in keys, "cs" in keys
