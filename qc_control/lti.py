@@ -664,21 +664,25 @@ class TailBound:
         self._ok = ok
         self.m = m
 
-    def __call__(self, x: np.ndarray) -> np.ndarray:
+    def __call__(self, x: np.ndarray, rows: slice | None = None) -> np.ndarray:
         """Bounds on ``|y_{k,r}|`` for all ``k >= K`` from ``x = x_K``: ``(m, n)`` gives
-        ``(m, p)``; ``(m, n, S)`` (S states per design) gives ``(m, p, S)``."""
+        ``(m, p)``; ``(m, n, S)`` (S states per design) gives ``(m, p, S)``.
+        With ``rows`` (a slice), only those outputs' bounds."""
         n = x.shape[1]
+        a, absolute = (
+            (self._a, self._abs) if rows is None else (self._a[:, rows], self._abs[:, rows])
+        )
         if x.ndim == 2:  # one state per design: broadcasting beats m tiny matmuls
             ri = (self._W_ri * x[:, None, :]).sum(axis=-1)  # (m, 2n)
             z = np.sqrt(ri[:, :n] ** 2 + ri[:, n:] ** 2)  # |V⁻¹ x| (np.hypot is slower)
-            beta = (self._a * z[:, None, :]).sum(axis=-1) * (1 + 1e-6)
-            beta += self._abs * np.abs(x).max(axis=-1)[:, None]
+            beta = (a * z[:, None, :]).sum(axis=-1) * (1 + 1e-6)
+            beta += absolute * np.abs(x).max(axis=-1)[:, None]
             return np.where(self._ok[:, None], beta, np.inf)
         ri = self._W_ri @ x  # (m, 2n, S)
         ri *= ri
         z = np.sqrt(ri[:, :n] + ri[:, n:])
-        beta = (self._a @ z) * (1 + 1e-6)
-        beta += self._abs[..., None] * np.abs(x).max(axis=-2)[:, None, :]
+        beta = (a @ z) * (1 + 1e-6)
+        beta += absolute[..., None] * np.abs(x).max(axis=-2)[:, None, :]
         return np.where(self._ok[:, None, None], beta, np.inf)
 
 

@@ -353,7 +353,8 @@ def _last_outside(out: OutputStream, tail: TailBound, carries, row, final, band,
     """
     m, L = carries.shape[0], out.L
     nb = carries.shape[-1] - 1
-    reach = (tail(carries)[:, row] + np.abs(final)[:, None]) * (1 + 1e-12)  # (m, nb + 1)
+    bound = tail(carries, rows=slice(row, row + 1))[:, 0]  # only the output searched
+    reach = (bound + np.abs(final)[:, None]) * (1 + 1e-12)  # (m, blocks)
     quiet = reach <= band[:, None]  # nothing outside from this block's start on
     hi = np.where(quiet.any(axis=-1), np.argmax(quiet, axis=-1), nb)  # blocks < hi to search
     last = np.full(m, -1)
