@@ -642,16 +642,29 @@ class TailBound:
     ----------
     phi : array, shape (m, n, n)
     C : array, shape (m, p, n)
+    vectors : array, shape (m, n, n), optional
+        Eigenvectors of ``Φ`` computed before: those of ``A`` for the step
+        map ``Φ = R(hA)`` of a Runge–Kutta method, a polynomial in ``hA``,
+        which has ``A``'s eigenvectors (one decomposition then serves the
+        stability check and this bound). ``Φ``'s eigenvalues are then read
+        off ``diag(V⁻¹ Φ V)``.
     """
 
-    def __init__(self, phi: np.ndarray, C: np.ndarray):
+    def __init__(self, phi: np.ndarray, C: np.ndarray, vectors: np.ndarray | None = None):
         phi, C = np.asarray(phi, dtype=float), np.asarray(C, dtype=float)
         m, n = phi.shape[0], phi.shape[-1]
         ok = np.all(np.isfinite(phi), axis=(-2, -1))
-        lam, V = np.linalg.eig(np.where(ok[:, None, None], phi, 0.0))
-        ok &= np.abs(lam).max(axis=-1) < 1.0
         with np.errstate(all="ignore"):
-            W = np.linalg.inv(np.where(ok[:, None, None], V, np.eye(n)))
+            if vectors is None:
+                lam, V = np.linalg.eig(np.where(ok[:, None, None], phi, 0.0))
+                ok &= np.abs(lam).max(axis=-1) < 1.0
+                W = np.linalg.inv(np.where(ok[:, None, None], V, np.eye(n)))
+            else:
+                V = np.asarray(vectors)
+                ok &= np.all(np.isfinite(V), axis=(-2, -1))
+                W = np.linalg.inv(np.where(ok[:, None, None], V, np.eye(n)))
+                lam = np.einsum("mij,mjk,mki->mi", W, np.where(ok[:, None, None], phi, 0.0), V)
+                ok &= np.abs(lam).max(axis=-1) < 1.0
             # κ₁(V) = ‖V‖₁‖V⁻¹‖₁, the largest column sums
             cond = np.abs(V).sum(axis=-2).max(axis=-1) * np.abs(W).sum(axis=-2).max(axis=-1)
         ok &= np.isfinite(cond) & (cond < 1e8)

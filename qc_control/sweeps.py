@@ -174,18 +174,23 @@ def _keep_heap() -> None:
     np.empty(2**21)  # not written to: no page is touched
 
 
-def _run_chunk(batch: BatchedModel, *args):
+def _run_chunk(batch: BatchedModel, *args, eig=None):
     """Simulate one chunk of designs; module level so that executors can pickle it.
 
     The chunk is computed `VECTOR_DESIGNS` designs at a time (the size at
     which a segment of streamed outputs stays in cache), whatever its size.
+    ``eig``: the designs' ``np.linalg.eig(A)``, when the caller has it.
     """
     _keep_heap()
     m = batch.A.shape[0]
     if m <= VECTOR_DESIGNS:
-        return _run_designs(batch, *args)
+        return _run_designs(batch, *args, eig=eig)
     parts = [
-        _run_designs(_take(batch, slice(s, s + VECTOR_DESIGNS)), *args)
+        _run_designs(
+            _take(batch, slice(s, s + VECTOR_DESIGNS)),
+            *args,
+            eig=None if eig is None else tuple(e[s : s + VECTOR_DESIGNS] for e in eig),
+        )
         for s in range(0, m, VECTOR_DESIGNS)
     ]
     result = {key: np.concatenate([r[key] for r, _ in parts]) for key in parts[0][0]}
@@ -204,18 +209,22 @@ def _run_designs(
     substeps: int,
     metric_items,
     keep_states: bool,
+    *,
+    eig=None,
 ):
     """Simulate up to `VECTOR_DESIGNS` designs together.
 
     ``metric_items`` are ``(column, name or callable, corner)``: registered
     metrics travel by name (their formulas live in this module's imports).
+    ``eig`` is ``np.linalg.eig(A)`` if the caller has it (else computed here).
     """
     A, B, C, D = batch.A, batch.B, batch.C, batch.D
     m, n = A.shape[0], A.shape[-1]
     if not keep_states and all(isinstance(metric, str) for _, metric, _ in metric_items):
         items = [(column, METRICS[name], corner) for column, name, corner in metric_items]
         if MetricStream.supports(items, roles):
-            return _stream_chunk(batch, labels, roles, T, X0, U, method, substeps, items), None
+            result = _stream_chunk(batch, labels, roles, T, X0, U, method, substeps, items, eig=eig)
+            return result, None
     # only the outputs the metrics read (a custom metric may read any)
     wanted = _outputs_read(metric_items, roles, labels)
     rows = [labels.index(label) for label in wanted]
@@ -248,7 +257,9 @@ def _run_designs(
             through = np.flatnonzero(np.any(D != 0, axis=(0, 2)))
             if through.size:
                 y[:, through] += D[:, through] @ U
-        stable = step_is_stable(method, H / substeps, np.linalg.eigvals(A))
+        stable = step_is_stable(
+            method, H / substeps, np.linalg.eigvals(A) if eig is None else eig[0]
+        )
         signals = RideSignals(
             T,
             {label: y[:, i] for i, label in enumerate(labels)},
@@ -265,7 +276,7 @@ def _run_designs(
     return result, x
 
 
-def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps, items):
+def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps, items, eig=None):
     """One chunk's registered metrics, streamed (`qc_control.lti.OutputStream`
     into `qc_control.metrics.MetricStream`): no ``(designs, outputs, samples)``
     array, only a segment of it at a time.
@@ -281,6 +292,10 @@ def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps
               a_w = C_w \\tilde x + \\tilde D a, \\quad \\tilde x_0 = -B_1 a_0,
 
     the same recursion `qc_control.iso2631.wk_weighted` evaluates by FFT.
+
+    With ``eig = np.linalg.eig(A)`` (the sweep has it, for its ordering), its
+    eigenvalues give ``stable`` and its eigenvectors, which the step map
+    ``R(hA)`` shares, the `TailBound`: no decomposition per chunk.
     """
     A, B, C, D = batch.A, batch.B, batch.C, batch.D
     m, n = A.shape[0], A.shape[-1]
@@ -336,7 +351,9 @@ def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps
             # the free response decays: once no later sample can move a peak, a
             # lift-off count or the settling time (TailBound, the modal bound on
             # every later output), the rest of the samples are not needed
-            tail = TailBound(phi, C[:, rows])
+            # the car's eigenvectors fit Φ = R(hA) (not the Wk filter's extended Φ)
+            vectors = None if eig is None or stream.weighted else eig[1]
+            tail = TailBound(phi, C[:, rows], vectors=vectors)
         cut = False
         for index, y in out:
             stream.update(index, {label: y[:, i] for i, label in enumerate(streamed)})
@@ -357,7 +374,8 @@ def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps
                     last = _last_outside(out, tail, carries, i, end, 0.02 * M, T.size)
                     stream.set_last_outside(streamed[i], last)
         stream.update(np.array([T.size - 1]), {k: v[:, None] for k, v in final.items()})
-        result = {"stable": step_is_stable(method, H / substeps, np.linalg.eigvals(A))}
+        lam = np.linalg.eigvals(A) if eig is None else eig[0]
+        result = {"stable": step_is_stable(method, H / substeps, lam)}
         for column, values in stream.result().items():
             result[column] = values
     return result
@@ -588,13 +606,15 @@ def sweep(
         else BatchedModel(*(np.zeros((0, 1, 1)),) * 4, (), ())
     )
     order = np.arange(len(good))
+    eig = None
     if U is None and streamed and len(good) > VECTOR_DESIGNS:
         # a free chunk stops once its slowest design has decayed past what its
         # metrics can see (TailBound): chunk designs of like decay together,
         # by their slowest mode's decay rate, fastest first (results go back by
-        # index, so the order is free)
+        # index, so the order is free); the chunks reuse the decomposition
+        eig = np.linalg.eig(batch.A)
         with np.errstate(invalid="ignore"):
-            abscissa = np.linalg.eigvals(batch.A).real.max(axis=-1)
+            abscissa = eig[0].real.max(axis=-1)
         order = np.argsort(np.nan_to_num(abscissa, nan=np.inf), kind="stable")
     chunks = [
         ([good[i] for i in order[s : s + chunk_size]], order[s : s + chunk_size])
@@ -602,9 +622,12 @@ def sweep(
     ]
     args = (tuple(sys_.output_labels), model.roles, T, X0, U, tab, substeps, metric_items, states)
     if executor is None:
-        results = (_run_chunk(_take(batch, sl), *args) for _, sl in chunks)
+        results = (_run_chunk(_take(batch, sl), *args, eig=_eig_part(eig, sl)) for _, sl in chunks)
     elif isinstance(executor, Executor) or hasattr(executor, "submit"):
-        futures = [executor.submit(_run_chunk, _take(batch, sl), *args) for _, sl in chunks]
+        futures = [
+            executor.submit(_run_chunk, _take(batch, sl), *args, eig=_eig_part(eig, sl))
+            for _, sl in chunks
+        ]
         results = (f.result() for f in futures)
     else:
         raise TypeError(
@@ -634,6 +657,11 @@ def sweep(
 
     frame, err_frame = _tables(designs, params, errors, model, stable, table)
     return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)
+
+
+def _eig_part(eig, idx):
+    """The rows ``idx`` of ``np.linalg.eig``'s ``(eigenvalues, eigenvectors)``, or None."""
+    return None if eig is None else (eig[0][idx], eig[1][idx])
 
 
 def _tables(designs, params, errors, model, stable, table) -> tuple[pd.DataFrame, pd.DataFrame]:
