@@ -667,15 +667,15 @@ def _eig_part(eig, idx):
 def _tables(designs, params, errors, model, stable, table) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The result's ``metrics`` and ``errors`` frames; warns about rejected designs."""
     names = list(model.params.to_dict())
-    frame = pd.DataFrame(  # column by column: one getattr per value, no dict per design
-        {n: [np.nan if p is None else getattr(p, n) for p in params] for n in names}
-    )
-    frame["stable"] = stable
-    for column, values in table.items():
-        frame[column] = values
-    frame["error"] = ""
+    # column by column (one getattr per value, no dict per design), in one frame
+    columns: dict = {n: [np.nan if p is None else getattr(p, n) for p in params] for n in names}
+    columns["stable"] = stable
+    columns.update(table)
+    error = [""] * len(params)
     for i, _, message in errors:
-        frame.loc[i, "error"] = message
+        error[i] = message
+    columns["error"] = error
+    frame = pd.DataFrame(columns)
     err_frame = pd.DataFrame(errors, columns=["index", "value", "error"])
     if errors:
         warnings.warn(
