@@ -153,6 +153,18 @@ def _take(batch: BatchedModel, idx) -> BatchedModel:
 #: Designs vectorised together inside a chunk: a chunk sent to an executor may
 #: be much larger (fewer, bigger tasks), and is computed this many at a time.
 VECTOR_DESIGNS = 64
+#: Designs vectorised together in a free sweep of registered metrics (the
+#: default sweep): its chunks are mostly set-up (power tables, carries, the
+#: settling search), whose per-call costs twice as many designs share; its
+#: outputs are streamed a fixed number of samples at a time whatever this is.
+FREE_VECTOR_DESIGNS = 128
+
+
+def _vector_designs(U, metric_items, keep_states: bool) -> int:
+    """Designs computed together: `FREE_VECTOR_DESIGNS` for a streamed free
+    sweep, else `VECTOR_DESIGNS`."""
+    streamed = not keep_states and all(isinstance(m, str) for _, m, _ in metric_items)
+    return FREE_VECTOR_DESIGNS if U is None and streamed else VECTOR_DESIGNS
 
 
 @functools.cache
@@ -178,20 +190,24 @@ def _run_chunk(batch: BatchedModel, *args, eig=None):
     """Simulate one chunk of designs; module level so that executors can pickle it.
 
     The chunk is computed `VECTOR_DESIGNS` designs at a time (the size at
-    which a segment of streamed outputs stays in cache), whatever its size.
-    ``eig``: the designs' ``np.linalg.eig(A)``, when the caller has it.
+    which a segment of streamed outputs stays in cache; `FREE_VECTOR_DESIGNS`
+    for a streamed free sweep), whatever its size. ``eig``: the designs'
+    ``np.linalg.eig(A)``, when the caller has it. ``args`` are
+    `_run_designs`'s after the batch.
     """
     _keep_heap()
     m = batch.A.shape[0]
-    if m <= VECTOR_DESIGNS:
+    _, _, _, _, U, _, _, metric_items, keep_states = args
+    vector = _vector_designs(U, metric_items, keep_states)
+    if m <= vector:
         return _run_designs(batch, *args, eig=eig)
     parts = [
         _run_designs(
-            _take(batch, slice(s, s + VECTOR_DESIGNS)),
+            _take(batch, slice(s, s + vector)),
             *args,
-            eig=None if eig is None else tuple(e[s : s + VECTOR_DESIGNS] for e in eig),
+            eig=None if eig is None else tuple(e[s : s + vector] for e in eig),
         )
-        for s in range(0, m, VECTOR_DESIGNS)
+        for s in range(0, m, vector)
     ]
     result = {key: np.concatenate([r[key] for r, _ in parts]) for key in parts[0][0]}
     states = None if parts[0][1] is None else np.concatenate([x for _, x in parts])
@@ -450,7 +466,7 @@ def sweep(
     *,
     model: VehicleModel | None = None,
     substeps: int = 1,
-    chunk_size: int = 64,
+    chunk_size: int | None = None,
     progress: bool | None = None,
     road: ISO8608Road | None = None,
     events: bool = False,
@@ -493,10 +509,12 @@ def sweep(
         design: the same numbers, as slow as that many responses. For a
         nonlinear model ``stable`` says the state stayed finite.
     substeps : int, default 1
-    chunk_size : int, default 64
+    chunk_size : int, optional
         Designs per chunk: the unit of work sent to the executor (make it
         large, thousands, for a cluster: fewer tasks). Each chunk is computed
-        `VECTOR_DESIGNS` (64) designs at a time. Results do not depend on it.
+        `VECTOR_DESIGNS` (64) designs at a time, `FREE_VECTOR_DESIGNS` (128)
+        for a free sweep of registered metrics; that is also the default
+        chunk. Results do not depend on it.
         Registered metrics are streamed: about 3 MB of outputs and carries at
         a time whatever ``len(T)`` (see Notes); custom metrics and
         ``states=True`` hold 64 designs' whole outputs (``64 × 5 × len(T)``
@@ -573,9 +591,15 @@ def sweep(
                 f"U must be finite, of shape ({T.size},) or ({k}, {T.size}) for the inputs "
                 f"{list(sys_.input_labels)} on T, got shape {given}"
             )
-    if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
+    if chunk_size is not None and (
+        isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1
+    ):
         raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
     metric_items = _metric_items(metrics, model.roles)
+    # by default the designs computed together (a nonlinear sweep: VECTOR_DESIGNS, as before)
+    nl_chunk = VECTOR_DESIGNS if chunk_size is None else chunk_size
+    if chunk_size is None:
+        chunk_size = _vector_designs(U, metric_items, states)
     streamed = not states and not isinstance(metrics, Mapping)
     rows = min(chunk_size, len(designs), VECTOR_DESIGNS) * (sys_.noutputs + n * states)
     # streamed: a segment of outputs (~1 MB), a run of carries (~2 MB) and the padded
@@ -593,7 +617,7 @@ def sweep(
     if is_nonlinear(model):  # stepped in a batch (qc_control.nlsweep), or one by one
         stable, table, kept = nonlinear_sweep(
             model, params, T, X0, U, tab, substeps, metric_items, states,
-            events=events, executor=executor, chunk_size=chunk_size,
+            events=events, executor=executor, chunk_size=nl_chunk,
         )  # fmt: skip
         frame, err_frame = _tables(designs, params, errors, model, stable, table)
         return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)

@@ -416,3 +416,30 @@ def test_free_sweep_of_many_designs_reuses_the_ordering_decomposition(monkeypatc
         else:
             np.testing.assert_allclose(streamed[column], whole[column], rtol=1e-12)
     assert (streamed["stable"] == whole["stable"]).all()
+
+
+def test_a_free_chunk_is_split_by_the_free_vector_unit():
+    """A free sweep of registered metrics computes FREE_VECTOR_DESIGNS (128)
+    designs together: a task of 300 designs sent to an executor is split into
+    128, 128 and 44, and run here the sweep goes by chunks of 128. The
+    reference: the materialised metrics of the whole trajectories
+    (states=True, 64 at a time): 1e-12 relative (regrouped sums of squares),
+    settling times and flags exactly."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from qc_control.sweeps import FREE_VECTOR_DESIGNS
+
+    grid = {"ks": np.linspace(1.5e4, 4.5e4, 15), "zeta": np.linspace(0.05, 1.2, 20)}
+    T2 = np.linspace(0, 3, 3001)
+    assert 2 * FREE_VECTOR_DESIGNS < 300
+    whole = sweep(grid, T2, X0, states=True, progress=False).metrics
+    with ThreadPoolExecutor(1) as pool:
+        sent = sweep(grid, T2, X0, executor=pool, chunk_size=300, progress=False).metrics
+    here = sweep(grid, T2, X0, progress=False).metrics
+    for streamed in (sent, here):
+        for column in DEFAULT_METRICS:
+            if column == "settling_time [s]":
+                assert (streamed[column] == whole[column]).all()
+            else:
+                np.testing.assert_allclose(streamed[column], whole[column], rtol=1e-12)
+        assert (streamed["stable"] == whole["stable"]).all()
