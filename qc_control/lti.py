@@ -642,16 +642,29 @@ class TailBound:
     ----------
     phi : array, shape (m, n, n)
     C : array, shape (m, p, n)
+    vectors : array, shape (m, n, n), optional
+        Eigenvectors of ``Φ`` computed before: those of ``A`` for the step
+        map ``Φ = R(hA)`` of a Runge–Kutta method, a polynomial in ``hA``,
+        which has ``A``'s eigenvectors (one decomposition then serves the
+        stability check and this bound). ``Φ``'s eigenvalues are then read
+        off ``diag(V⁻¹ Φ V)``.
     """
 
-    def __init__(self, phi: np.ndarray, C: np.ndarray):
+    def __init__(self, phi: np.ndarray, C: np.ndarray, vectors: np.ndarray | None = None):
         phi, C = np.asarray(phi, dtype=float), np.asarray(C, dtype=float)
         m, n = phi.shape[0], phi.shape[-1]
         ok = np.all(np.isfinite(phi), axis=(-2, -1))
-        lam, V = np.linalg.eig(np.where(ok[:, None, None], phi, 0.0))
-        ok &= np.abs(lam).max(axis=-1) < 1.0
         with np.errstate(all="ignore"):
-            W = np.linalg.inv(np.where(ok[:, None, None], V, np.eye(n)))
+            if vectors is None:
+                lam, V = np.linalg.eig(np.where(ok[:, None, None], phi, 0.0))
+                ok &= np.abs(lam).max(axis=-1) < 1.0
+                W = np.linalg.inv(np.where(ok[:, None, None], V, np.eye(n)))
+            else:
+                V = np.asarray(vectors)
+                ok &= np.all(np.isfinite(V), axis=(-2, -1))
+                W = np.linalg.inv(np.where(ok[:, None, None], V, np.eye(n)))
+                lam = np.einsum("mij,mjk,mki->mi", W, np.where(ok[:, None, None], phi, 0.0), V)
+                ok &= np.abs(lam).max(axis=-1) < 1.0
             # κ₁(V) = ‖V‖₁‖V⁻¹‖₁, the largest column sums
             cond = np.abs(V).sum(axis=-2).max(axis=-1) * np.abs(W).sum(axis=-2).max(axis=-1)
         ok &= np.isfinite(cond) & (cond < 1e8)
@@ -664,21 +677,25 @@ class TailBound:
         self._ok = ok
         self.m = m
 
-    def __call__(self, x: np.ndarray) -> np.ndarray:
+    def __call__(self, x: np.ndarray, rows: slice | None = None) -> np.ndarray:
         """Bounds on ``|y_{k,r}|`` for all ``k >= K`` from ``x = x_K``: ``(m, n)`` gives
-        ``(m, p)``; ``(m, n, S)`` (S states per design) gives ``(m, p, S)``."""
+        ``(m, p)``; ``(m, n, S)`` (S states per design) gives ``(m, p, S)``.
+        With ``rows`` (a slice), only those outputs' bounds."""
         n = x.shape[1]
+        a, absolute = (
+            (self._a, self._abs) if rows is None else (self._a[:, rows], self._abs[:, rows])
+        )
         if x.ndim == 2:  # one state per design: broadcasting beats m tiny matmuls
             ri = (self._W_ri * x[:, None, :]).sum(axis=-1)  # (m, 2n)
             z = np.sqrt(ri[:, :n] ** 2 + ri[:, n:] ** 2)  # |V⁻¹ x| (np.hypot is slower)
-            beta = (self._a * z[:, None, :]).sum(axis=-1) * (1 + 1e-6)
-            beta += self._abs * np.abs(x).max(axis=-1)[:, None]
+            beta = (a * z[:, None, :]).sum(axis=-1) * (1 + 1e-6)
+            beta += absolute * np.abs(x).max(axis=-1)[:, None]
             return np.where(self._ok[:, None], beta, np.inf)
         ri = self._W_ri @ x  # (m, 2n, S)
         ri *= ri
         z = np.sqrt(ri[:, :n] + ri[:, n:])
-        beta = (self._a @ z) * (1 + 1e-6)
-        beta += self._abs[..., None] * np.abs(x).max(axis=-2)[:, None, :]
+        beta = (a @ z) * (1 + 1e-6)
+        beta += absolute[..., None] * np.abs(x).max(axis=-2)[:, None, :]
         return np.where(self._ok[:, None, None], beta, np.inf)
 
 

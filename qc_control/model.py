@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -228,6 +228,77 @@ class QuarterCarParams:
             raise ValueError(f"unknown parameter {unknown[0]!r}; expected one of {sorted(_FIELDS)}")
         return cls(**dict(values))
 
+    @classmethod
+    def from_mappings(cls, designs: Sequence[Any]) -> list[QuarterCarParams | None]:
+        """Many designs checked at once: each one's parameters, or None where
+        only the one-by-one constructor can say (it raises, naming the value).
+
+        The checks of ``__post_init__`` (finite; masses and stiffnesses > 0,
+        damping >= 0; ``cs`` and ``zeta`` agree; `_check_scales`) run as one
+        array expression per condition over the designs that are dicts of
+        numbers, with the same formulas (``2·√ks·√ms``, ``math.isclose``'s
+        test), so a design passes here only if the constructor accepts it, and
+        gets the same values to the bit (IEEE square root and products). Any
+        other design (a bad value, another type, an unknown key, a
+        `QuarterCarParams` already) is left as None for the caller to build
+        one by one. Used by `qc_control.sweeps.sweep` on thousands of designs.
+        """
+        out: list[QuarterCarParams | None] = [None] * len(designs)
+        names = ("ms", "mu", "ks", "ku", "zeta", "cs")
+        # the common case, a grid: dicts with the same keys, one column per key
+        keys = designs[0].keys() if designs and isinstance(designs[0], Mapping) else None
+        if keys is None or not _FIELDS.issuperset(keys):
+            return out
+        if not all(isinstance(d, Mapping) and d.keys() == keys for d in designs):
+            return out
+        columns = {}
+        for key in keys:
+            column = [d[key] for d in designs]
+            # plain numbers only (bool, None, other types: one by one)
+            if not _NUMBER_TYPES.issuperset(map(type, column)):
+                return out
+            try:
+                columns[key] = np.array(column, dtype=float)
+            except OverflowError:  # an int beyond float's range
+                return out
+        m = len(designs)
+        seed = cls()  # the defaults of the fields not in the grid
+        ms, mu, ks, ku = (
+            columns[k] if k in columns else np.full(m, getattr(seed, k)) for k in names[:4]
+        )
+        zeta, cs = columns.get("zeta", np.nan), columns.get("cs", np.nan)
+        has_zeta, has_cs = "zeta" in keys, "cs" in keys
+        with np.errstate(all="ignore"):
+            ok = np.isfinite(ms) & np.isfinite(mu) & np.isfinite(ks) & np.isfinite(ku)
+            ok &= (ms > 0) & (mu > 0) & (ks > 0) & (ku > 0)
+            for given, value in ((has_zeta, zeta), (has_cs, cs)):
+                if given:
+                    ok &= np.isfinite(value) & (value >= 0)
+            critical = 2.0 * np.sqrt(ks) * np.sqrt(ms)
+            if not has_cs:
+                zeta = zeta if has_zeta else np.full(m, 0.25)
+                cs = zeta * critical
+            elif not has_zeta:
+                zeta = cs / critical
+            else:  # both: math.isclose(cs, zeta·critical, rel_tol=1e-9, abs_tol=1e-12)
+                target = zeta * critical
+                ok &= np.abs(cs - target) <= np.maximum(
+                    1e-9 * np.maximum(np.abs(cs), np.abs(target)), 1e-12
+                )
+            # _check_scales, the same arithmetic in the same order
+            ratios = [cs, ks / ms, ks / mu, ku / mu, cs / ms, cs / mu]
+            ok &= np.isfinite(sum(ratios))
+            rates = [np.sqrt(ratios[1]), np.sqrt(ratios[2]), np.sqrt(ratios[3]), *ratios[4:]]
+            fastest, slowest = np.maximum.reduce(rates), np.minimum.reduce(rates[:3])
+            ok &= ~(fastest > MAX_RATE_SPAN * slowest)
+        values = np.stack([ms, mu, ks, ku, zeta, cs], axis=1)
+        for i, (row, good) in enumerate(zip(values.tolist(), ok.tolist())):
+            if good:  # what __post_init__ stores: six Python floats
+                p = object.__new__(cls)
+                vars(p).update(zip(names, row))
+                out[i] = p
+        return out
+
     def to_dict(self, *, changing: Iterable[str] | None = None) -> dict[str, float]:
         """The six values as a plain dict (``cs`` and ``zeta`` both resolved).
 
@@ -247,6 +318,10 @@ class QuarterCarParams:
 
 
 _FIELDS = frozenset(f.name for f in fields(QuarterCarParams))
+
+
+#: The value types `QuarterCarParams.from_mappings` checks in arrays (not bool).
+_NUMBER_TYPES = frozenset({float, int, np.float64, np.float32, np.int64, np.int32})
 
 
 def as_params(params) -> QuarterCarParams:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import itertools
 import sys
 import warnings
@@ -116,9 +117,15 @@ def _validate(designs, params_type) -> tuple[list, list]:
     """(params or None per design, [(index, value, message)])."""
     out: list = []
     errors: list = []
-    for i, d in enumerate(designs):
+    # the whole list checked at once where the type can (QuarterCarParams.from_mappings);
+    # the rest, one by one: their errors come from the constructor itself
+    many = getattr(params_type, "from_mappings", None)
+    checked = many(designs) if many is not None else [None] * len(designs)
+    for i, (d, p) in enumerate(zip(designs, checked)):
         try:
-            if isinstance(d, params_type):
+            if p is not None:
+                out.append(p)
+            elif isinstance(d, params_type):
                 out.append(d)
             elif isinstance(d, Mapping):
                 out.append(params_type.from_mapping(d))
@@ -146,20 +153,61 @@ def _take(batch: BatchedModel, idx) -> BatchedModel:
 #: Designs vectorised together inside a chunk: a chunk sent to an executor may
 #: be much larger (fewer, bigger tasks), and is computed this many at a time.
 VECTOR_DESIGNS = 64
+#: Designs vectorised together in a free sweep of registered metrics (the
+#: default sweep): its chunks are mostly set-up (power tables, carries, the
+#: settling search), whose per-call costs twice as many designs share; its
+#: outputs are streamed a fixed number of samples at a time whatever this is.
+FREE_VECTOR_DESIGNS = 128
 
 
-def _run_chunk(batch: BatchedModel, *args):
+def _vector_designs(U, metric_items, keep_states: bool) -> int:
+    """Designs computed together: `FREE_VECTOR_DESIGNS` for a streamed free
+    sweep, else `VECTOR_DESIGNS`."""
+    streamed = not keep_states and all(isinstance(m, str) for _, m, _ in metric_items)
+    return FREE_VECTOR_DESIGNS if U is None and streamed else VECTOR_DESIGNS
+
+
+@functools.cache
+def _keep_heap() -> None:
+    """Once per process: let glibc's allocator keep a chunk's freed arrays.
+
+    Each chunk allocates and frees a few MB of arrays (carries, power tables,
+    segments). With glibc's default, adaptive thresholds (about 1 MB and 2 MB
+    once such arrays have been freed), the free top of the heap is handed
+    back to the system after every chunk, and the next chunk touches fresh
+    pages again: their page faults were a third of a free sweep's time. A
+    16 MB array, mapped and freed once, raises the thresholds the way glibc
+    documents (mallopt(3), M_MMAP_THRESHOLD: the threshold follows the
+    largest freed mapped block, up to 32 MB, and the trim threshold is twice
+    that), as any program that once used such an array would: up to 32 MB
+    of freed memory then stay with the process. A no-op where the thresholds
+    were set (`DASK_WORKER_ENV`) or under another allocator.
+    """
+    np.empty(2**21)  # not written to: no page is touched
+
+
+def _run_chunk(batch: BatchedModel, *args, eig=None):
     """Simulate one chunk of designs; module level so that executors can pickle it.
 
     The chunk is computed `VECTOR_DESIGNS` designs at a time (the size at
-    which a segment of streamed outputs stays in cache), whatever its size.
+    which a segment of streamed outputs stays in cache; `FREE_VECTOR_DESIGNS`
+    for a streamed free sweep), whatever its size. ``eig``: the designs'
+    ``np.linalg.eig(A)``, when the caller has it. ``args`` are
+    `_run_designs`'s after the batch.
     """
+    _keep_heap()
     m = batch.A.shape[0]
-    if m <= VECTOR_DESIGNS:
-        return _run_designs(batch, *args)
+    _, _, _, _, U, _, _, metric_items, keep_states = args
+    vector = _vector_designs(U, metric_items, keep_states)
+    if m <= vector:
+        return _run_designs(batch, *args, eig=eig)
     parts = [
-        _run_designs(_take(batch, slice(s, s + VECTOR_DESIGNS)), *args)
-        for s in range(0, m, VECTOR_DESIGNS)
+        _run_designs(
+            _take(batch, slice(s, s + vector)),
+            *args,
+            eig=None if eig is None else tuple(e[s : s + vector] for e in eig),
+        )
+        for s in range(0, m, vector)
     ]
     result = {key: np.concatenate([r[key] for r, _ in parts]) for key in parts[0][0]}
     states = None if parts[0][1] is None else np.concatenate([x for _, x in parts])
@@ -177,18 +225,22 @@ def _run_designs(
     substeps: int,
     metric_items,
     keep_states: bool,
+    *,
+    eig=None,
 ):
     """Simulate up to `VECTOR_DESIGNS` designs together.
 
     ``metric_items`` are ``(column, name or callable, corner)``: registered
     metrics travel by name (their formulas live in this module's imports).
+    ``eig`` is ``np.linalg.eig(A)`` if the caller has it (else computed here).
     """
     A, B, C, D = batch.A, batch.B, batch.C, batch.D
     m, n = A.shape[0], A.shape[-1]
     if not keep_states and all(isinstance(metric, str) for _, metric, _ in metric_items):
         items = [(column, METRICS[name], corner) for column, name, corner in metric_items]
         if MetricStream.supports(items, roles):
-            return _stream_chunk(batch, labels, roles, T, X0, U, method, substeps, items), None
+            result = _stream_chunk(batch, labels, roles, T, X0, U, method, substeps, items, eig=eig)
+            return result, None
     # only the outputs the metrics read (a custom metric may read any)
     wanted = _outputs_read(metric_items, roles, labels)
     rows = [labels.index(label) for label in wanted]
@@ -221,7 +273,9 @@ def _run_designs(
             through = np.flatnonzero(np.any(D != 0, axis=(0, 2)))
             if through.size:
                 y[:, through] += D[:, through] @ U
-        stable = step_is_stable(method, H / substeps, np.linalg.eigvals(A))
+        stable = step_is_stable(
+            method, H / substeps, np.linalg.eigvals(A) if eig is None else eig[0]
+        )
         signals = RideSignals(
             T,
             {label: y[:, i] for i, label in enumerate(labels)},
@@ -238,7 +292,7 @@ def _run_designs(
     return result, x
 
 
-def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps, items):
+def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps, items, eig=None):
     """One chunk's registered metrics, streamed (`qc_control.lti.OutputStream`
     into `qc_control.metrics.MetricStream`): no ``(designs, outputs, samples)``
     array, only a segment of it at a time.
@@ -254,6 +308,10 @@ def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps
               a_w = C_w \\tilde x + \\tilde D a, \\quad \\tilde x_0 = -B_1 a_0,
 
     the same recursion `qc_control.iso2631.wk_weighted` evaluates by FFT.
+
+    With ``eig = np.linalg.eig(A)`` (the sweep has it, for its ordering), its
+    eigenvalues give ``stable`` and its eigenvectors, which the step map
+    ``R(hA)`` shares, the `TailBound`: no decomposition per chunk.
     """
     A, B, C, D = batch.A, batch.B, batch.C, batch.D
     m, n = A.shape[0], A.shape[-1]
@@ -309,7 +367,9 @@ def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps
             # the free response decays: once no later sample can move a peak, a
             # lift-off count or the settling time (TailBound, the modal bound on
             # every later output), the rest of the samples are not needed
-            tail = TailBound(phi, C[:, rows])
+            # the car's eigenvectors fit Φ = R(hA) (not the Wk filter's extended Φ)
+            vectors = None if eig is None or stream.weighted else eig[1]
+            tail = TailBound(phi, C[:, rows], vectors=vectors)
         cut = False
         for index, y in out:
             stream.update(index, {label: y[:, i] for i, label in enumerate(streamed)})
@@ -330,7 +390,8 @@ def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps
                     last = _last_outside(out, tail, carries, i, end, 0.02 * M, T.size)
                     stream.set_last_outside(streamed[i], last)
         stream.update(np.array([T.size - 1]), {k: v[:, None] for k, v in final.items()})
-        result = {"stable": step_is_stable(method, H / substeps, np.linalg.eigvals(A))}
+        lam = np.linalg.eigvals(A) if eig is None else eig[0]
+        result = {"stable": step_is_stable(method, H / substeps, lam)}
         for column, values in stream.result().items():
             result[column] = values
     return result
@@ -347,7 +408,8 @@ def _last_outside(out: OutputStream, tail: TailBound, carries, row, final, band,
     """
     m, L = carries.shape[0], out.L
     nb = carries.shape[-1] - 1
-    reach = (tail(carries)[:, row] + np.abs(final)[:, None]) * (1 + 1e-12)  # (m, nb + 1)
+    bound = tail(carries, rows=slice(row, row + 1))[:, 0]  # only the output searched
+    reach = (bound + np.abs(final)[:, None]) * (1 + 1e-12)  # (m, blocks)
     quiet = reach <= band[:, None]  # nothing outside from this block's start on
     hi = np.where(quiet.any(axis=-1), np.argmax(quiet, axis=-1), nb)  # blocks < hi to search
     last = np.full(m, -1)
@@ -404,7 +466,7 @@ def sweep(
     *,
     model: VehicleModel | None = None,
     substeps: int = 1,
-    chunk_size: int = 64,
+    chunk_size: int | None = None,
     progress: bool | None = None,
     road: ISO8608Road | None = None,
     events: bool = False,
@@ -447,10 +509,12 @@ def sweep(
         design: the same numbers, as slow as that many responses. For a
         nonlinear model ``stable`` says the state stayed finite.
     substeps : int, default 1
-    chunk_size : int, default 64
+    chunk_size : int, optional
         Designs per chunk: the unit of work sent to the executor (make it
         large, thousands, for a cluster: fewer tasks). Each chunk is computed
-        `VECTOR_DESIGNS` (64) designs at a time. Results do not depend on it.
+        `VECTOR_DESIGNS` (64) designs at a time, `FREE_VECTOR_DESIGNS` (128)
+        for a free sweep of registered metrics; that is also the default
+        chunk. Results do not depend on it.
         Registered metrics are streamed: about 3 MB of outputs and carries at
         a time whatever ``len(T)`` (see Notes); custom metrics and
         ``states=True`` hold 64 designs' whole outputs (``64 × 5 × len(T)``
@@ -527,9 +591,15 @@ def sweep(
                 f"U must be finite, of shape ({T.size},) or ({k}, {T.size}) for the inputs "
                 f"{list(sys_.input_labels)} on T, got shape {given}"
             )
-    if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
+    if chunk_size is not None and (
+        isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1
+    ):
         raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
     metric_items = _metric_items(metrics, model.roles)
+    # by default the designs computed together (a nonlinear sweep: VECTOR_DESIGNS, as before)
+    nl_chunk = VECTOR_DESIGNS if chunk_size is None else chunk_size
+    if chunk_size is None:
+        chunk_size = _vector_designs(U, metric_items, states)
     streamed = not states and not isinstance(metrics, Mapping)
     rows = min(chunk_size, len(designs), VECTOR_DESIGNS) * (sys_.noutputs + n * states)
     # streamed: a segment of outputs (~1 MB), a run of carries (~2 MB) and the padded
@@ -547,7 +617,7 @@ def sweep(
     if is_nonlinear(model):  # stepped in a batch (qc_control.nlsweep), or one by one
         stable, table, kept = nonlinear_sweep(
             model, params, T, X0, U, tab, substeps, metric_items, states,
-            events=events, executor=executor, chunk_size=chunk_size,
+            events=events, executor=executor, chunk_size=nl_chunk,
         )  # fmt: skip
         frame, err_frame = _tables(designs, params, errors, model, stable, table)
         return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)
@@ -560,13 +630,15 @@ def sweep(
         else BatchedModel(*(np.zeros((0, 1, 1)),) * 4, (), ())
     )
     order = np.arange(len(good))
+    eig = None
     if U is None and streamed and len(good) > VECTOR_DESIGNS:
         # a free chunk stops once its slowest design has decayed past what its
         # metrics can see (TailBound): chunk designs of like decay together,
         # by their slowest mode's decay rate, fastest first (results go back by
-        # index, so the order is free)
+        # index, so the order is free); the chunks reuse the decomposition
+        eig = np.linalg.eig(batch.A)
         with np.errstate(invalid="ignore"):
-            abscissa = np.linalg.eigvals(batch.A).real.max(axis=-1)
+            abscissa = eig[0].real.max(axis=-1)
         order = np.argsort(np.nan_to_num(abscissa, nan=np.inf), kind="stable")
     chunks = [
         ([good[i] for i in order[s : s + chunk_size]], order[s : s + chunk_size])
@@ -574,9 +646,12 @@ def sweep(
     ]
     args = (tuple(sys_.output_labels), model.roles, T, X0, U, tab, substeps, metric_items, states)
     if executor is None:
-        results = (_run_chunk(_take(batch, sl), *args) for _, sl in chunks)
+        results = (_run_chunk(_take(batch, sl), *args, eig=_eig_part(eig, sl)) for _, sl in chunks)
     elif isinstance(executor, Executor) or hasattr(executor, "submit"):
-        futures = [executor.submit(_run_chunk, _take(batch, sl), *args) for _, sl in chunks]
+        futures = [
+            executor.submit(_run_chunk, _take(batch, sl), *args, eig=_eig_part(eig, sl))
+            for _, sl in chunks
+        ]
         results = (f.result() for f in futures)
     else:
         raise TypeError(
@@ -608,18 +683,23 @@ def sweep(
     return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)
 
 
+def _eig_part(eig, idx):
+    """The rows ``idx`` of ``np.linalg.eig``'s ``(eigenvalues, eigenvectors)``, or None."""
+    return None if eig is None else (eig[0][idx], eig[1][idx])
+
+
 def _tables(designs, params, errors, model, stable, table) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The result's ``metrics`` and ``errors`` frames; warns about rejected designs."""
     names = list(model.params.to_dict())
-    frame = pd.DataFrame(  # column by column: one getattr per value, no dict per design
-        {n: [np.nan if p is None else getattr(p, n) for p in params] for n in names}
-    )
-    frame["stable"] = stable
-    for column, values in table.items():
-        frame[column] = values
-    frame["error"] = ""
+    # column by column (one getattr per value, no dict per design), in one frame
+    columns: dict = {n: [np.nan if p is None else getattr(p, n) for p in params] for n in names}
+    columns["stable"] = stable
+    columns.update(table)
+    error = [""] * len(params)
     for i, _, message in errors:
-        frame.loc[i, "error"] = message
+        error[i] = message
+    columns["error"] = error
+    frame = pd.DataFrame(columns)
     err_frame = pd.DataFrame(errors, columns=["index", "value", "error"])
     if errors:
         warnings.warn(

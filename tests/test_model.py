@@ -170,3 +170,54 @@ def test_works_with_python_control_functions():
     fr = control.frequency_response(sys, np.logspace(-1, 2, 20))
     assert fr.magnitude.shape == (5, 1, 20)
     assert control.bode_plot(fr) is not None
+
+
+def _one_by_one(d):
+    try:
+        return QuarterCarParams.from_mapping(d)
+    except ValueError as exc:
+        return str(exc)
+
+
+@pytest.mark.parametrize(
+    "designs",
+    [
+        # ks and zeta: good, at the edges, and every way to be refused
+        [{"ks": ks, "zeta": z} for ks in (3e4, 1e-3, 0.0, -1.0, np.inf, 1e305, np.nan)
+         for z in (0.0, 0.3, -0.1, np.nan, 1e300)],
+        # cs given alone, and with zeta (agreeing to 1e-9 relative or not)
+        [{"ks": 3e4, "cs": c} for c in (0.0, 1500.0, -1.0, 1e200, 1e9)],
+        [{"ms": 301.2, "ks": 3e4, "zeta": 0.25, "cs": c}
+         for c in (1502.997, 0.25 * 2 * np.sqrt(3e4) * np.sqrt(301.2) * (1 + 1e-10), 1400.0)],
+        # time scales beyond MAX_RATE_SPAN, masses refused, ints
+        [{"ms": m, "mu": u, "ku": 29530} for m in (301, 1e-9, -5.0, 1e12) for u in (100, 1e-20)],
+    ],
+)  # fmt: skip
+def test_from_mappings_accepts_exactly_what_the_constructor_accepts(designs):
+    """The array checks of from_mappings against the one-by-one constructor
+    (the reference): a design it passes must be one the constructor accepts,
+    with the same six floats to the bit; every design the constructor refuses
+    must be left to it (None), so its message names the value."""
+    fast = QuarterCarParams.from_mappings(designs)
+    for d, p in zip(designs, fast):
+        ref = _one_by_one(d)
+        if p is not None:  # (None, left to the constructor, is always safe)
+            assert not isinstance(ref, str), (d, ref)
+            assert vars(p) == vars(ref) and all(type(v) is float for v in vars(p).values())
+    # the good designs of a grid are all taken by the array path
+    good = [p for d, p in zip(designs, fast) if not isinstance(_one_by_one(d), str)]
+    assert all(p is not None for p in good)
+
+
+def test_from_mappings_leaves_other_designs_to_the_constructor():
+    """Mixed keys, bools, None, strings and non-dicts are not checked in arrays."""
+    for designs in (
+        [{"ks": 3e4}, {"zeta": 0.3}],
+        [{"ks": True}],
+        [{"ks": 3e4, "zeta": None}],
+        [{"ks": "3e4"}],
+        [QuarterCarParams()],
+        [{"kt": 1.0}],
+        [{"ks": 10**400}],
+    ):
+        assert QuarterCarParams.from_mappings(designs) == [None] * len(designs)

@@ -340,3 +340,107 @@ def test_tail_bound_bounds_every_later_output():
         assert np.all(y[:-1] <= beta[:-1]), (k, K)
         x = (phi @ x[..., None])[..., 0]
     assert np.all(np.isfinite(beta[:-1])) and np.all(np.isinf(beta[-1]))
+
+
+def test_rejected_designs_carry_the_constructors_messages():
+    """sweep checks a grid of dicts in arrays (QuarterCarParams.from_mappings);
+    its rejected designs and their messages must be those of the one-by-one
+    constructor (the reference), index by index."""
+    grid = {"ks": [3e4, -1.0, np.nan], "zeta": [0.2, -0.5]}
+    designs = qc.sweeps.design_grid(grid)
+    expected = []
+    for i, d in enumerate(designs):
+        try:
+            qc.QuarterCarParams.from_mapping(d)
+        except ValueError as exc:
+            expected.append((i, str(exc)))
+    T = np.linspace(0, 1, 101)
+    with pytest.warns(RuntimeWarning, match="5 of 6 designs were rejected"):
+        res = qc.sweep(grid, T, progress=False)
+    assert list(zip(res.errors["index"], res.errors["error"])) == expected
+    assert res.metrics["error"].ne("").tolist() == [i != 0 for i in range(6)]
+
+
+def test_tail_bound_from_the_eigenvectors_of_A():
+    """Given A's eigenvectors (the sweep's one decomposition), `TailBound` reads
+    Φ = R(hA)'s eigenvalues off V⁻¹ Φ V. The reference: the bound from Φ's own
+    decomposition, `np.linalg.eig(Φ)`. β = Σ_i |(CV)_ri| |(V⁻¹x)_i| does not
+    depend on how the eigenvectors are scaled or ordered, so the two agree to
+    rounding amplified by κ(V) (~1e3 for these cars): 1e-9 relative. It still
+    bounds every later output (checked on the recurrence for 3000 steps)."""
+    rng = np.random.default_rng(5)
+    designs = [
+        qc.QuarterCarParams(ks=ks, zeta=z) for ks in (1.5e4, 4.5e4) for z in (0.02, 0.3, 1.5)
+    ]
+    A = np.array([np.asarray(qc.quarter_car(p).A) for p in designs])
+    phi = np.array([step_matrices(get_method("rk4"), a, np.zeros((4, 1)), 1e-3)[0] for a in A])
+    C = rng.standard_normal((len(designs), 3, 4))
+    shared = TailBound(phi, C, vectors=np.linalg.eig(A)[1])
+    own = TailBound(phi, C)
+    x = rng.standard_normal((len(designs), 4))
+    np.testing.assert_allclose(shared(x), own(x), rtol=1e-9)
+    beta = shared(x)
+    assert np.all(np.isfinite(beta))
+    for _ in range(3000):
+        assert np.all(np.abs((C @ x[..., None])[..., 0]) <= beta)
+        x = (phi @ x[..., None])[..., 0]
+
+
+def test_free_sweep_of_many_designs_reuses_the_ordering_decomposition(monkeypatch):
+    """Past 64 designs a free sweep orders the designs by decay with one
+    np.linalg.eig(A) and hands each chunk its eigenvalues (``stable``) and
+    eigenvectors (`TailBound`). Its metrics against the whole trajectories
+    (states=True, no bound, no decomposition shared): 1e-12 relative
+    (regrouped sums of squares), settling time and flags exactly."""
+    grid = {
+        "ks": [1.5e4, 3e4, 4.5e4],
+        "zeta": [0.02, 0.1, 0.3, 0.6, 1.5],
+        "mu": [30.0, 45.0, 60.0, 80.0, 100.0],
+    }
+    T10 = np.linspace(0, 10, 10001)
+    whole = sweep(grid, T10, X0, states=True, progress=False).metrics
+    given = []  # the chunks' TailBounds got the shared eigenvectors
+    init = TailBound.__init__
+    monkeypatch.setattr(
+        TailBound,
+        "__init__",
+        lambda self, phi, C, vectors=None: (
+            given.append(vectors is not None) or init(self, phi, C, vectors)
+        ),
+    )
+    streamed = sweep(grid, T10, X0, progress=False).metrics
+    assert len(streamed) > 64 and given and all(given)
+    _assert_default_metrics_equal(streamed, whole)
+
+
+def _assert_default_metrics_equal(streamed, whole):
+    """The default metrics streamed against the materialised ones: 1e-12
+    relative (regrouped sums of squares), settling times and flags exactly."""
+    for column in DEFAULT_METRICS:
+        if column == "settling_time [s]":
+            assert (streamed[column] == whole[column]).all()
+        else:
+            np.testing.assert_allclose(streamed[column], whole[column], rtol=1e-12)
+    assert (streamed["stable"] == whole["stable"]).all()
+
+
+def test_a_free_chunk_is_split_by_the_free_vector_unit():
+    """A free sweep of registered metrics computes FREE_VECTOR_DESIGNS (128)
+    designs together: a task of 300 designs sent to an executor is split into
+    128, 128 and 44, and run here the sweep goes by chunks of 128. The
+    reference: the materialised metrics of the whole trajectories
+    (states=True, 64 at a time): 1e-12 relative (regrouped sums of squares),
+    settling times and flags exactly."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from qc_control.sweeps import FREE_VECTOR_DESIGNS
+
+    grid = {"ks": np.linspace(1.5e4, 4.5e4, 15), "zeta": np.linspace(0.05, 1.2, 20)}
+    T2 = np.linspace(0, 3, 3001)
+    assert 2 * FREE_VECTOR_DESIGNS < 300
+    whole = sweep(grid, T2, X0, states=True, progress=False).metrics
+    with ThreadPoolExecutor(1) as pool:
+        sent = sweep(grid, T2, X0, executor=pool, chunk_size=300, progress=False).metrics
+    here = sweep(grid, T2, X0, progress=False).metrics
+    for streamed in (sent, here):
+        _assert_default_metrics_equal(streamed, whole)
