@@ -715,6 +715,53 @@ class NonlinearQuarterCarBatch:
 
         return rhs
 
+    def compiled_stepper(self):
+        """The compiled batched step of these designs, or None where an option has none.
+
+        Returns ``step(x, out, first, count, step, substeps, a, b, stage_u)``:
+        `qc_control.nlkernel.advance` with these designs' parameters and
+        options bound (its docstring has the arguments). None for a callable
+        spring, damper or road profile: user Python code, which only the
+        NumPy path (`rhs`) can call.
+        """
+        damper = self._damper
+        if damper is None:
+            # a linear damper as a bilinear one without knees, with each design's cs
+            knees, c_reb, c_bnd = PiecewiseDamper(0.0, 0.0), self.params["cs"], self.params["cs"]
+        elif isinstance(damper, PiecewiseDamper):
+            c_reb, c_bnd = np.full(self.size, damper.rebound), np.full(self.size, damper.bound)
+            knees = damper
+        else:
+            return None
+        if self._spring is not None or self._profile is not None:
+            return None
+        # numba: ~0.5 s to import, needed only to step a batch
+        from .nlkernel import OPTION_SLOTS, advance
+
+        q, inf, stop = self.params, math.inf, self._stop
+        floor = -q["static"] if self._unilateral else np.full(self.size, -inf)  # least F_t - k_u δ0
+        rows = [-1.0 / q["ms"], 1.0 / q["mu"], q["ks"], q["ku"], floor, c_reb, c_bnd]
+        p = np.stack(rows)  # (7, m), C-contiguous
+        options = {
+            "k3": self._k3 or 0.0,
+            "stop_bound": inf if stop is None else stop.clearance_bound,
+            "stop_rebound": inf if stop is None else stop.clearance_rebound,
+            "stop_k": 0.0 if stop is None else stop.stiffness,
+            "stop_k3": 0.0 if stop is None else stop.cubic,
+            "knee_rebound": knees.knee_rebound,
+            "knee_bound": knees.knee_bound,
+            "rebound_high": knees.rebound_high,
+            "bound_high": knees.bound_high,
+            "road": -1.0 if self._iz is None else float(self._iz),
+            "actuator": -1.0 if self._ia is None else float(self._ia),
+        }
+        o = np.array([options[name] for name in OPTION_SLOTS], dtype=float)
+
+        def step(x, out, first, count, start, substeps, a, b, stage_u):
+            advance(x, out, first, count, start, substeps, a, b, stage_u, p, o)
+
+        return step
+
     def _block_rhs(self, t, x, u, out=None):
         """`rhs` on states with more axes (``(4, m, L)``): the general formula."""
         q = self._col

@@ -80,6 +80,72 @@ def test_each_design_is_its_own_input_output_response(method, substeps, events):
     assert lifted >= 2  # the case is nonlinear: some wheels do leave the road
 
 
+_RALSTON3 = qc.ButcherTableau(
+    "ralston3", a=[[0, 0, 0], [1 / 2, 0, 0], [0, 3 / 4, 0]], b=[2 / 9, 1 / 3, 4 / 9]
+)
+
+
+@pytest.mark.parametrize(
+    "method, substeps", [("euler", 1), ("heun", 2), ("rk4", 1), (_RALSTON3, 1)]
+)
+@pytest.mark.parametrize(
+    "options",
+    [
+        OPTIONS,  # stops both ways, bilinear damper with knees, cubic spring
+        {},  # unilateral tire only
+        {"tire": "linear", "bump_stop": qc.BumpStop(0.02, 1e5)},  # bound stop only
+        {"actuator": True, "damper": qc.PiecewiseDamper(1500.0, 700.0)},  # zr and fa
+        {"actuator": True, "road": False, "gravity": False, "tire": "linear"},
+    ],
+    ids=["all", "tire", "linear-tire-bound-stop", "actuator", "actuator-no-road"],
+)
+def test_compiled_steps_equal_the_numpy_steps(method, substeps, options, monkeypatch):
+    """`NonlinearQuarterCarBatch.compiled_stepper` (numba loops) against the NumPy
+    path (`rhs` over the designs), an independent writing of the same equations:
+    equal to rounding (the sums run in other orders; observed below 1e-13)."""
+    model = qc.nonlinear_quarter_car_model(**options)
+    dynamics = model.batch_dynamics(DESIGNS)
+    assert dynamics.compiled_stepper() is not None
+    k = len(dynamics.input_labels)
+    force = 800.0 * np.sin(2 * np.pi * 3.0 * T2)  # an actuator force [N]
+    U = (
+        np.stack([ROAD, force])[-k:]
+        if k == 2
+        else (force if options.get("road") is False else ROAD)
+    )
+    compiled = simulate_batch(dynamics, T2, np.zeros(4), U, method, substeps=substeps)
+    monkeypatch.setattr(NonlinearQuarterCarBatch, "compiled_stepper", lambda self: None)
+    plain = simulate_batch(dynamics, T2, np.zeros(4), U, method, substeps=substeps)
+    assert _max_rel(compiled.states, plain.states) < 1e-13
+    assert np.array_equal(compiled.success, plain.success) and compiled.success.all()
+    if options.get("tire", "unilateral") == "unilateral":  # a wheel does leave the road
+        assert np.any(plain.outputs["tire_force"] == 0.0)
+
+
+def test_compiled_steps_diverge_as_the_numpy_steps(monkeypatch):
+    """A design beyond its step's stability (a 1e9 N/m spring at 1 ms) goes
+    non-finite in both paths alike; the others are untouched by it."""
+    model = qc.nonlinear_quarter_car_model(**OPTIONS)
+    designs = [*DESIGNS[:2], {**DESIGNS[0], "ks": 1e9}]
+    compiled = simulate_batch(model.batch_dynamics(designs), T2, np.zeros(4), ROAD)
+    monkeypatch.setattr(NonlinearQuarterCarBatch, "compiled_stepper", lambda self: None)
+    plain = simulate_batch(model.batch_dynamics(designs), T2, np.zeros(4), ROAD)
+    assert compiled.success.tolist() == plain.success.tolist() == [True, True, False]
+    assert _max_rel(compiled.states[:2], plain.states[:2]) < 1e-13
+    assert np.array_equal(np.isfinite(compiled.states), np.isfinite(plain.states))
+
+
+def test_user_callables_have_no_compiled_steps():
+    """A callable spring, damper or road is user Python: the NumPy path runs it."""
+    for options in (
+        {"spring": lambda d: 2e4 * d + 1e6 * d**3},
+        {"damper": lambda v: 1500.0 * np.tanh(v)},
+        {"road": lambda t: 0.0},
+    ):
+        model = qc.nonlinear_quarter_car_model(**options)
+        assert model.batch_dynamics(DESIGNS[:1]).compiled_stepper() is None
+
+
 def test_custom_tableau_and_road_function():
     ralston = qc.ButcherTableau("ralston", a=[[0, 0], [2 / 3, 0]], b=[1 / 4, 3 / 4])
 

@@ -1,0 +1,167 @@
+"""The nonlinear quarter car's batched steps, compiled (numba).
+
+`qc_control.nlsweep` steps many designs of `qc_control.nonlinear_quarter_car`
+together. Written with NumPy over the designs, each stage of each step is a
+dozen NumPy calls on arrays of a thousand numbers, and the calls' fixed cost
+(about a microsecond each) is most of the time: 1,000 designs over 10 s at
+1 ms take about a second whatever the machine's arithmetic could do. This
+module writes the same step as loops over the designs and compiles them
+with numba (LLVM), so that a step costs its arithmetic: the loops over the
+designs are simple enough for the compiler to vectorise.
+
+One step of an explicit tableau with the stepper's own ``h a_ij``, ``h b_i``
+(`qc_control.integrate`):
+
+.. math::
+
+    k_i = f\\big(x + \\textstyle\\sum_{j<i} h a_{ij} k_j,\\; u(t + c_i h)\\big),
+    \\qquad x \\leftarrow x + \\textstyle\\sum_i h b_i k_i ,
+
+with the inputs at the stage times given (`qc_control.nlsweep` interpolates
+them as python-control does). The right-hand side is
+`NonlinearQuarterCarBatch`'s (the module docstring of
+`qc_control.nonlinear` has the equations) with the same folded constants:
+``-F/m_s`` as ``F·(-1/m_s)``, the tire's dynamic force ``F_t - k_u δ0`` as
+``max(k_u (z_r - x_u), -k_u δ0)`` for a unilateral tire, the stops'
+``F = q (k + k3 q²)`` with ``q = d - clip(d, -c_b, c_r)``, which is exactly
+0 between the clearances. The sums run in the NumPy path's order; a
+design's trajectory equals it, and `qc_control.input_output_response`'s, to
+rounding (a few ulps a step; the tests hold it to 1e-12 of the largest
+state).
+
+What has no compiled form: a callable spring, damper or road profile (user
+Python code), and event location (a Python call per event); the NumPy path
+takes those (`NonlinearQuarterCarBatch.compiled_stepper` returns None).
+
+numba is imported with this module, which takes about half a second, so
+`qc_control.nonlinear` imports it only when a batch is first stepped. The
+compiled code is cached on disk beside this file (numba's ``cache=True``;
+numba falls back to a per-user cache where the package is read-only), so
+the one-off compilation (about two seconds) is paid once per installation.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+__all__ = ["advance", "PARAMETER_ROWS", "OPTION_SLOTS"]
+
+#: Rows of the per-design parameter array ``p`` ``(7, m)``, in this order. The
+#: tire floor is the least dynamic tire force ``F_t - k_u δ0``: ``-k_u δ0`` for a
+#: unilateral tire, -inf for a linear one; the damper's low-speed coefficients in
+#: rebound and in bound are each design's ``cs`` for a linear damper, the
+#: `PiecewiseDamper`'s otherwise.
+PARAMETER_ROWS = ("neg_inv_ms", "inv_mu", "ks", "ku", "tire_floor", "c_rebound", "c_bound")
+#: Slots of the options array ``o``: every option as a number, each chosen so
+#: that an element that is off adds exactly 0 (no branch in the loops).
+OPTION_SLOTS = (
+    "k3",  # the cubic spring coefficient [N/m³] (0: linear)
+    "stop_bound",  # c_b [m] (inf: none)
+    "stop_rebound",  # c_r [m] (inf: none)
+    "stop_k",  # k [N/m]
+    "stop_k3",  # k3 [N/m³]
+    "knee_rebound",  # the damper's knees [m/s] (inf: none) and high-speed coefficients
+    "knee_bound",
+    "rebound_high",
+    "bound_high",
+    "road",  # the road input's row in u (-1: none, zr = 0)
+    "actuator",  # the actuator force's row in u (-1: none)
+)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _accelerations(x, u, p, o, out):  # pragma: no cover - compiled (tested through advance)
+    """``out[:2] = (v̇s, v̇u)`` and ``out[2:] = (vs, vu)`` of every design at ``x`` ``(4, m)``.
+
+    Branch-free over the designs (selects, and terms that are exactly 0 when
+    an element is off), so that the compiler vectorises the loop.
+    """
+    m = x.shape[1]
+    k3, cb, cr, kb, kb3 = o[0], o[1], o[2], o[3], o[4]
+    knee_r, knee_b, c_reb_hi, c_bnd_hi = o[5], o[6], o[7], o[8]
+    iz, ia = int(o[9]), int(o[10])
+    zr = u[iz] if iz >= 0 else 0.0
+    fa = u[ia] if ia >= 0 else 0.0
+    # one row at a time (1-D views: unit strides the compiler can vectorise)
+    x0, x1, x2, x3 = x[0], x[1], x[2], x[3]
+    neg_inv_ms, inv_mu, ks, ku, floor, c_rebound, c_bound = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
+    out0, out1, out2, out3 = out[0], out[1], out[2], out[3]
+    for j in range(m):
+        vs, vu, xs, xu = x0[j], x1[j], x2[j], x3[j]
+        v = vs - vu
+        d = xs - xu
+        fs = ks[j] * d + k3 * (d * d * d)
+        c_reb, c_bnd = c_rebound[j], c_bound[j]
+        fd = c_reb * v if v >= 0.0 else c_bnd * v
+        fd = c_reb * knee_r + c_reb_hi * (v - knee_r) if v > knee_r else fd
+        fd = -c_bnd * knee_b + c_bnd_hi * (v + knee_b) if v < -knee_b else fd
+        # the stops: q = d - clip(d, -c_b, c_r), exactly 0 between the clearances
+        clip = d if d > -cb else -cb
+        clip = clip if clip < cr else cr
+        q = d - clip
+        f = (fd + fs) + q * (kb + kb3 * (q * q)) - fa
+        tire = (zr - xu) * ku[j]  # F_t - k_u δ0
+        tire = floor[j] if tire < floor[j] else tire  # (a NaN stays NaN, as np.maximum)
+        out0[j] = f * neg_inv_ms[j]
+        out1[j] = (f + tire) * inv_mu[j]
+        out2[j] = vs
+        out3[j] = vu
+
+
+@numba.njit(cache=True, nogil=True)
+def advance(x, out, first, count, step, substeps, a, b, stage_u, p, o):  # pragma: no cover
+    """Step the designs ``x`` ``(4, m)`` (in place) over ``count`` samples.
+
+    Whole arrays and offsets, not slices, so that numba compiles one
+    specialisation (a slice's layout would depend on where it falls).
+
+    Parameters
+    ----------
+    x : ndarray (4, m)
+        The states at the first sample's start; on return, at the last one's end.
+    out : ndarray (4, B, m)
+        Written: ``out[:, first + l]`` is the state after sample ``l`` (``l < count``).
+    first, count : int
+    step : int
+        The index in ``stage_u`` of the first step.
+    substeps : int
+        Steps of the tableau per sample.
+    a : ndarray (s, s)
+        ``h a_ij`` (strictly lower triangular).
+    b : ndarray (s,)
+        ``h b_i``.
+    stage_u : ndarray (steps, s, k)
+        The inputs at every step's stage times.
+    p : ndarray (7, m)
+        The designs' parameters (`PARAMETER_ROWS`).
+    o : ndarray (11,)
+        The options (`OPTION_SLOTS`).
+    """
+    n, m = x.shape
+    s = b.size
+    K = np.empty((s, n, m))
+    xi = np.empty((n, m))
+    # flat views: the stage sums as loops of unit stride over all n·m numbers
+    x_flat, xi_flat, K_flat = x.reshape(n * m), xi.reshape(n * m), K.reshape(s, n * m)
+    for sample in range(first, first + count):
+        for _ in range(substeps):
+            for i in range(s):
+                for j in range(n * m):
+                    xi_flat[j] = x_flat[j]
+                for q in range(i):
+                    c = a[i, q]
+                    if c != 0.0:
+                        k_q = K_flat[q]
+                        for j in range(n * m):
+                            xi_flat[j] = xi_flat[j] + c * k_q[j]
+                _accelerations(xi, stage_u[step, i], p, o, K[i])
+            for j in range(n * m):
+                acc = 0.0
+                for i in range(s):
+                    acc = acc + b[i] * K_flat[i, j]
+                x_flat[j] = x_flat[j] + acc
+            step += 1
+        for r in range(n):  # (explicit loops: numba compiles a slice assignment slowly)
+            for j in range(m):
+                out[r, sample, j] = x[r, j]
