@@ -446,7 +446,7 @@ class OutputStream:
             self._G_mat = np.ascontiguousarray(G.transpose(0, 3, 1, 2, 4)).reshape(
                 m, p * L, (L + 1) * k
             )
-        self._Q = P[:, L]
+        self._Q = np.ascontiguousarray(P[:, L])
         #: while iterating: the state where the next segment starts (its first block's carry)
         self.carry: np.ndarray | None = None
         # first pass: the carries segment by segment, keeping only where each
@@ -507,19 +507,18 @@ class OutputStream:
         """``(m, n, b1 - b0 + 1)``: the carries ``c_{b0} .. c_{b1}`` from ``c = c_{b0}``.
 
         ``V_0 = c``, ``V_{i+1}`` = the input's effect over block ``b0 + i``,
-        then ``V_i <- Σ_{j<=i} Q^{i-j} V_j`` with ``Q = Φ^L`` (Hillis–Steele,
-        log2 rounds). The same arithmetic on both passes, so the same bits.
+        then ``V_{i+1} <- Q V_i + V_{i+1}`` with ``Q = Φ^L``, in order
+        (`qc_control.recurrence.carry_scan`). The same arithmetic on both
+        passes, so the same bits.
         """
         V = np.zeros((self.m, self.n, b1 - b0 + 1))
         V[:, :, 0] = c
         if self._forced:
             V[:, :, 1:] = np.matmul(self._E_mat, self._window(b0, b1))
-        Q, d, total = self._Q, 1, V.shape[-1]
-        tmp = np.empty_like(V)  # one buffer for every round's product (no fresh pages per round)
-        while d < total:
-            V[:, :, d:] += np.matmul(Q, V[:, :, :-d], out=tmp[:, :, : total - d])
-            Q = Q @ Q
-            d *= 2
+        # numba: ~0.5 s to import, needed only by a stream (sweeps)
+        from .recurrence import carry_scan
+
+        carry_scan(self._Q, V)  # c_{b+1} = Q c_b + w_{b+1}, a compiled loop per design
         return V
 
     def block_carries(self) -> np.ndarray:

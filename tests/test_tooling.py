@@ -41,11 +41,12 @@ LINTED = ["qc_control", "tests", "examples", "benchmarks"]
 DEFERRABLE = {"matplotlib", "dask", "distributed"}
 #: The deferred imports of the package's own code: the entry point loads the
 #: command inside its Ctrl-C handler (qc_control/console.py says why), and the
-#: nonlinear car loads its compiled steps, which import numba (~0.5 s), only
-#: when a batch is stepped.
+#: nonlinear car and the sweeps' streams load their compiled loops, which
+#: import numba (~0.5 s), only when a batch is stepped or a stream is built.
 DEFERRED_OWN = {
     ("qc_control/console.py", "qc_control.cli"),
     ("qc_control/nonlinear.py", "qc_control.nlkernel"),
+    ("qc_control/lti.py", "qc_control.recurrence"),
 }
 #: The presentation layer, where matplotlib may be imported at module level.
 PRESENTATION = ("qc_control.report", "qc_control.plotting")
