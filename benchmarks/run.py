@@ -4,9 +4,9 @@
     python benchmarks/run.py --quick    # smoke mode (CI): small sizes, same code paths
     python benchmarks/run.py --loop     # only qc.integrate against hand-written loops
 
-Every speed is a ratio measured in this run on this machine (best of several
-repeats, or for the stepping loop medians of alternating runs in CPU time), because
-the machines are shared and noisy; absolute times are
+Every speed is a ratio measured in this run on this machine (medians of runs
+timed in turns, with their spread, or best of several repeats where a table
+says so), because the machines are shared and noisy; absolute times are
 printed for context only. Benchmarks are not tests: nothing here fails on a
 slow machine.
 """
@@ -40,8 +40,8 @@ def best_of(fn, repeats: int) -> float:
     return best_time(fn, repeats, warmup=True)
 
 
-def paired_medians(fn_a, fn_b, repeats: int) -> tuple[float, float, float]:
-    """Median CPU times of ``fn_a`` and ``fn_b``, and the median of their ratios.
+def paired_runs(fn_a, fn_b, repeats: int) -> tuple[list[float], list[float], list[float]]:
+    """CPU times of ``fn_a`` and ``fn_b``, timed in turns, and each pair's ratio.
 
     After one untimed call of each, the two are timed in turns (a b, b a, a b,
     ...) in CPU time of this process (``time.process_time``), so that other
@@ -57,8 +57,14 @@ def paired_medians(fn_a, fn_b, repeats: int) -> tuple[float, float, float]:
             start = time.process_time()
             fn()
             times[side].append(time.process_time() - start)
-    ratios = [b / a for a, b in zip(*times)]
-    return statistics.median(times[0]), statistics.median(times[1]), statistics.median(ratios)
+    return times[0], times[1], [b / a for a, b in zip(*times)]
+
+
+def paired_medians(fn_a, fn_b, repeats: int) -> tuple[float, float, float]:
+    """Median CPU times of ``fn_a`` and ``fn_b``, and the median of their ratios
+    (`paired_runs`)."""
+    a, b, ratios = paired_runs(fn_a, fn_b, repeats)
+    return statistics.median(a), statistics.median(b), statistics.median(ratios)
 
 
 def timed_runs(fn, repeats: int) -> list[float]:
@@ -641,7 +647,7 @@ def main(argv=None) -> int:
 
     say(
         f"qc_control benchmarks ({'quick smoke mode' if quick else 'full'}): "
-        f"{n_samples} samples, h = {h * 1e3:g} ms, best of {repeats}"
+        f"{n_samples} samples, h = {h * 1e3:g} ms, {repeats} repeats"
     )
 
     # -- the problem and its reference
@@ -665,12 +671,21 @@ def main(argv=None) -> int:
     ]
 
     # -- 1. LTI engine and generic stepper against control, every method
-    t_ci = best_of(lambda: control.initial_response(sys_free, T, X0), repeats)
-    t_cf = best_of(lambda: control.forced_response(sys_road, T, U, X0), repeats)
-    rows, lti_times = [], {}
+    # each method's response and control's, timed in turns (paired CPU times)
+    rows, lti_times, control_free, control_road = [], {}, [], []
     for m in qc.METHODS:
-        t_lf = best_of(lambda: qc.initial_response(sys_free, T, X0, method=m), repeats)
-        t_lr = best_of(lambda: qc.forced_response(sys_road, T, U, X0, method=m), repeats)
+        t_lf, t_ci, r_free = paired_runs(
+            lambda: qc.initial_response(sys_free, T, X0, method=m),
+            lambda: control.initial_response(sys_free, T, X0),
+            repeats,
+        )
+        t_lr, t_cf, r_road = paired_runs(
+            lambda: qc.forced_response(sys_road, T, U, X0, method=m),
+            lambda: control.forced_response(sys_road, T, U, X0),
+            repeats,
+        )
+        control_free += t_ci
+        control_road += t_cf
         t_gf = best_of(
             lambda: qc.initial_response(sys_free, T, X0, method=m, engine="generic"),
             max(1, repeats // 3),
@@ -678,18 +693,19 @@ def main(argv=None) -> int:
         lti = qc.initial_response(sys_free, T, X0, method=m)
         gen = qc.initial_response(sys_free, T, X0, method=m, engine="generic")
         gap = float(np.max(np.abs(lti.states - gen.states)) / np.max(np.abs(gen.states)))
-        lti_times[m] = t_lf
+        lti_times[m] = statistics.median(t_lf)
         rows.append(
             [
                 m,
-                g(t_lf * 1e3),
-                g(t_ci / t_lf),
-                g(t_lr * 1e3),
-                g(t_cf / t_lr),
+                g(statistics.median(t_lf) * 1e3),
+                med_spread(r_free),
+                g(statistics.median(t_lr) * 1e3),
+                med_spread(r_road),
                 g(t_gf * 1e3),
                 g(gap, 2),
             ]
         )
+    t_ci, t_cf = statistics.median(control_free), statistics.median(control_road)
     head = [
         "method",
         "LTI free [ms]",
@@ -705,7 +721,9 @@ def main(argv=None) -> int:
         "### The LTI engine against python-control",
         "",
         f"control.initial_response: {g(t_ci * 1e3)} ms; control.forced_response "
-        f"(road step): {g(t_cf * 1e3)} ms.",
+        f"(road step): {g(t_cf * 1e3)} ms (medians). Each method's response and control's "
+        f"were timed in turns, {repeats} pairs, in CPU time; times are medians, ratios the "
+        "median (min–max) of the pairs' ratios.",
         "",
         table(head, rows),
         "",
@@ -716,7 +734,7 @@ def main(argv=None) -> int:
         f"{row[0]}'s single {kind} response, {row[col]}x control, is below its target ≥ 60"
         for row in rows
         for kind, col in (("free", 2), ("road-step", 4))
-        if float(row[col]) < 60
+        if float(row[col].split()[0]) < 60
     ]
 
     # -- 2. generic stepper against hand-written loops (Python f)

@@ -414,7 +414,10 @@ class OutputStream:
             run = max(1, (1 << 18) // max(1, m * n * self.step))
         self.run = self.step * run
         P = _powers(phi, L)  # (m, L+1, n, n)
-        obs = C[:, None] @ P[:, :L]  # C Φ^j: (m, L, p, n)
+        # C Φ^j for j < L as one product per design, C (p, n) @ [Φ^0 .. Φ^{L-1}] laid
+        # (n, L n), not L broadcast 4 × 4 ones: (m, p, L, n), row (output, j)
+        powers = np.ascontiguousarray(P[:, :L].transpose(0, 2, 1, 3)).reshape(m, n, L * n)
+        obs = (C @ powers).reshape(m, p, L, n)
         self._obs = obs
         # the carries' product: (m, p L, n) @ V (m, n, S) -> (m, p, L, S)
         self._obs_mat: np.ndarray | None = None  # built when first streamed (`_observation`)
@@ -479,7 +482,7 @@ class OutputStream:
             if self._forced:
                 last = last + D @ U[:, -1]
         else:
-            last = (obs[:, jl] @ carry_last[..., None])[..., 0]
+            last = (obs[:, :, jl] @ carry_last[..., None])[..., 0]
             if self._forced:
                 u = self._window(b_last, b_last + 1)[:, 0].reshape(L + 1, self._k)
                 last = last + np.einsum("mrpk,rk->mp", self._G[:, jl], u)
@@ -539,17 +542,14 @@ class OutputStream:
     def _observation(self) -> np.ndarray:
         """``(m, p L, n)``: the streamed rows of ``C Φ^j``, row (output, j)."""
         if self._obs_mat is None:
-            self._obs_mat = np.ascontiguousarray(self._obs.transpose(0, 2, 1, 3)).reshape(
-                self.m, self.p * self.L, self.n
-            )
+            self._obs_mat = self._obs.reshape(self.m, self.p * self.L, self.n)
         return self._obs_mat
 
     def keep_rows(self, rows) -> None:
         """Stream only these output rows (`final` keeps them all)."""
         rows = list(rows)
-        obs = self._obs[:, :, rows]
         self.p = len(rows)
-        self._obs_mat = np.ascontiguousarray(obs.transpose(0, 2, 1, 3)).reshape(
+        self._obs_mat = np.ascontiguousarray(self._obs[:, rows]).reshape(
             self.m, self.p * self.L, self.n
         )
         if self._forced:
@@ -572,7 +572,7 @@ class OutputStream:
         if self._forced:
             raise ValueError("sum_squares is the free response's: this stream has an input")
         L, nb, N = self.L, self.nb, self.N
-        obs = np.swapaxes(self._obs, 1, 2)  # (m, p, L, n): C Φ^j
+        obs = self._obs  # (m, p, L, n): C Φ^j
         gram = np.swapaxes(obs, -1, -2) @ obs  # (m, p, n, n)
         total = (gram * self._gram_K[:, None]).sum(axis=(-2, -1))
         J = (N - 1) - (nb - 1) * L  # samples of the last block before sample N - 1
