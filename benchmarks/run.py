@@ -60,6 +60,35 @@ def paired_runs(fn_a, fn_b, repeats: int) -> tuple[list[float], list[float], lis
     return times[0], times[1], [b / a for a, b in zip(*times)]
 
 
+def round_times(
+    fn_a, fn_b, rounds: int, calls: int
+) -> tuple[list[float], list[float], list[float]]:
+    """Per round, the best wall time of ``calls`` consecutive calls of ``fn_a``,
+    then of ``fn_b`` (the order alternating between rounds), and their ratio.
+
+    For calls of a millisecond or less. Within a round each function runs
+    warm, as a loop over designs runs it, and its best time is its own cost
+    (Python's ``timeit`` advice: the slower calls measure other processes, and
+    the first call after the other function's, with cold caches and heap);
+    across rounds, the spread of the ratios shows how far the machine moved.
+    Timing single calls in turns (`paired_runs`) would charge a 0.5 ms call
+    for the 40 ms call before it.
+    """
+    fn_a()
+    fn_b()
+    times: tuple[list[float], list[float]] = ([], [])
+    for r in range(rounds):
+        for side in (0, 1) if r % 2 == 0 else (1, 0):
+            fn = (fn_a, fn_b)[side]
+            block = []
+            for _ in range(calls):
+                start = time.perf_counter()
+                fn()
+                block.append(time.perf_counter() - start)
+            times[side].append(min(block))
+    return times[0], times[1], [b / a for a, b in zip(*times)]
+
+
 def paired_medians(fn_a, fn_b, repeats: int) -> tuple[float, float, float]:
     """Median CPU times of ``fn_a`` and ``fn_b``, and the median of their ratios
     (`paired_runs`)."""
@@ -671,17 +700,20 @@ def main(argv=None) -> int:
     ]
 
     # -- 1. LTI engine and generic stepper against control, every method
-    # each method's response and control's, timed in turns (paired CPU times)
+    # each method's response and control's, in alternating rounds of consecutive calls
+    rounds = 1 if quick else 5
     rows, lti_times, control_free, control_road = [], {}, [], []
     for m in qc.METHODS:
-        t_lf, t_ci, r_free = paired_runs(
+        t_lf, t_ci, r_free = round_times(
             lambda: qc.initial_response(sys_free, T, X0, method=m),
             lambda: control.initial_response(sys_free, T, X0),
+            rounds,
             repeats,
         )
-        t_lr, t_cf, r_road = paired_runs(
+        t_lr, t_cf, r_road = round_times(
             lambda: qc.forced_response(sys_road, T, U, X0, method=m),
             lambda: control.forced_response(sys_road, T, U, X0),
+            rounds,
             repeats,
         )
         control_free += t_ci
@@ -722,8 +754,9 @@ def main(argv=None) -> int:
         "",
         f"control.initial_response: {g(t_ci * 1e3)} ms; control.forced_response "
         f"(road step): {g(t_cf * 1e3)} ms (medians). Each method's response and control's "
-        f"were timed in turns, {repeats} pairs, in CPU time; times are medians, ratios the "
-        "median (min–max) of the pairs' ratios.",
+        f"in {rounds} alternating rounds of {repeats} consecutive calls each, wall time: a "
+        "round's time is the best of its calls (`round_times`), the times below the "
+        "median over rounds, the ratio columns the median (min–max) of the rounds' ratios.",
         "",
         table(head, rows),
         "",

@@ -415,15 +415,20 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
         )
         warnings.warn(message, DivergenceWarning, stacklevel=_stacklevel())
     uniform = dt is not None
+    # one look at the input: a zero input is the free response (no input scan, no D u)
+    has_input = bool(u_samples.size) and bool(np.any(u_samples))
+    states_finite = False  # proven by the engine: _finalise need not look again
     if opts.engine == "lti" and not uniform:
         raise ValueError("engine='lti' needs a uniformly spaced T")
     if opts.engine == "lti" or (opts.engine == "auto" and uniform and success):
+        u_engine = u_samples if has_input else None
         if success:
-            x, cut = lti_states(tab, A, B, T, u_samples, x0, substeps)
+            x, cut = lti_states(tab, A, B, T, u_engine, x0, substeps)
         else:
             with warnings.catch_warnings():  # the step-size warning already told the user
                 warnings.simplefilter("ignore", DivergenceWarning)
-                x, cut = lti_states(tab, A, B, T, u_samples, x0, substeps)
+                x, cut = lti_states(tab, A, B, T, u_engine, x0, substeps)
+        states_finite = True  # lti_states cuts before the first non-finite sample
         steps = (T.size - 1) * substeps  # the engine computes every interval at once
         t, nfev, ok = T[: x.shape[-1]], tab.stages * steps, not cut
     else:
@@ -434,8 +439,8 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
     N = t.size
     u = u_samples[:, :N]
     with np.errstate(over="ignore", invalid="ignore"):
-        y = C @ x + D @ u if np.any(u) else C @ x
-    meta.update(t=t, x=x, y=y, u=u, steps=steps, nfev=nfev)
+        y = C @ x + D @ u if has_input else C @ x
+    meta.update(t=t, x=x, y=y, u=u, steps=steps, nfev=nfev, states_finite=states_finite)
     meta.update(success=success, message=message, note=None)
     return meta
 
@@ -451,15 +456,17 @@ def _all_finite(v: np.ndarray) -> bool:
     return bool(np.isfinite(total) or (np.isfinite(v.min()) and np.isfinite(v.max())))
 
 
-def _finalise(resp: FixedStepResponse) -> FixedStepResponse:
+def _finalise(resp: FixedStepResponse, states_finite: bool = False) -> FixedStepResponse:
     """The one response-level check: any NaN or inf makes ``success`` False.
 
     Every result passes here, whichever engine (LTI scan, generic stepper,
-    python-control's difference equation) computed it.
+    python-control's difference equation) computed it. ``states_finite``: the
+    engine has proven the states finite (the LTI engine's cut), so only the
+    outputs are looked at.
     """
     bad = [
         name
-        for name, v in (("outputs", resp.y), ("states", resp.x))
+        for name, v in (("outputs", resp.y), ("states", None if states_finite else resp.x))
         if v is not None and not _all_finite(np.asarray(v))
     ]
     if bad:
@@ -637,7 +644,7 @@ def _forced(
         message=run["message"] or None,
     )
     resp = _set_meta(resp, run)
-    return resp if inner else _finalise(resp)
+    return resp if inner else _finalise(resp, run.get("states_finite", False))
 
 
 def _linear_run(ss, T, U, X0, transpose, opts, auto) -> dict:
@@ -959,7 +966,7 @@ def _initial(sys, T, auto, X0, output, params, transpose, return_x, squeeze, opt
         success=success,
         message=message,
     )
-    return _finalise(_set_meta(resp, run))
+    return _finalise(_set_meta(resp, run), run.get("states_finite", False))
 
 
 def _single_index(index, what: str):
