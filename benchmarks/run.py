@@ -40,31 +40,48 @@ def best_of(fn, repeats: int) -> float:
     return best_time(fn, repeats, warmup=True)
 
 
-def paired_runs(fn_a, fn_b, repeats: int) -> tuple[list[float], list[float], list[float]]:
-    """CPU times of ``fn_a`` and ``fn_b``, timed in turns, and each pair's ratio.
+def in_turns(fn_a, fn_b, rounds: int, measure) -> tuple[list[float], list[float], list[float]]:
+    """``rounds`` times of ``fn_a`` and of ``fn_b`` taken in turns, and each round's ratio.
 
-    After one untimed call of each, the two are timed in turns (a b, b a, a b,
-    ...) in CPU time of this process (``time.process_time``), so that other
-    processes on a shared machine count on neither side; each pair's ratio
-    ``b / a`` compares two runs made within a fraction of a second.
+    After one untimed call of each, the two are measured in turns (a b, b a,
+    a b, ...), so that a drift of the machine's load reaches both sides alike;
+    ``measure(fn)`` gives one time. Returns ``(a's times, b's times, b / a per
+    round)``.
     """
     fn_a()
     fn_b()
     times: tuple[list[float], list[float]] = ([], [])
-    for r in range(repeats):
+    for r in range(rounds):
         for side in (0, 1) if r % 2 == 0 else (1, 0):
-            fn = (fn_a, fn_b)[side]
-            start = time.process_time()
-            fn()
-            times[side].append(time.process_time() - start)
+            times[side].append(measure((fn_a, fn_b)[side]))
     return times[0], times[1], [b / a for a, b in zip(*times)]
+
+
+def cpu_time(fn) -> float:
+    """This process's CPU time of one call (other processes count on neither side)."""
+    start = time.process_time()
+    fn()
+    return time.process_time() - start
+
+
+def wall_time(fn) -> float:
+    """The wall time of one call."""
+    start = time.perf_counter()
+    fn()
+    return time.perf_counter() - start
+
+
+def paired_runs(fn_a, fn_b, repeats: int) -> tuple[list[float], list[float], list[float]]:
+    """CPU times of ``fn_a`` and ``fn_b``, one call each in turns (`in_turns`):
+    each pair's ratio ``b / a`` compares two runs made within a fraction of a second."""
+    return in_turns(fn_a, fn_b, repeats, cpu_time)
 
 
 def round_times(
     fn_a, fn_b, rounds: int, calls: int
 ) -> tuple[list[float], list[float], list[float]]:
     """Per round, the best wall time of ``calls`` consecutive calls of ``fn_a``,
-    then of ``fn_b`` (the order alternating between rounds), and their ratio.
+    then of ``fn_b`` (`in_turns`), and their ratio.
 
     For calls of a millisecond or less. Within a round each function runs
     warm, as a loop over designs runs it, and its best time is its own cost
@@ -74,19 +91,7 @@ def round_times(
     Timing single calls in turns (`paired_runs`) would charge a 0.5 ms call
     for the 40 ms call before it.
     """
-    fn_a()
-    fn_b()
-    times: tuple[list[float], list[float]] = ([], [])
-    for r in range(rounds):
-        for side in (0, 1) if r % 2 == 0 else (1, 0):
-            fn = (fn_a, fn_b)[side]
-            block = []
-            for _ in range(calls):
-                start = time.perf_counter()
-                fn()
-                block.append(time.perf_counter() - start)
-            times[side].append(min(block))
-    return times[0], times[1], [b / a for a, b in zip(*times)]
+    return in_turns(fn_a, fn_b, rounds, lambda fn: min(wall_time(fn) for _ in range(calls)))
 
 
 def paired_medians(fn_a, fn_b, repeats: int) -> tuple[float, float, float]:
@@ -99,12 +104,7 @@ def paired_medians(fn_a, fn_b, repeats: int) -> tuple[float, float, float]:
 def timed_runs(fn, repeats: int) -> list[float]:
     """Wall times [s] of ``repeats`` calls after one untimed warm-up."""
     fn()
-    out = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - start)
-    return out
+    return [wall_time(fn) for _ in range(repeats)]
 
 
 def med_spread(times: list[float], scale: float = 1.0) -> str:
@@ -162,16 +162,8 @@ def sweep_comparison(T, quick: bool):
     runs = 5
     rows = []
     for name, (ours, theirs, target) in cases.items():
-        ours()
-        theirs()
-        t_ours, t_loop, ratios = [], [], []
-        for r in range(runs):  # alternating, so that load drifts hit both sides
-            pair = [(ours, t_ours, 1), (theirs, t_loop, every)]
-            for fn, out, scale in pair if r % 2 == 0 else pair[::-1]:
-                start = time.perf_counter()
-                fn()
-                out.append((time.perf_counter() - start) * scale)
-            ratios.append(t_loop[-1] / t_ours[-1])
+        t_ours, t_loop, ratios = in_turns(ours, theirs, runs, wall_time)
+        t_loop, ratios = [t * every for t in t_loop], [r * every for r in ratios]
         rows.append(
             [
                 name,
@@ -704,20 +696,20 @@ def main(argv=None) -> int:
     rounds = 1 if quick else 5
     rows, lti_times, control_free, control_road = [], {}, [], []
     for m in qc.METHODS:
-        t_lf, t_ci, r_free = round_times(
+        t_lf, c_free, r_free = round_times(
             lambda: qc.initial_response(sys_free, T, X0, method=m),
             lambda: control.initial_response(sys_free, T, X0),
             rounds,
             repeats,
         )
-        t_lr, t_cf, r_road = round_times(
+        t_lr, c_road, r_road = round_times(
             lambda: qc.forced_response(sys_road, T, U, X0, method=m),
             lambda: control.forced_response(sys_road, T, U, X0),
             rounds,
             repeats,
         )
-        control_free += t_ci
-        control_road += t_cf
+        control_free += c_free
+        control_road += c_road
         t_gf = best_of(
             lambda: qc.initial_response(sys_free, T, X0, method=m, engine="generic"),
             max(1, repeats // 3),
