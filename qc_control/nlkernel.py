@@ -33,17 +33,19 @@ What has no compiled form: a callable spring, damper or road profile (user
 Python code), and event location (a Python call per event); the NumPy path
 takes those (`NonlinearQuarterCarBatch.compiled_stepper` returns None).
 
-numba is imported with this module, which takes about half a second, so
-`qc_control.nonlinear` imports it only when a batch is first stepped. The
-compiled code is cached on disk beside this file (numba's ``cache=True``;
-numba falls back to a per-user cache where the package is read-only), so
-the one-off compilation (about two seconds) is paid once per installation.
+numba is imported with this module (through `qc_control.recurrence`), which
+takes about half a second, so `qc_control.nonlinear` imports it only when a
+batch is first stepped. The compiled code is cached on disk
+(`qc_control.recurrence.compiled`: beside this file, or in a per-user cache
+where the package is read-only), so the one-off compilation (about three
+seconds) is paid once per installation.
 """
 
 from __future__ import annotations
 
-import numba
 import numpy as np
+
+from .recurrence import compiled
 
 __all__ = ["advance", "PARAMETER_ROWS", "OPTION_SLOTS"]
 
@@ -70,7 +72,7 @@ OPTION_SLOTS = (
 )
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@compiled(inline="always")
 def _accelerations(x, u, p, o, out):  # pragma: no cover - compiled (tested through advance)
     """``out[:2] = (v̇s, v̇u)`` and ``out[2:] = (vs, vu)`` of every design at ``x`` ``(4, m)``.
 
@@ -109,7 +111,7 @@ def _accelerations(x, u, p, o, out):  # pragma: no cover - compiled (tested thro
         out3[j] = vu
 
 
-@numba.njit(cache=True, nogil=True)
+@compiled()
 def advance(x, out, first, count, step, substeps, a, b, stage_u, p, o):  # pragma: no cover
     """Step the designs ``x`` ``(4, m)`` (in place) over ``count`` samples.
 

@@ -17,12 +17,34 @@ is cached on disk beside the module.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numba
 
-__all__ = ["carry_scan"]
+__all__ = ["carry_scan", "compiled"]
 
 
-@numba.njit(cache=True, nogil=True)
+def compiled(**options) -> Callable:
+    """A decorator: the function compiled by numba (nopython, without the GIL),
+    its machine code cached on disk where numba finds a place to write it
+    (``NUMBA_CACHE_DIR``, beside the module, or the user's cache directory).
+
+    Where it finds none (a read-only installation run by a user without a
+    writable home), ``numba.njit(cache=True)`` raises when the module is
+    imported; the function is then compiled anew in each process instead, at
+    the cost of the compilation (a few seconds) on first use.
+    """
+
+    def decorate(fn: Callable) -> Callable:
+        try:
+            return numba.njit(cache=True, nogil=True, **options)(fn)
+        except RuntimeError:  # "cannot cache function ...: no locator available"
+            return numba.njit(nogil=True, **options)(fn)
+
+    return decorate
+
+
+@compiled()
 def carry_scan(Q, V):  # pragma: no cover - compiled (tested through lti.OutputStream)
     """In place, per design ``d``: ``V[d, :, b+1] += Q[d] @ V[d, :, b]`` for ``b = 0 .. S-2``.
 

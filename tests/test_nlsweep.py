@@ -10,9 +10,13 @@ event) on the equations written out here.
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.integrate import solve_ivp
 
@@ -133,6 +137,40 @@ def test_compiled_steps_diverge_as_the_numpy_steps(monkeypatch):
     assert compiled.success.tolist() == plain.success.tolist() == [True, True, False]
     assert _max_rel(compiled.states[:2], plain.states[:2]) < 1e-13
     assert np.array_equal(np.isfinite(compiled.states), np.isfinite(plain.states))
+
+
+def test_compiled_steps_without_a_writable_cache(tmp_path):
+    """Where numba finds no place to cache machine code (here: no cache locator
+    that accepts the package, as for a read-only installation and home),
+    `qc_control.recurrence.compiled` compiles in the process instead of failing
+    at import: a nonlinear batch and a free sweep (both compiled loops) give
+    the same numbers as this process's cached code."""
+    script = tmp_path / "run.py"
+    script.write_text(
+        "import numpy as np, qc_control as qc\n"
+        "from qc_control.nlsweep import simulate_batch\n"
+        "from qc_control.recurrence import carry_scan\n"
+        "T = np.linspace(0.0, 0.5, 501)\n"
+        "zr = 0.06 * (T >= 0.1)\n"
+        "model = qc.nonlinear_quarter_car_model(bump_stop=qc.BumpStop(0.02, 1e5))\n"
+        "designs = [dict(ms=300.0, mu=40.0, ks=ks, ku=2e5, cs=1e3) for ks in (1.5e4, 4e4)]\n"
+        "r = simulate_batch(model.batch_dynamics(designs), T, np.zeros(4), zr)\n"
+        "s = qc.sweep({'ks': [2e4, 3e4], 'zeta': [0.2, 0.4]}, T, qc.model.SEED_X0)\n"
+        "print(type(carry_scan._cache).__name__)\n"
+        "import sys; np.save(sys.argv[1], r.states); s.metrics.to_pickle(sys.argv[2])\n"
+    )
+    env = {**os.environ, "NUMBA_CACHE_LOCATOR_CLASSES": "IPythonCacheLocator"}
+    args = [sys.executable, str(script), str(tmp_path / "x.npy"), str(tmp_path / "m.pkl")]
+    run = subprocess.run(args, capture_output=True, text=True, env=env, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split()[-1] == "NullCache"  # it did compile without a cache
+    T = np.linspace(0.0, 0.5, 501)
+    model = qc.nonlinear_quarter_car_model(bump_stop=qc.BumpStop(0.02, 1e5))
+    designs = [dict(ms=300.0, mu=40.0, ks=ks, ku=2e5, cs=1e3) for ks in (1.5e4, 4e4)]
+    here = simulate_batch(model.batch_dynamics(designs), T, np.zeros(4), 0.06 * (T >= 0.1))
+    assert np.array_equal(np.load(tmp_path / "x.npy"), here.states)  # the same machine code
+    sweep = qc.sweep({"ks": [2e4, 3e4], "zeta": [0.2, 0.4]}, T, qc.model.SEED_X0)
+    assert pd.read_pickle(tmp_path / "m.pkl").equals(sweep.metrics)
 
 
 def test_user_callables_have_no_compiled_steps():
