@@ -4,7 +4,7 @@
 together. Written with NumPy over the designs, each stage of each step is a
 dozen NumPy calls on arrays of a thousand numbers, and the calls' fixed cost
 (about a microsecond each) is most of the time: 1,000 designs over 10 s at
-1 ms take about a second whatever the machine's arithmetic could do. This
+1 ms took 1-2.5 s, whatever the machine's arithmetic could do. This
 module writes the same step as loops over the designs and compiles them
 with numba (LLVM), so that a step costs its arithmetic: the loops over the
 designs are simple enough for the compiler to vectorise.
@@ -24,10 +24,10 @@ them as python-control does). The right-hand side is
 ``-F/m_s`` as ``F·(-1/m_s)``, the tire's dynamic force ``F_t - k_u δ0`` as
 ``max(k_u (z_r - x_u), -k_u δ0)`` for a unilateral tire, the stops'
 ``F = q (k + k3 q²)`` with ``q = d - clip(d, -c_b, c_r)``, which is exactly
-0 between the clearances. The sums run in the NumPy path's order; a
-design's trajectory equals it, and `qc_control.input_output_response`'s, to
-rounding (a few ulps a step; the tests hold it to 1e-12 of the largest
-state).
+0 between the clearances. The sums are the NumPy path's, some in another
+order: a design's trajectory equals it, and
+`qc_control.input_output_response`'s, to rounding (the tests hold it to
+1e-13 and 1e-12 of the largest state).
 
 What has no compiled form: a callable spring, damper or road profile (user
 Python code), and event location (a Python call per event); the NumPy path

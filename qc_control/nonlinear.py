@@ -736,12 +736,20 @@ class NonlinearQuarterCarBatch:
         if self._spring is not None or self._profile is not None:
             return None
         # numba: ~0.5 s to import, needed only to step a batch
-        from .nlkernel import OPTION_SLOTS, advance
+        from .nlkernel import OPTION_SLOTS, PARAMETER_ROWS, advance
 
         q, inf, stop = self.params, math.inf, self._stop
-        floor = -q["static"] if self._unilateral else np.full(self.size, -inf)  # least F_t - k_u δ0
-        rows = [-1.0 / q["ms"], 1.0 / q["mu"], q["ks"], q["ku"], floor, c_reb, c_bnd]
-        p = np.stack(rows)  # (7, m), C-contiguous
+        rows = {
+            "neg_inv_ms": -1.0 / q["ms"],
+            "inv_mu": 1.0 / q["mu"],
+            "ks": q["ks"],
+            "ku": q["ku"],
+            # the least F_t - k_u δ0: the tire lets go of its static load, or never
+            "tire_floor": -q["static"] if self._unilateral else np.full(self.size, -inf),
+            "c_rebound": c_reb,
+            "c_bound": c_bnd,
+        }
+        p = np.stack([rows[name] for name in PARAMETER_ROWS])  # (7, m), C-contiguous
         options = {
             "k3": self._k3 or 0.0,
             "stop_bound": inf if stop is None else stop.clearance_bound,
