@@ -372,7 +372,8 @@ class OutputStream:
     windows shared: ``Γ₀u + Γ₁u⁺`` is never formed per design, and each
     product stays small enough for one BLAS thread (a chunk of designs is
     the unit of parallelism). The carries ``c_b`` are one product of the same
-    kind and a log-depth scan with powers of ``Φ^L`` (`affine_scan`'s).
+    kind and the recurrence ``c_{b+1} = Φ^L c_b + …`` as a compiled loop per
+    design (`qc_control.recurrence.carry_scan`).
     The work per sample and design is ``2(L+1)kp`` flops for the input and
     ``2np`` for the carries: the input's part bounds a forced sweep.
     """

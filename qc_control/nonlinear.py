@@ -718,7 +718,7 @@ class NonlinearQuarterCarBatch:
     def compiled_stepper(self):
         """The compiled batched step of these designs, or None where an option has none.
 
-        Returns ``step(x, out, first, count, step, substeps, a, b, stage_u)``:
+        Returns ``step(x, out, first, count, start, substeps, a, b, stage_u)``:
         `qc_control.nlkernel.advance` with these designs' parameters and
         options bound (its docstring has the arguments). None for a callable
         spring, damper or road profile: user Python code, which only the

@@ -12,7 +12,7 @@ and design, and its sums are the recurrence's own (no reassociation).
 
 numba is imported with this module, so `qc_control.lti` imports it only when
 a stream is first built (sweeps, never a single response); the compiled code
-is cached on disk beside the module.
+is cached on disk (`compiled`).
 """
 
 from __future__ import annotations
