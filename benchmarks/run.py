@@ -29,8 +29,8 @@ import scipy
 from scipy.integrate import solve_ivp
 
 import qc_control as qc
-from qc_control.compare import best_time
-from qc_control.sweeps import DEFAULT_METRICS, design_grid, sweep
+from qc_control.studies.compare import best_time
+from qc_control.studies.sweeps import DEFAULT_METRICS, design_grid, sweep
 
 X0 = np.array([0.0, 0.0, 0.05, 0.0])
 
@@ -284,7 +284,7 @@ def dask_comparison(quick: bool, m: int = 100_000, chunk: int = 5_000):
     CPU time (every process's CPU time during the Dask run, the client's and
     the workers', less the single process's), which a loaded machine does not
     inflate as it does wall time. Twice: with Dask's default worker
-    environment, and with `qc_control.sweeps.DASK_WORKER_ENV` (the allocator
+    environment, and with `qc_control.studies.sweeps.DASK_WORKER_ENV` (the allocator
     settings that spare the page faults of Dask's ``MALLOC_TRIM_THRESHOLD_``)."""
     if quick:  # starting a cluster takes seconds: not in the smoke run
         return None
@@ -293,7 +293,7 @@ def dask_comparison(quick: bool, m: int = 100_000, chunk: int = 5_000):
         from dask.distributed import Client, LocalCluster
     except ImportError:
         return None
-    from qc_control.sweeps import DASK_WORKER_ENV
+    from qc_control.studies.sweeps import DASK_WORKER_ENV
 
     T = np.linspace(0.0, 1.0, 1001)
     U = np.where(T >= 0.1, 0.05, 0.0)
@@ -609,8 +609,9 @@ def nonlinear_sweep_benchmark(quick: bool) -> tuple[list[str], list[str], list[l
         "wheel 40 kg, unilateral tire 200 kN/m with gravity, bump and rebound stops at 5 and "
         "8 cm), RK4 at h = 1 ms, "
         f"0-{t_end:g} s, on ISO 8608 roads at 20 m/s. `qc.sweep(..., "
-        "model=qc.nonlinear_quarter_car_model(...))` steps them together (`qc_control.nlsweep`, "
-        "with the car's compiled steps, `qc_control.nlkernel`) "
+        "model=qc.nonlinear_quarter_car_model(...))` steps them together "
+        "(`qc_control.studies.nlsweep`, "
+        "with the car's compiled steps, `qc_control.models.nlkernel`) "
         "and streams its default metrics; the loop calls `control.input_output_response` "
         "(solve_ivp RK45 at its defaults) on designs spread over the grid, scaled to all. "
         "CPU times, paired medians; the last column is the largest state difference of the "
@@ -944,7 +945,7 @@ def main(argv=None) -> int:
             "allocator). Dask's nanny starts workers with `MALLOC_TRIM_THRESHOLD_=65536`, "
             "which makes glibc map every block above 128 kB afresh: each chunk's "
             "megabyte-sized arrays then cost page faults, which is most of the default "
-            "row's overhead; `qc_control.sweeps.DASK_WORKER_ENV` keeps them in the heap "
+            "row's overhead; `qc_control.studies.sweeps.DASK_WORKER_ENV` keeps them in the heap "
             "(second row; a negative overhead means the workers' allocator beat the "
             "single process's). The wall-clock "
             "speed-up is bounded by the cores actually free: on this 2-core machine shared "

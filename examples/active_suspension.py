@@ -6,7 +6,7 @@ Closes the loop around the seed's quarter car with skyhook (ideal and
 semi-active), LQR (``control.lqr``) and, when slycot is installed, H∞ on
 MATLAB's active-suspension weights; finds the comfort-optimal passive
 damper in closed form; and compares them on a bump and an ISO 8608 class C
-road at 20 m/s (`qc_control.control_study.compare_controllers`), with the
+road at 20 m/s (`qc_control.studies.control_study.compare_controllers`), with the
 transmissibility of each linear design.
 
 Run: ``python examples/active_suspension.py [OUT_DIR]`` (default
@@ -21,9 +21,9 @@ from pathlib import Path
 import pandas as pd
 
 import qc_control as qc
-from qc_control.control_study import compare_controllers
-from qc_control.controllers import HINF_AVAILABLE
+from qc_control.models.controllers import HINF_AVAILABLE
 from qc_control.report.control import transmissibility_chart
+from qc_control.studies.control_study import compare_controllers
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
 out.mkdir(parents=True, exist_ok=True)

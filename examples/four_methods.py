@@ -21,7 +21,7 @@ import control
 import numpy as np
 
 import qc_control as qc
-from qc_control.plotting import output_signal, plot_outputs
+from qc_control.report.plotting import output_signal, plot_outputs
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
 out.mkdir(parents=True, exist_ok=True)

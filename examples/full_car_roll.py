@@ -5,7 +5,7 @@ Roll of a full car on a one-sided bump, with and without anti-roll bars
 The full car (`qc_control.full_car`, Ikenaga et al., 2000) drives at
 10 m/s over a 5 cm bump under its left wheels only: the left track has the
 bump, the right track is flat, the rear wheels meet it a wheelbase later
-(`qc_control.road.corner_inputs`). The car heaves, pitches and rolls. Anti-roll
+(`qc_control.ride.road.corner_inputs`). The car heaves, pitches and rolls. Anti-roll
 bars (20 kN·m/rad in front, 8 kN·m/rad at the rear) stiffen roll, and only
 roll: the roll mode (and the axle tramp modes) move up while bounce and pitch
 stay where they were. What bars buy in cornering they cost on a one-sided

@@ -4,7 +4,7 @@ Bounce and pitch of a half car on a bump, and wheelbase filtering
 
 The half car (`qc_control.half_car`, the passenger car of Ikenaga et al.,
 2000) drives over a 5 cm, 1 m long bump at two speeds: the front wheel meets
-it first, the rear wheel a wheelbase later (`qc_control.road.axle_inputs`).
+it first, the rear wheel a wheelbase later (`qc_control.ride.road.axle_inputs`).
 The slower the car, the longer the time between the two hits, and the more
 the car pitches rather than bounces.
 

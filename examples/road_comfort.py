@@ -22,7 +22,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control import road
+from qc_control.ride import road
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
 out.mkdir(parents=True, exist_ok=True)

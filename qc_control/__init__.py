@@ -44,7 +44,7 @@ observed orders, cost, stability limits, numerical modes), and
 {'euler': 1.2, 'midpoint': 2.0, 'heun': 2.0, 'rk4': 4.0}
 >>> qc.write_report(comparison, "report")  # doctest: +SKIP
 
-Beyond the seed: ISO 8608 roads (`qc_control.road`), ISO 2631-1 ride
+Beyond the seed: ISO 8608 roads (`qc_control.ride.road`), ISO 2631-1 ride
 metrics (`ride_metrics`, `transmissibility`), the LTI engine behind the
 responses, and sweeps over thousands of designs (`sweep`). The command
 ``qc-control report`` writes the same report from the shell.
@@ -61,11 +61,8 @@ from importlib.metadata import PackageNotFoundError
 from importlib.metadata import version as _distribution_version
 from typing import TYPE_CHECKING, Any
 
-# The function shares its name with its module. Importing the submodule
-# qc_control.integrate (which the responses and sweeps do) binds the package
-# attribute ``integrate`` to the module, so the function is bound here,
-# eagerly; the module needs only numpy.
-from .integrate import integrate
+# Bound eagerly: the module needs only numpy.
+from .numerics.integrate import integrate
 
 try:
     # The version is written once, in pyproject.toml; this reads it back
@@ -75,10 +72,8 @@ except PackageNotFoundError:  # pragma: no cover - a source tree that was never 
     __version__ = "0+unknown"
 
 if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
-    from . import road, spectral
-    from .compare import MethodComparison, compare_methods
-    from .control_study import ControlComparison, compare_controllers
-    from .controllers import (
+    from .cli.scenario import Scenario, ScenarioError, load_config, read_config
+    from .models.controllers import (
         HinfDesign,
         add_damper,
         closed_loop,
@@ -88,8 +83,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         lqr_controller,
         skyhook,
     )
-    from .damping import DampingOptimum, ParetoFront, optimal_damping, pareto_front
-    from .halfcar import (
+    from .models.halfcar import (
         FullCarParams,
         HalfCarParams,
         full_car,
@@ -97,28 +91,28 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         half_car,
         half_car_model,
     )
-    from .integrate import DivergenceWarning, Solution
-    from .methods import METHODS, ButcherTableau, get_method
-    from .metrics import Metric, RideSignals
-    from .modal import ModalAnalysis, Mode, modal_analysis, numerical_modes
-    from .model import (
-        OUTPUTS,
-        STATES,
-        QuarterCarParams,
-        quarter_car,
-        quarter_car_model,
-    )
-    from .nlsweep import BatchResponse, simulate_batch
-    from .nonlinear import (
+    from .models.modal import ModalAnalysis, Mode, modal_analysis, numerical_modes
+    from .models.nonlinear import (
         BumpStop,
         NonlinearQuarterCarBatch,
         PiecewiseDamper,
         nonlinear_quarter_car,
         nonlinear_quarter_car_model,
     )
-    from .plotting import plot_outputs
+    from .models.quarter import (
+        OUTPUTS,
+        STATES,
+        QuarterCarParams,
+        quarter_car,
+        quarter_car_model,
+    )
+    from .models.vehicle import Corner, SignalRoles, VehicleModel
+    from .numerics.integrate import DivergenceWarning, Solution
+    from .numerics.methods import METHODS, ButcherTableau, get_method
+    from .numerics.stability import max_stable_step, stability_function
     from .report import write_report
-    from .response import (
+    from .report.plotting import plot_outputs
+    from .responses.timeresp import (
         FixedStepResponse,
         forced_response,
         impulse_response,
@@ -126,7 +120,8 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         input_output_response,
         step_response,
     )
-    from .ride import (
+    from .ride import road, spectral
+    from .ride.comfort import (
         Transmissibility,
         ride_metrics,
         ride_metrics_spectral,
@@ -134,103 +129,113 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         wk_filter,
         wk_weighted,
     )
-    from .scenario import Scenario, ScenarioError, load_config, read_config
-    from .spectral import (
+    from .ride.metrics import Metric, RideSignals
+    from .ride.spectral import (
         ISO8608Road,
         iso8608_intensity,
         lyapunov_variances,
         white_velocity_variances,
     )
-    from .stability import max_stable_step, stability_function
-    from .sweeps import DEFAULT_METRICS, METRICS, SweepChunk, SweepResult, design_grid, sweep
-    from .vehicle import Corner, SignalRoles, VehicleModel
+    from .studies.compare import MethodComparison, compare_methods
+    from .studies.control_study import ControlComparison, compare_controllers
+    from .studies.damping import DampingOptimum, ParetoFront, optimal_damping, pareto_front
+    from .studies.nlsweep import BatchResponse, simulate_batch
+    from .studies.sweeps import (
+        DEFAULT_METRICS,
+        METRICS,
+        SweepChunk,
+        SweepResult,
+        design_grid,
+        sweep,
+    )
 
-#: Public name -> the submodule that defines it (``"road"`` is a submodule).
+#: Public name -> the module that defines it, below the package (``"road"``
+#: and ``"spectral"`` are modules themselves).
 #: tests/test_tooling.py checks that this map, the TYPE_CHECKING imports above
 #: and ``__all__`` name the same things.
 _LAZY: dict[str, str] = {
-    "road": "road",
-    "MethodComparison": "compare",
-    "compare_methods": "compare",
-    "compare_controllers": "control_study",
-    "ControlComparison": "control_study",
-    "optimal_damping": "damping",
-    "pareto_front": "damping",
-    "DampingOptimum": "damping",
-    "ParetoFront": "damping",
-    "closed_loop": "controllers",
-    "skyhook": "controllers",
-    "groundhook": "controllers",
-    "hybrid": "controllers",
-    "add_damper": "controllers",
-    "lqr_controller": "controllers",
-    "hinf_controller": "controllers",
-    "HinfDesign": "controllers",
-    "DivergenceWarning": "integrate",
-    "Solution": "integrate",
-    "METHODS": "methods",
-    "ButcherTableau": "methods",
-    "get_method": "methods",
-    "ModalAnalysis": "modal",
-    "Mode": "modal",
-    "modal_analysis": "modal",
-    "OUTPUTS": "model",
-    "STATES": "model",
-    "QuarterCarParams": "model",
-    "load_config": "scenario",
-    "quarter_car": "model",
-    "read_config": "scenario",
-    "quarter_car_model": "model",
-    "Metric": "metrics",
-    "RideSignals": "metrics",
+    "road": "ride.road",
+    "MethodComparison": "studies.compare",
+    "compare_methods": "studies.compare",
+    "compare_controllers": "studies.control_study",
+    "ControlComparison": "studies.control_study",
+    "optimal_damping": "studies.damping",
+    "pareto_front": "studies.damping",
+    "DampingOptimum": "studies.damping",
+    "ParetoFront": "studies.damping",
+    "closed_loop": "models.controllers",
+    "skyhook": "models.controllers",
+    "groundhook": "models.controllers",
+    "hybrid": "models.controllers",
+    "add_damper": "models.controllers",
+    "lqr_controller": "models.controllers",
+    "hinf_controller": "models.controllers",
+    "HinfDesign": "models.controllers",
+    "DivergenceWarning": "numerics.integrate",
+    "Solution": "numerics.integrate",
+    "METHODS": "numerics.methods",
+    "ButcherTableau": "numerics.methods",
+    "get_method": "numerics.methods",
+    "ModalAnalysis": "models.modal",
+    "Mode": "models.modal",
+    "modal_analysis": "models.modal",
+    "OUTPUTS": "models.quarter",
+    "STATES": "models.quarter",
+    "QuarterCarParams": "models.quarter",
+    "load_config": "cli.scenario",
+    "quarter_car": "models.quarter",
+    "read_config": "cli.scenario",
+    "quarter_car_model": "models.quarter",
+    "Metric": "ride.metrics",
+    "RideSignals": "ride.metrics",
     "write_report": "report",
-    "plot_outputs": "plotting",
-    "Scenario": "scenario",
-    "ScenarioError": "scenario",
-    "Corner": "vehicle",
-    "SignalRoles": "vehicle",
-    "VehicleModel": "vehicle",
-    "FixedStepResponse": "response",
-    "forced_response": "response",
-    "initial_response": "response",
-    "step_response": "response",
-    "impulse_response": "response",
-    "input_output_response": "response",
-    "Transmissibility": "ride",
-    "ride_metrics": "ride",
-    "ride_metrics_spectral": "ride",
-    "transmissibility": "ride",
-    "wk_filter": "ride",
-    "wk_weighted": "ride",
-    "max_stable_step": "stability",
-    "numerical_modes": "modal",
-    "stability_function": "stability",
-    "DEFAULT_METRICS": "sweeps",
-    "METRICS": "sweeps",
-    "SweepChunk": "sweeps",
-    "SweepResult": "sweeps",
-    "design_grid": "sweeps",
-    "sweep": "sweeps",
-    "spectral": "spectral",
-    "lyapunov_variances": "spectral",
-    "white_velocity_variances": "spectral",
-    "iso8608_intensity": "spectral",
-    "ISO8608Road": "spectral",
-    "HalfCarParams": "halfcar",
-    "FullCarParams": "halfcar",
-    "half_car": "halfcar",
-    "half_car_model": "halfcar",
-    "full_car": "halfcar",
-    "full_car_model": "halfcar",
+    "plot_outputs": "report.plotting",
+    "Scenario": "cli.scenario",
+    "ScenarioError": "cli.scenario",
+    "Corner": "models.vehicle",
+    "SignalRoles": "models.vehicle",
+    "VehicleModel": "models.vehicle",
+    "FixedStepResponse": "responses.timeresp",
+    "forced_response": "responses.timeresp",
+    "initial_response": "responses.timeresp",
+    "step_response": "responses.timeresp",
+    "impulse_response": "responses.timeresp",
+    "input_output_response": "responses.timeresp",
+    "Transmissibility": "ride.comfort",
+    "ride_metrics": "ride.comfort",
+    "ride_metrics_spectral": "ride.comfort",
+    "transmissibility": "ride.comfort",
+    "wk_filter": "ride.comfort",
+    "wk_weighted": "ride.comfort",
+    "max_stable_step": "numerics.stability",
+    "numerical_modes": "models.modal",
+    "stability_function": "numerics.stability",
+    "DEFAULT_METRICS": "studies.sweeps",
+    "METRICS": "studies.sweeps",
+    "SweepChunk": "studies.sweeps",
+    "SweepResult": "studies.sweeps",
+    "design_grid": "studies.sweeps",
+    "sweep": "studies.sweeps",
+    "spectral": "ride.spectral",
+    "lyapunov_variances": "ride.spectral",
+    "white_velocity_variances": "ride.spectral",
+    "iso8608_intensity": "ride.spectral",
+    "ISO8608Road": "ride.spectral",
+    "HalfCarParams": "models.halfcar",
+    "FullCarParams": "models.halfcar",
+    "half_car": "models.halfcar",
+    "half_car_model": "models.halfcar",
+    "full_car": "models.halfcar",
+    "full_car_model": "models.halfcar",
     # nonlinear quarter car (issue 11)
-    "nonlinear_quarter_car": "nonlinear",
-    "nonlinear_quarter_car_model": "nonlinear",
-    "BumpStop": "nonlinear",
-    "PiecewiseDamper": "nonlinear",
+    "nonlinear_quarter_car": "models.nonlinear",
+    "nonlinear_quarter_car_model": "models.nonlinear",
+    "BumpStop": "models.nonlinear",
+    "PiecewiseDamper": "models.nonlinear",
     # batched nonlinear sweeps (issue 11 item 7)
-    "NonlinearQuarterCarBatch": "nonlinear",
-    "simulate_batch": "nlsweep",
-    "BatchResponse": "nlsweep",
+    "NonlinearQuarterCarBatch": "models.nonlinear",
+    "simulate_batch": "studies.nlsweep",
+    "BatchResponse": "studies.nlsweep",
 }
 
 
@@ -243,7 +248,7 @@ if not TYPE_CHECKING:  # hidden from type checkers, so a misspelt name stays an 
         except KeyError:
             raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
         module = importlib.import_module(f"{__name__}.{module_name}")
-        value = module if name == module_name else getattr(module, name)
+        value = module if module_name.endswith(f".{name}") else getattr(module, name)
         globals()[name] = value  # later lookups find it without this hook
         return value
 

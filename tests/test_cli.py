@@ -13,15 +13,16 @@ import pandas as pd
 import pytest
 
 import qc_control
-from qc_control import cli, console
-from qc_control.cli import build_parser, scenario_from_args
-from qc_control.console import main
-from qc_control.scenario import BumpRoad, Scenario
+from qc_control.cli import console
+from qc_control.cli import parser as cli
+from qc_control.cli.console import main
+from qc_control.cli.parser import build_parser, scenario_from_args
+from qc_control.cli.scenario import BumpRoad, Scenario
 
 
 def run(*args):
     return subprocess.run(
-        [sys.executable, "-m", "qc_control.console", *args],
+        [sys.executable, "-m", "qc_control.cli.console", *args],
         capture_output=True,
         text=True,
         timeout=300,
@@ -178,7 +179,7 @@ def test_internal_error_is_not_a_usage_error(files, monkeypatch, error, capsys):
     def broken(*args, **kwargs):
         raise error
 
-    monkeypatch.setattr("qc_control.scenario.compare_methods", broken)
+    monkeypatch.setattr("qc_control.cli.scenario.compare_methods", broken)
     status = main(["report", "--t-end", "1", "--methods", "rk4", "--out", "R"])
     err = capsys.readouterr().err
     assert status == 1  # never 2: a bug is not passed off as bad input
@@ -199,7 +200,10 @@ def test_ctrl_c_during_imports_is_one_line(monkeypatch, capsys):
     real = builtins.__import__
 
     def importing(name, *args, **kwargs):
-        if name in ("cli", "qc_control.cli"):  # the entry point imports the command's module
+        if name in (
+            "parser",
+            "qc_control.cli.parser",
+        ):  # the entry point imports the command's module
             raise KeyboardInterrupt
         return real(name, *args, **kwargs)
 
@@ -307,7 +311,7 @@ def test_undamped_car_has_no_stable_euler_step_in_words(tmp_path):
 def test_warning_summary_counts_each_distinct_warning_once():
     import warnings
 
-    from qc_control.integrate import DivergenceWarning
+    from qc_control.numerics.integrate import DivergenceWarning
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

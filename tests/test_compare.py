@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 
 import qc_control as qc
-from qc_control.compare import TOLERANCES
+from qc_control.studies.compare import TOLERANCES
 
 ORDERS = {"euler": 1, "midpoint": 2, "heun": 2, "rk4": 4}
 X0 = np.array([0.0, 0.0, 0.05, 0.0])
@@ -142,7 +142,7 @@ def test_non_uniform_grid_rejected():
 def test_steps_compose_and_timing_is_optional():
     """compare_methods is its steps: each run alone gives the same numbers, and
     without timing every number but the times is unchanged."""
-    from qc_control import compare as cmp_mod
+    from qc_control.studies import compare as cmp_mod
 
     T = np.linspace(0, 2, 201)
     X0 = [0.0, 0.0, 0.05, 0.0]

@@ -25,8 +25,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import qc_control as qc
-from qc_control.compare import DEFAULT_X0, nonlinear_reference
-from qc_control.road import bump as road_bump
+from qc_control.ride.road import bump as road_bump
+from qc_control.studies.compare import DEFAULT_X0, nonlinear_reference
 
 P = qc.QuarterCarParams()
 G = 9.80665
@@ -274,7 +274,7 @@ def test_scenario_with_a_bump_stop_steps_to_every_event():
     The stop engages and releases in compression before the wheel flies; with events
     RK4 keeps order 4 (measured 3.94), stepping across the stop's kink it falls to 0.47.
     """
-    from qc_control.scenario import Scenario
+    from qc_control.cli.scenario import Scenario
 
     cmp = Scenario(model="nonlinear", bump_stop=(0.05, 1e5)).run()
     nl = cmp.nonlinear

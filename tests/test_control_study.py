@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control import road
-from qc_control.cli import run
-from qc_control.control_study import compare_controllers
+from qc_control.cli.parser import run
 from qc_control.report.control import transmissibility_chart, write_control_report
+from qc_control.ride import road
+from qc_control.studies.control_study import compare_controllers
 
 P = qc.QuarterCarParams()
 F_INV = math.sqrt(P.ku / P.mu) / (2 * math.pi)

@@ -25,8 +25,8 @@ import pytest
 import scipy.linalg
 
 import qc_control as qc
-from qc_control import controllers as C
-from qc_control import road
+from qc_control.models import controllers as C
+from qc_control.ride import road
 
 CAR = qc.quarter_car_model(road=True, actuator=True)
 SEED = qc.quarter_car_model(road=True)

@@ -5,9 +5,9 @@ References:
 * The Gobbi & Mastinu (2001) closed forms for body acceleration and travel
   under unit white road velocity, and the issue's seed optimum
   cs = ks·√((ms+mu)/kt) ≈ 3497 N·s/m (ζ ≈ 0.58).
-* The tire-deflection form of `qc_control.damping` against
+* The tire-deflection form of `qc_control.studies.damping` against
   ``scipy.linalg.solve_continuous_lyapunov`` on the car written in relative
-  coordinates here (not through `qc_control.spectral`): 1e-10 relative, a
+  coordinates here (not through `qc_control.ride.spectral`): 1e-10 relative, a
   well-conditioned 4x4 solve.
 * Each closed-form optimum against ``scipy.optimize.minimize_scalar`` on
   the exact spectral metric (``method='numerical'``): the objective is flat
@@ -22,8 +22,8 @@ import pytest
 import scipy.linalg
 
 import qc_control as qc
-from qc_control import damping as D
-from qc_control.vehicle import STANDARD_GRAVITY
+from qc_control.models.vehicle import STANDARD_GRAVITY
+from qc_control.studies import damping as D
 
 SEED = qc.QuarterCarParams()
 

@@ -10,8 +10,8 @@ import pytest
 import scipy.linalg
 
 import qc_control as qc
-from qc_control.halfcar import FullCarParams, HalfCarParams
-from qc_control.vehicle import STANDARD_GRAVITY
+from qc_control.models.halfcar import FullCarParams, HalfCarParams
+from qc_control.models.vehicle import STANDARD_GRAVITY
 
 HALF = HalfCarParams(
     ms=640.0,

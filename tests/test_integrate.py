@@ -11,13 +11,15 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from qc_control import METHODS, DivergenceWarning, integrate, quarter_car
-from qc_control.integrate import Solution, integrate_stepper, uniform_step
-from qc_control.lti import lti_trajectory
-from qc_control.methods import RK4
+from qc_control.numerics.integrate import Solution, integrate_stepper, uniform_step
+from qc_control.numerics.lti import lti_trajectory
+from qc_control.numerics.methods import RK4
 
 A = np.asarray(quarter_car().A)
 EPS = np.finfo(float).eps
-integrate_module = sys.modules["qc_control.integrate"]  # qc_control.integrate is the function
+integrate_module = sys.modules[
+    "qc_control.numerics.integrate"
+]  # qc_control.numerics.integrate is the function
 
 
 def counting(f):

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control import limits, road
+from qc_control.numerics import limits
+from qc_control.ride import road
 
 
 def test_limit_from_the_environment(monkeypatch):

@@ -7,7 +7,7 @@ import pytest
 
 import qc_control as qc
 from qc_control import METHODS
-from qc_control.lti import affine_scan, lti_solve, step_matrices
+from qc_control.numerics.lti import affine_scan, lti_solve, step_matrices
 
 X0 = [0.1, -0.3, 0.05, 0.01]
 RALSTON = qc.ButcherTableau(
@@ -152,7 +152,7 @@ def test_output_stream_equals_the_recurrence(N, block):
     every sample once, equal to rounding (1e-13 of the largest output), for
     lengths that do and do not fill the last block, with the carries in runs
     of two segments, and the free response."""
-    from qc_control.lti import OutputStream
+    from qc_control.numerics.lti import OutputStream
 
     rng = np.random.default_rng(N + block)
     m, n, p, k = 3, 4, 2, 2

@@ -10,9 +10,9 @@ import pytest
 from scipy.integrate._ivp import dop853_coefficients, rk
 
 from qc_control import METHODS, ButcherTableau, get_method, integrate
-from qc_control.methods import HEUN, RK4
-from qc_control.order_conditions import check_order, density, rooted_trees, tree_str
-from qc_control.stability import stability_coefficients
+from qc_control.numerics.methods import HEUN, RK4
+from qc_control.numerics.order_conditions import check_order, density, rooted_trees, tree_str
+from qc_control.numerics.stability import stability_coefficients
 
 # Published tableaus (exact fractions, rounded once to double).
 RALSTON = dict(a=[[0, 0], [2 / 3, 0]], b=[1 / 4, 3 / 4], c=[0, 2 / 3])

@@ -5,9 +5,9 @@ import pandas as pd
 import pytest
 
 import qc_control as qc
-from qc_control import road
-from qc_control.metrics import METRICS, RIDE_METRICS, RideSignals, evaluate, metric_columns
-from qc_control.vehicle import Corner, SignalRoles
+from qc_control.models.vehicle import Corner, SignalRoles
+from qc_control.ride import road
+from qc_control.ride.metrics import METRICS, RIDE_METRICS, RideSignals, evaluate, metric_columns
 
 T = np.linspace(0, 4, 2001)  # h = 2 ms
 

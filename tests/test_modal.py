@@ -9,7 +9,7 @@ from conftest import valid_params
 from hypothesis import given, settings
 
 from qc_control import QuarterCarParams, modal_analysis, quarter_car
-from qc_control.stability import MARGINAL_RTOL
+from qc_control.numerics.stability import MARGINAL_RTOL
 
 
 def undamped_closed_form(p):

@@ -1,4 +1,4 @@
-"""Batched nonlinear sweeps (issue 11 item 7): qc_control.nlsweep and sweep's dispatch.
+"""Batched nonlinear sweeps (issue 11 item 7): qc_control.studies.nlsweep and sweep's dispatch.
 
 References: `qc.input_output_response` on each design's own
 `nonlinear_quarter_car` (the single-system stepper, same method and step),
@@ -21,9 +21,10 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import qc_control as qc
-from qc_control.metrics import RideSignals, evaluate
-from qc_control.nlsweep import simulate_batch
-from qc_control.nonlinear import NonlinearQuarterCarBatch
+from qc_control.models.nonlinear import NonlinearQuarterCarBatch
+from qc_control.models.quarter import SEED_X0
+from qc_control.ride.metrics import SWEEP_METRICS, RideSignals, evaluate
+from qc_control.studies.nlsweep import simulate_batch
 
 G = 9.80665
 T2 = np.linspace(0.0, 2.0, 2001)  # h = 1 ms
@@ -142,20 +143,21 @@ def test_compiled_steps_diverge_as_the_numpy_steps(monkeypatch):
 def test_compiled_steps_without_a_writable_cache(tmp_path):
     """Where numba finds no place to cache machine code (here: no cache locator
     that accepts the package, as for a read-only installation and home),
-    `qc_control.recurrence.compiled` compiles in the process instead of failing
+    `qc_control.numerics.recurrence.compiled` compiles in the process instead of failing
     at import: a nonlinear batch and a free sweep (both compiled loops) give
     the same numbers as this process's cached code."""
     script = tmp_path / "run.py"
     script.write_text(
         "import numpy as np, qc_control as qc\n"
-        "from qc_control.nlsweep import simulate_batch\n"
-        "from qc_control.recurrence import carry_scan\n"
+        "from qc_control.studies.nlsweep import simulate_batch\n"
+        "from qc_control.numerics.recurrence import carry_scan\n"
+        "from qc_control.models.quarter import SEED_X0\n"
         "T = np.linspace(0.0, 0.5, 501)\n"
         "zr = 0.06 * (T >= 0.1)\n"
         "model = qc.nonlinear_quarter_car_model(bump_stop=qc.BumpStop(0.02, 1e5))\n"
         "designs = [dict(ms=300.0, mu=40.0, ks=ks, ku=2e5, cs=1e3) for ks in (1.5e4, 4e4)]\n"
         "r = simulate_batch(model.batch_dynamics(designs), T, np.zeros(4), zr)\n"
-        "s = qc.sweep({'ks': [2e4, 3e4], 'zeta': [0.2, 0.4]}, T, qc.model.SEED_X0)\n"
+        "s = qc.sweep({'ks': [2e4, 3e4], 'zeta': [0.2, 0.4]}, T, SEED_X0)\n"
         "print(type(carry_scan._cache).__name__)\n"
         "import sys; np.save(sys.argv[1], r.states); s.metrics.to_pickle(sys.argv[2])\n"
     )
@@ -169,7 +171,7 @@ def test_compiled_steps_without_a_writable_cache(tmp_path):
     designs = [dict(ms=300.0, mu=40.0, ks=ks, ku=2e5, cs=1e3) for ks in (1.5e4, 4e4)]
     here = simulate_batch(model.batch_dynamics(designs), T, np.zeros(4), 0.06 * (T >= 0.1))
     assert np.array_equal(np.load(tmp_path / "x.npy"), here.states)  # the same machine code
-    sweep = qc.sweep({"ks": [2e4, 3e4], "zeta": [0.2, 0.4]}, T, qc.model.SEED_X0)
+    sweep = qc.sweep({"ks": [2e4, 3e4], "zeta": [0.2, 0.4]}, T, SEED_X0)
     assert pd.read_pickle(tmp_path / "m.pkl").equals(sweep.metrics)
 
 
@@ -207,11 +209,11 @@ def test_linear_limit_equals_the_linear_sweep():
     grid = {"ks": [15e3, 30e3, 45e3], "cs": [500.0, 1500.0, 3000.0]}
     nl = qc.nonlinear_quarter_car_model(tire="linear", gravity=False)
     lin = qc.quarter_car_model(road=True)
-    a = qc.sweep(grid, T, qc.model.SEED_X0, road, model=nl, states=True)
-    b = qc.sweep(grid, T, qc.model.SEED_X0, road, model=lin, states=True)
+    a = qc.sweep(grid, T, SEED_X0, road, model=nl, states=True)
+    b = qc.sweep(grid, T, SEED_X0, road, model=lin, states=True)
     assert _max_rel(a.states, b.states) < 1e-11  # two evaluation orders of one map
-    a = qc.sweep(grid, T, qc.model.SEED_X0, road, model=nl)  # streamed metrics
-    b = qc.sweep(grid, T, qc.model.SEED_X0, road, model=lin)
+    a = qc.sweep(grid, T, SEED_X0, road, model=nl)  # streamed metrics
+    b = qc.sweep(grid, T, SEED_X0, road, model=lin)
     for column in qc.DEFAULT_METRICS:
         x, y = a.metrics[column].to_numpy(float), b.metrics[column].to_numpy(float)
         if column.startswith("settling_time"):  # a threshold crossing: within a sample
@@ -223,7 +225,7 @@ def test_linear_limit_equals_the_linear_sweep():
 
 def test_streamed_metrics_equal_the_metrics_of_each_response():
     model = qc.nonlinear_quarter_car_model(**OPTIONS)
-    names = [*qc.metrics.SWEEP_METRICS, "peak_body_acc", "lift_off"]
+    names = [*SWEEP_METRICS, "peak_body_acc", "lift_off"]
     got = qc.sweep(DESIGNS, T2, np.zeros(4), ROAD, model=model, metrics=names)
     wk = qc.sweep(DESIGNS, T2, np.zeros(4), ROAD, model=model, metrics=["vdv"])  # whole signals
     for j, design in enumerate(DESIGNS):
@@ -370,7 +372,7 @@ def test_bad_input_names_the_value():
     assert np.isnan(res.metrics["rms_body_acc [m/s²]"][1])
     assert np.isfinite(res.metrics["rms_body_acc [m/s²]"][0])
     with pytest.raises(ValueError, match="events=True applies to a nonlinear model"):
-        qc.sweep(DESIGNS[:1], T2[:11], qc.model.SEED_X0, events=True)
+        qc.sweep(DESIGNS[:1], T2[:11], SEED_X0, events=True)
 
 
 def test_executor_chunks_and_a_diverging_design():

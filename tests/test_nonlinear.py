@@ -329,7 +329,7 @@ def test_events_are_refused_clearly():
 
 def test_nonlinear_reference_restarts_at_events(lift_off_reference):
     """compare.nonlinear_reference on the car against the hand-written solve_ivp above."""
-    from qc_control.compare import nonlinear_reference
+    from qc_control.studies.compare import nonlinear_reference
 
     reference, ref_events = lift_off_reference
     car = qc.nonlinear_quarter_car(road=bump)

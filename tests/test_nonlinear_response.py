@@ -368,7 +368,7 @@ def _car_and_skyhook(c_sky=3000.0):
 
 
 def test_fast_path_equals_the_rhs_path_to_rounding():
-    from qc_control.interconnect import compile_interconnect
+    from qc_control.numerics.interconnect import compile_interconnect
 
     cl = _car_and_skyhook()
     T = grid(1e-3, 2.0)
@@ -403,7 +403,7 @@ def test_fast_path_with_stateful_subsystems_and_events():
 
 
 def test_algebraic_loop_falls_back_to_control():
-    from qc_control.interconnect import compile_interconnect
+    from qc_control.numerics.interconnect import compile_interconnect
 
     # u = -y with y = u + x: a direct loop through a nonlinear block, which control iterates
     plant = control.nlsys(
@@ -421,7 +421,7 @@ def test_algebraic_loop_falls_back_to_control():
 
 
 def test_stage_times_are_the_steppers_own():
-    from qc_control.integrate import stage_times
+    from qc_control.numerics.integrate import stage_times
 
     seen = []
 
@@ -435,7 +435,7 @@ def test_stage_times_are_the_steppers_own():
         assert np.array_equal(np.array(seen), stage_times(T, "rk4", substeps=substeps).ravel())
 
 
-# ------------------------------------------------- fused steps (qc_control.interconnect.FusedSteps)
+# ------------------------------ fused steps (qc_control.numerics.interconnect.FusedSteps)
 #
 # A linear plant closed by static nonlinear subsystems is stepped a whole step at a
 # time: the stage values come from precomputed matrices (A_l, B_lr of FusedSteps), not

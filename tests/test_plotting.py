@@ -1,4 +1,4 @@
-"""qc_control.plotting: any named output of several responses over a reference."""
+"""qc_control.report.plotting: any named output of several responses over a reference."""
 
 import ast
 import types
@@ -11,7 +11,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.plotting import OUTPUT_UNITS, output_signal, output_unit, plot_outputs
+from qc_control.report.plotting import OUTPUT_UNITS, output_signal, output_unit, plot_outputs
 
 T = np.linspace(0.0, 3.0, 301)
 
@@ -119,7 +119,9 @@ def test_bad_input_is_named(runs):
 
 
 def test_matplotlib_is_imported_only_when_drawing():
-    tree = ast.parse(Path(qc.__file__).with_name("plotting.py").read_text(encoding="utf-8"))
+    tree = ast.parse(
+        (Path(qc.__file__).parent / "report" / "plotting.py").read_text(encoding="utf-8")
+    )
     top = [n for n in tree.body if isinstance(n, (ast.Import, ast.ImportFrom))]
     names = [a.name for n in top for a in n.names] + [
         n.module for n in top if isinstance(n, ast.ImportFrom)

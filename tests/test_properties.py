@@ -24,8 +24,9 @@ from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 
 import qc_control as qc
-from qc_control import cli, console
-from qc_control.stability import MARGINAL_RTOL
+from qc_control.cli import console
+from qc_control.cli import parser as cli
+from qc_control.numerics.stability import MARGINAL_RTOL
 
 EPS = np.finfo(float).eps
 

@@ -16,7 +16,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.console import main
+from qc_control.cli.console import main
 from qc_control.report import (
     MARKER,
     ReportError,

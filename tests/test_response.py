@@ -24,8 +24,8 @@ import pytest
 
 import qc_control as qc
 from qc_control import METHODS, DivergenceWarning
-from qc_control import response as qr
-from qc_control.integrate import uniform_step
+from qc_control.numerics.integrate import uniform_step
+from qc_control.responses import timeresp as qr
 
 X0 = [0.0, 0.0, 0.05, 0.0]  # the default scenario: body released from 5 cm
 ORDERS = {"euler": 1, "midpoint": 2, "heun": 2, "rk4": 4}

@@ -5,14 +5,14 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control import road
-from qc_control.ride import (
+from qc_control.models.vehicle import STANDARD_GRAVITY
+from qc_control.ride import road
+from qc_control.ride.comfort import (
     ride_metrics,
     ride_metrics_spectral,
     transmissibility,
     wk_filter,
 )
-from qc_control.vehicle import STANDARD_GRAVITY
 
 # ISO 2631-1:1997 Table 3, Wk (factor x 1000 in the standard)
 WK_TABLE = {

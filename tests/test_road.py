@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import scipy.signal
 
-from qc_control import road
+from qc_control.ride import road
 
 T = np.linspace(0, 3, 3001)
 

@@ -10,8 +10,8 @@ import scipy.integrate
 import scipy.signal
 
 import qc_control as qc
-from qc_control import road
-from qc_control.halfcar import HalfCarParams
+from qc_control.models.halfcar import HalfCarParams
+from qc_control.ride import road
 
 
 def test_delay_by_whole_steps_is_an_exact_shift():

@@ -1,6 +1,6 @@
-"""qc_control.scenario: validation, defaults from where they are defined, TOML, command, run.
+"""qc_control.cli.scenario: validation, defaults from where they are defined, TOML, command, run.
 
-References: the road functions of `qc_control.road` called directly (road
+References: the road functions of `qc_control.ride.road` called directly (road
 samples), the functions' own signatures (defaults), `compare_methods` called
 directly (run), and TOML read by `tomllib` (the writer's output).
 """
@@ -15,10 +15,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from qc_control import QuarterCarParams, compare_methods, road
-from qc_control.cli import build_parser, scenario_from_args
-from qc_control.compare import DEFAULT_H, DEFAULT_METHODS, DEFAULT_T_END, DEFAULT_X0
-from qc_control.scenario import (
+from qc_control import QuarterCarParams, compare_methods
+from qc_control.cli.parser import build_parser, scenario_from_args
+from qc_control.cli.scenario import (
     MAX_STEPS,
     ROADS,
     BumpRoad,
@@ -29,6 +28,8 @@ from qc_control.scenario import (
     SineRoad,
     StepRoad,
 )
+from qc_control.ride import road
+from qc_control.studies.compare import DEFAULT_H, DEFAULT_METHODS, DEFAULT_T_END, DEFAULT_X0
 
 try:
     import tomllib

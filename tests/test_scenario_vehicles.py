@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control import road
-from qc_control.cli import build_parser, run, scenario_from_args
-from qc_control.halfcar import FullCarParams, HalfCarParams
-from qc_control.scenario import BumpRoad, ISO8608Road, Scenario, ScenarioError
+from qc_control.cli.parser import build_parser, run, scenario_from_args
+from qc_control.cli.scenario import BumpRoad, ISO8608Road, Scenario, ScenarioError
+from qc_control.models.halfcar import FullCarParams, HalfCarParams
+from qc_control.ride import road
 
 
 def test_model_defaults_and_the_free_release():

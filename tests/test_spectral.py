@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control import road
-from qc_control.model import quarter_car_model
-from qc_control.ride import ride_metrics_spectral
-from qc_control.spectral import (
+from qc_control.models.quarter import quarter_car_model
+from qc_control.ride import road
+from qc_control.ride.comfort import ride_metrics_spectral
+from qc_control.ride.spectral import (
     iso8608_intensity,
     lyapunov_variances,
     stationary_covariance,
@@ -183,7 +183,7 @@ def test_spectral_sweep_equals_single_designs():
     one design at a time (the Kronecker and the eigendecomposition paths,
     batched against single): 1e-9 relative; an undamped design (cs = 0, not
     Hurwitz) is flagged unstable with NaN metrics, the others unaffected."""
-    from qc_control.spectral import SPECTRAL_CAPABLE, ISO8608Road
+    from qc_control.ride.spectral import SPECTRAL_CAPABLE, ISO8608Road
 
     grid = {"ks": [15e3, 30e3, 45e3], "zeta": [0.0, 0.1, 0.35, 0.8]}
     road_ = ISO8608Road("D", speed=25.0)
@@ -206,7 +206,7 @@ def test_spectral_sweep_equals_single_designs():
 
 
 def test_spectral_sweep_bad_input():
-    from qc_control.spectral import ISO8608Road
+    from qc_control.ride.spectral import ISO8608Road
 
     road_ = ISO8608Road("C", 20.0)
     with pytest.raises(ValueError, match="takes no T or U"):

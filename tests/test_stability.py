@@ -11,7 +11,7 @@ import pytest
 
 import qc_control as qc
 from qc_control import METHODS, max_stable_step, stability_function
-from qc_control.stability import (
+from qc_control.numerics.stability import (
     MARGINAL_RTOL,
     amplification,
     eigenvalues_of,

@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control import road
-from qc_control.lti import OutputStream, TailBound, step_matrices
-from qc_control.methods import get_method
-from qc_control.ride import ride_metrics
-from qc_control.sweeps import DEFAULT_METRICS, METRICS, design_grid, sweep
+from qc_control.numerics.lti import OutputStream, TailBound, step_matrices
+from qc_control.numerics.methods import get_method
+from qc_control.ride import road
+from qc_control.ride.comfort import ride_metrics
+from qc_control.studies.sweeps import DEFAULT_METRICS, METRICS, design_grid, sweep
 
 T = np.linspace(0, 5, 2001)  # h = 2.5 ms
 X0 = [0.0, 0.0, 0.05, 0.0]
@@ -259,7 +259,7 @@ def test_a_chunk_larger_than_the_vector_unit_is_split_and_reassembled():
     """A chunk of 100 designs is computed 64 at a time (VECTOR_DESIGNS); its
     metrics and kept states equal those of chunks of 7, design for design
     (the same arithmetic per design: 1e-13)."""
-    from qc_control.sweeps import VECTOR_DESIGNS
+    from qc_control.studies.sweeps import VECTOR_DESIGNS
 
     Ts = np.linspace(0, 1, 101)
     grid = {"ks": np.linspace(2e4, 4e4, 10), "zeta": np.linspace(0.1, 0.6, 10)}
@@ -347,7 +347,7 @@ def test_rejected_designs_carry_the_constructors_messages():
     its rejected designs and their messages must be those of the one-by-one
     constructor (the reference), index by index."""
     grid = {"ks": [3e4, -1.0, np.nan], "zeta": [0.2, -0.5]}
-    designs = qc.sweeps.design_grid(grid)
+    designs = qc.design_grid(grid)
     expected = []
     for i, d in enumerate(designs):
         try:
@@ -433,7 +433,7 @@ def test_a_free_chunk_is_split_by_the_free_vector_unit():
     settling times and flags exactly."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from qc_control.sweeps import FREE_VECTOR_DESIGNS
+    from qc_control.studies.sweeps import FREE_VECTOR_DESIGNS
 
     grid = {"ks": np.linspace(1.5e4, 4.5e4, 15), "zeta": np.linspace(0.05, 1.2, 20)}
     T2 = np.linspace(0, 3, 3001)

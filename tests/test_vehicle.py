@@ -6,8 +6,14 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control.model import quarter_car_abcd
-from qc_control.vehicle import STANDARD_GRAVITY, Corner, SignalRoles, VehicleModel
+from qc_control.models.quarter import UNITS, quarter_car_abcd
+from qc_control.models.vehicle import (
+    STANDARD_GRAVITY,
+    Corner,
+    SignalRoles,
+    VehicleModel,
+    stack_models,
+)
 
 
 def test_quarter_car_model_roles_and_units():
@@ -52,7 +58,7 @@ def test_batch_equals_one_rebuild_per_design():
         assert batch.tire_stiffness[0][i] == single.corners[0].tire_stiffness
         assert batch.static_load[0][i] == single.corners[0].static_load
     # the vectorised assembly agrees with the generic one (stack of rebuilds)
-    generic = qc.vehicle.stack_models([model.rebuild(d) for d in designs])
+    generic = stack_models([model.rebuild(d) for d in designs])
     np.testing.assert_array_equal(generic.A, batch.A)
     A, B, C, D = quarter_car_abcd(301.2, 100.0, 3e4, 29530.0, 1500.0, road=True)
     assert A.shape == (4, 4) and B.shape == (4, 1) and C.shape == (5, 4) and D.shape == (5, 1)
@@ -62,10 +68,10 @@ def test_a_model_with_a_missing_role_is_refused():
     sys = qc.quarter_car(road=True)
     roles = SignalRoles("body_acc", "xs", (Corner("", "travel", "tire_defl", "zr", 1.0, 1.0),))
     with pytest.raises(ValueError, match="'travel' is not an output"):
-        VehicleModel(sys, None, qc.model.UNITS, roles, lambda p: None)
+        VehicleModel(sys, None, UNITS, roles, lambda p: None)
     roles = SignalRoles("body_acc", "xs", (Corner("", "susp_travel", "tire_defl", "z", 1.0, 1.0),))
     with pytest.raises(ValueError, match="road input 'z'"):
-        VehicleModel(sys, None, qc.model.UNITS, roles, lambda p: None)
+        VehicleModel(sys, None, UNITS, roles, lambda p: None)
     with pytest.raises(ValueError, match="no unit for"):
         VehicleModel(sys, None, {}, SignalRoles("body_acc", "xs", ()), lambda p: None)
     with pytest.raises(ValueError, match="has no output 'seat_acc'"):

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control.halfcar import FullCarParams, HalfCarParams
+from qc_control.models.halfcar import FullCarParams, HalfCarParams
 
 #: A tire 1e5 times stiffer than the springs: "rigid" up to the series spring
 #: k·ku/(k+ku) (used below) and the wheel's inertia, a relative effect of

@@ -1,7 +1,7 @@
 """The controller comparison report (``qc-control control-report``).
 
 Presentation only: every number comes from the
-`qc_control.control_study.ControlComparison`. One table (bump and road
+`qc_control.studies.control_study.ControlComparison`. One table (bump and road
 metrics per design) and two transmissibility figures, one per signal (body
 acceleration and tire deflection against frequency), every linear design
 on each.

@@ -11,7 +11,7 @@ Conventions, so that a projected figure reads at a glance:
 - methods with the same trajectory (``cmp.coincident``, e.g. Midpoint and
   Heun on a linear system) are drawn dashed over each other, and the figure
   says that they coincide;
-- outputs are looked up by label (`qc_control.plotting.output_signal`),
+- outputs are looked up by label (`qc_control.report.plotting.output_signal`),
   never by position.
 """
 
@@ -25,9 +25,9 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 from matplotlib.ticker import NullFormatter
 
-from ..plotting import output_signal, output_unit
-from ..stability import stability_function
+from ..numerics.stability import stability_function
 from .findings import coincidence_groups
+from .plotting import output_signal, output_unit
 
 __all__ = [
     "reference_figure",
@@ -195,7 +195,7 @@ _ERROR_CEILING = 1e200  # [m] far beyond any physical error, far below float ove
 
 
 def error_figure(cmp) -> Figure:
-    """|xs error| against time on a log axis."""
+    """``|xs error|`` against time on a log axis."""
     colors, rank = _colors(cmp.responses), _rank(cmp)
     fig = Figure(figsize=(8, 3.6), layout="constrained")
     ax = fig.subplots()
@@ -251,7 +251,7 @@ def _slope_guide(ax, x, y0, p, color):
 
 
 def convergence_figure(cmp) -> Figure:
-    """Max |xs error| against h, log-log, with guides of slope p."""
+    """Max ``|xs error|`` against h, log-log, with guides of slope p."""
     conv = cmp.convergence
     colors, rank = _colors(cmp.responses), _rank(cmp)
     fig = Figure(figsize=(7.5, 4.6), layout="constrained")
@@ -296,7 +296,7 @@ def step_ticks(ax, steps) -> None:
 
 
 def work_precision_figure(cmp) -> Figure:
-    """Max |xs error| against RHS evaluations and against wall time.
+    """Max ``|xs error|`` against RHS evaluations and against wall time.
 
     Left, each method's refinements are joined in order of work (RHS
     evaluations). Right, the measured wall times are drawn as points
@@ -358,7 +358,7 @@ def _modes(ax, cmp, size=6):
 
 
 def stability_figure(cmp) -> Figure:
-    """Stability regions |R(z)| <= 1 with hλ of each mode, and a zoom on hλ.
+    """Stability regions ``|R(z)| <= 1`` with hλ of each mode, and a zoom on hλ.
 
     Left: the regions in full. Right: the square around the origin that
     holds every hλ (outlined on the left), with the regions redrawn there,
@@ -424,7 +424,7 @@ def transmissibility_figure(cmp) -> Figure:
 
     Drawn from ``cmp.transmissibility`` (frequencies and complex gains);
     the circle marks the invariant point √(ku/mu), where
-    |body_acc/zr| = ku/ms for every damper.
+    ``|body_acc/zr|`` = ku/ms for every damper.
     """
     tr = cmp.transmissibility
     fig = Figure(figsize=(10, 6.5), layout="constrained")

@@ -1,7 +1,7 @@
 """The nonlinear section of a method comparison: contact events, order, Midpoint vs Heun.
 
 Presentation only: every number comes from ``cmp.nonlinear`` (a
-`qc_control.compare.NonlinearStudy`). The figures use
+`qc_control.studies.compare.NonlinearStudy`). The figures use
 `matplotlib.figure.Figure` directly (no pyplot state, no show()).
 """
 
@@ -14,9 +14,9 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from ..plotting import output_signal
 from .document import Heading, Image, Paragraph, Table, fmt
 from .figures import step_ticks
+from .plotting import output_signal
 
 __all__ = [
     "nonlinear_figures",

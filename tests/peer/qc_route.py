@@ -61,7 +61,7 @@ import control.timeresp as ct_timeresp
 import numpy as np
 import pytest
 
-import qc_control.response as qc_response
+import qc_control.responses.timeresp as qc_response
 
 MODE = os.environ.get("QC_PEER_MODE", "qc")
 SCOPE = os.environ.get("QC_PEER_SCOPE", "direct")

@@ -1,7 +1,7 @@
 """Modal analysis of any vehicle: frequencies, damping, and modes named by shape.
 
 The quarter car's two modes are body bounce and wheel hop. A half or full car
-(`qc_control.halfcar`) has body modes (bounce, pitch, roll) and wheel modes
+(`qc_control.models.halfcar`) has body modes (bounce, pitch, roll) and wheel modes
 (per axle: wheel hop, and on a full car axle tramp, the wheels against each
 other), named from their eigenvectors by `vehicle_modes`.
 """
@@ -16,9 +16,9 @@ import numpy as np
 import pandas as pd
 import scipy.optimize
 
-from . import stability
+from ..numerics import stability
 from .halfcar import FULL_CAR_CORNERS, HALF_CAR_CORNERS, FullCarParams, HalfCarParams
-from .model import QuarterCarParams, quarter_car
+from .quarter import QuarterCarParams, quarter_car
 from .vehicle import VehicleModel
 
 __all__ = [
@@ -358,7 +358,7 @@ def _damping_note(body: Mode, MinvK: np.ndarray) -> str:
 
 
 def numerical_modes(method, h: float, vehicle=None) -> pd.DataFrame:
-    """`qc_control.stability.numerical_modes` with the vehicle's modes named.
+    """`qc_control.numerics.stability.numerical_modes` with the vehicle's modes named.
 
     A quarter car (parameters, a dict, ``None`` for the seed's, or a system
     in quarter-car form) gets rows ``body bounce`` and ``wheel hop`` from
@@ -559,7 +559,7 @@ def vehicle_modes(vehicle) -> ModalAnalysis:
 
     Examples
     --------
-    >>> from qc_control.halfcar import half_car_model
+    >>> from qc_control.models.halfcar import half_car_model
     >>> [m.name for m in vehicle_modes(half_car_model()).modes]
     ['bounce', 'pitch', 'front wheel hop', 'rear wheel hop']
     """

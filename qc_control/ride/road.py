@@ -19,8 +19,8 @@ import math
 import numpy as np
 import scipy.special
 
-from .integrate import check_time_grid, uniform_step
-from .limits import check_memory
+from ..numerics.integrate import check_time_grid, uniform_step
+from ..numerics.limits import check_memory
 
 __all__ = [
     "step",

@@ -6,7 +6,7 @@ through the LTI engine, semi-active ones through
 `qc_control.input_output_response`), and computes:
 
 - on the bump: peak body acceleration, peak suspension travel, the 2 %
-  settling time of the body displacement (`qc_control.metrics`);
+  settling time of the body displacement (`qc_control.ride.metrics`);
 - on the road: RMS and ISO 2631-1 Wk-weighted RMS body acceleration, RMS
   travel, RMS dynamic tire load over the static load, RMS actuator force
   and the mean actuator power ``⟨fa·(vs - vu)⟩`` (positive: the actuator
@@ -29,8 +29,7 @@ import control
 import numpy as np
 import pandas as pd
 
-from . import road
-from .controllers import (
+from ..models.controllers import (
     add_damper,
     closed_loop,
     groundhook,
@@ -39,14 +38,15 @@ from .controllers import (
     lqr_controller,
     skyhook,
 )
+from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
+from ..models.vehicle import VehicleModel
+from ..numerics.integrate import check_time_grid
+from ..responses.timeresp import auto_step, forced_response, input_output_response
+from ..ride import road
+from ..ride.comfort import ride_metrics
+from ..ride.metrics import mean_square
+from ..ride.road import positive
 from .damping import ParetoFront, optimal_damping, pareto_front, spectral_ride
-from .integrate import check_time_grid
-from .metrics import mean_square
-from .model import QuarterCarParams, as_params, quarter_car_model
-from .response import auto_step, forced_response, input_output_response
-from .ride import ride_metrics
-from .road import positive
-from .vehicle import VehicleModel
 
 __all__ = ["ControlComparison", "compare_controllers", "DESIGNS", "BUMP_METRICS", "ROAD_METRICS"]
 
@@ -64,7 +64,7 @@ DESIGNS = (
     "LQR",
     "H∞",
 )
-#: Metrics of the bump run (names of `qc_control.metrics`).
+#: Metrics of the bump run (names of `qc_control.ride.metrics`).
 BUMP_METRICS = ("peak_body_acc", "peak_susp_travel", "settling_time")
 #: Metrics of the road run.
 ROAD_METRICS = ("rms_body_acc", "rms_body_acc_wk", "rms_susp_travel", "rms_tire_load / static")
@@ -96,7 +96,7 @@ class ControlComparison:
         The time step [s] of the bump and road runs.
     exact : pandas.DataFrame
         Linear design -> its exact stationary RMS metrics on the road's
-        white road velocity (`qc_control.damping.spectral_ride`: Lyapunov,
+        white road velocity (`qc_control.studies.damping.spectral_ride`: Lyapunov,
         unbounded band), free of the finite run's sampling spread.
     pareto : ParetoFront or None
         The passive comfort / road-holding front (cs x ks around the car)
@@ -233,7 +233,7 @@ def compare_controllers(
         A subset of `DESIGNS` (``'H∞'`` needs slycot).
     road_class, speed, road_duration, road_seed
         The ISO 8608 road [-, m/s, s, -], sampled at 5 ms (within
-        `qc_control.road.largest_step` up to 35 m/s).
+        `qc_control.ride.road.largest_step` up to 35 m/s).
     bump_height, bump_duration
         The 1 m long 1 - cos bump met at 10 m/s [m, s], sampled at 2 ms;
         the run must be long enough for the body to settle (the seed car's

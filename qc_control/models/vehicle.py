@@ -13,7 +13,7 @@ to know about it, stated once:
 
 Compare, ride metrics, sweeps and the report look signals up by these
 labels, never by index, so a new vehicle plugs in by returning a
-`VehicleModel`; nothing downstream changes. `qc_control.model.quarter_car_model`
+`VehicleModel`; nothing downstream changes. `qc_control.models.quarter.quarter_car_model`
 is the first such model.
 """
 
@@ -136,7 +136,7 @@ class VehicleModel:
     batch_dynamics : callable ``Sequence[params] -> dynamics``, optional
         For a nonlinear ``system``: its right-hand side over arrays of
         designs, which `qc_control.sweep` steps for all designs at once
-        (`qc_control.nlsweep`). The dynamics object has ``size``,
+        (`qc_control.studies.nlsweep`). The dynamics object has ``size``,
         ``state_labels``, ``input_labels``, ``output_labels``,
         ``switching_labels``, ``tire_stiffness`` and ``static_load`` (per
         corner, ``(m,)``), ``rhs(t, x, u)`` on states ``(n, m)``,

@@ -164,7 +164,7 @@ class CompiledInterconnect:
 
         With ``inputs = (T, U)`` (the samples ``u_of_t`` interpolates
         linearly) and ``times`` (every stage time the stepper will ask for,
-        `qc_control.integrate.stage_times`), the input's terms are computed
+        `qc_control.numerics.integrate.stage_times`), the input's terms are computed
         for all stages at once (``np.interp``), and a stage at one of those
         times looks them up; any other time (an event's root finding)
         computes them from ``u_of_t``.
@@ -242,7 +242,7 @@ class CompiledInterconnect:
         Applies when every state belongs to a linear subsystem and every
         nonlinear subsystem is static with an output function (a plant and
         a static controller); ``stages`` are the stage times of every step
-        (`qc_control.integrate.stage_times` on a uniform grid, ``substeps``
+        (`qc_control.numerics.integrate.stage_times` on a uniform grid, ``substeps``
         steps ``h`` per interval), ``inputs = (T, U)`` the samples the
         input interpolates.
         """
@@ -295,7 +295,7 @@ class FusedSteps:
     car and clipped skyhook).
 
     Built by `CompiledInterconnect.fused`; ``stepper()`` is what
-    `qc_control.integrate.integrate_stepper` runs.
+    `qc_control.numerics.integrate.integrate_stepper` runs.
 
     The first stage is at ``(t_k, x_k)`` itself, so its ``y`` is the
     nonlinear subsystems' output at the sample: it is kept (``yn``) and the
@@ -380,9 +380,9 @@ class FusedSteps:
         self.compiled = compiled
 
     def stepper(self):
-        """``run(x, out, start, stop)`` for `qc_control.integrate.integrate_stepper`.
+        """``run(x, out, start, stop)`` for `qc_control.numerics.integrate.integrate_stepper`.
 
-        ``substeps`` steps per interval of the grid, as `qc_control.integrate.integrate`
+        ``substeps`` steps per interval of the grid, as `qc_control.numerics.integrate.integrate`
         takes them: into a scratch buffer, every ``substeps``-th kept.
         """
         steps = self._steps()

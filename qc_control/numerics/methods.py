@@ -8,7 +8,7 @@ A method with ``s`` stages advances ``x' = f(t, x)`` by one step ``h``:
     x_{n+1} = x_n + h \\sum_i b_i k_i
 
 (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.1). One loop,
-`qc_control.integrate`, runs every tableau; the seed's four methods are
+`qc_control.numerics.integrate`, runs every tableau; the seed's four methods are
 four entries of `METHODS`.
 """
 
@@ -72,7 +72,7 @@ class ButcherTableau:
     every rooted tree with at most ``p`` vertices (Butcher, *Numerical
     Methods for ODEs*, 3rd ed., §31-§32; HNW I, §II.2, Table 2.2), checked
     up to ``min(s, MAX_ORDER)`` (an explicit ``s``-stage method has order at
-    most ``s``) by `qc_control.order_conditions.check_order`.
+    most ``s``) by `qc_control.numerics.order_conditions.check_order`.
 
     A tableau equals another with the same name, coefficients and order,
     and equals the string of its name, so ``resp.method == "heun"`` reads

@@ -22,14 +22,23 @@ import scipy
 import scipy.signal
 from scipy.integrate import solve_ivp
 
-from .halfcar import FullCarParams, HalfCarParams
-from .integrate import DivergenceWarning, check_time_grid, uniform_step
-from .limits import check_memory
-from .methods import ButcherTableau, get_method
-from .modal import ModalAnalysis, modal_analysis
-from .model import OUTPUTS, SEED_X0, STATES, QuarterCarParams, as_params, quarter_car_model
-from .nonlinear import NONLINEAR_OUTPUTS, nonlinear_quarter_car_model
-from .response import (
+from ..models.halfcar import FullCarParams, HalfCarParams
+from ..models.modal import ModalAnalysis, modal_analysis
+from ..models.nonlinear import NONLINEAR_OUTPUTS, nonlinear_quarter_car_model
+from ..models.quarter import (
+    OUTPUTS,
+    SEED_X0,
+    STATES,
+    QuarterCarParams,
+    as_params,
+    quarter_car_model,
+)
+from ..models.vehicle import VehicleModel
+from ..numerics.integrate import DivergenceWarning, check_time_grid, uniform_step
+from ..numerics.limits import check_memory
+from ..numerics.methods import ButcherTableau, get_method
+from ..numerics.stability import max_stable_step, numerical_modes
+from ..responses.timeresp import (
     check_initial_state,
     check_input_samples,
     forced_response,
@@ -37,9 +46,7 @@ from .response import (
     input_output_response,
     linear_input,
 )
-from .ride import Transmissibility, ride_metrics, transmissibility
-from .stability import max_stable_step, numerical_modes
-from .vehicle import VehicleModel
+from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
 
 __all__ = [
     "MethodComparison",
@@ -123,7 +130,7 @@ class MethodComparison:
         The vehicle's description (signal roles, units), when known.
     scenario : Scenario or None
         The run this comparison came from, when it came from one
-        (`qc_control.scenario.Scenario.run`); the report saves it.
+        (`qc_control.cli.scenario.Scenario.run`); the report saves it.
     nonlinear : NonlinearStudy or None
         On a nonlinear system: events, the order with and without them,
         where Midpoint and Heun part, the linearisation behind ``modes``.

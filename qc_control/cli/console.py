@@ -17,10 +17,10 @@ PROG = "qc-control"
 
 
 def main(argv=None) -> int:
-    """Entry point of ``qc-control``; returns the exit status (see `qc_control.cli`)."""
+    """Entry point of ``qc-control``; returns the exit status (see `qc_control.cli.parser`)."""
     try:
         # deferred: the whole library loads here, inside the Ctrl-C handler
-        from .cli import run
+        from .parser import run
 
         return run(sys.argv[1:] if argv is None else list(argv))
     except KeyboardInterrupt:

@@ -465,7 +465,7 @@ def half_car(
     road : bool, default False
         Add the inputs ``zr_front`` and ``zr_rear`` [m], the road under each
         wheel (for the delayed rear input of one road, see
-        `qc_control.road.wheelbase_inputs`).
+        `qc_control.ride.road.wheelbase_inputs`).
     actuator : bool, default False
         Add ``fa_front`` and ``fa_rear`` [N], forces pushing body and wheel
         apart at each axle.

@@ -241,7 +241,7 @@ class QuarterCarParams:
         gets the same values to the bit (IEEE square root and products). Any
         other design (a bad value, another type, an unknown key, a
         `QuarterCarParams` already) is left as None for the caller to build
-        one by one. Used by `qc_control.sweeps.sweep` on thousands of designs.
+        one by one. Used by `qc_control.studies.sweeps.sweep` on thousands of designs.
         """
         out: list[QuarterCarParams | None] = [None] * len(designs)
         names = ("ms", "mu", "ks", "ku", "zeta", "cs")

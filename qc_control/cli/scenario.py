@@ -13,7 +13,7 @@ The TOML layout (every key optional)::
     zeta = 0.25           # ms, mu, ks, ku and zeta or cs (QuarterCarParams)
 
     [scenario]
-    model = "quarter"     # or "half", "full" (qc_control.scenario.MODELS); the
+    model = "quarter"     # or "half", "full" (qc_control.cli.scenario.MODELS); the
                           # top-level keys are then HalfCarParams' or FullCarParams'
     t_end = 10.0          # end time [s]
     h = 0.01              # step [s]
@@ -57,8 +57,13 @@ from typing import Any, ClassVar, cast
 
 import numpy as np
 
-from . import road as roads
-from .compare import (
+from ..models.halfcar import FullCarParams, HalfCarParams, full_car_model, half_car_model
+from ..models.nonlinear import BumpStop, nonlinear_quarter_car_model
+from ..models.quarter import QuarterCarParams, quarter_car_model
+from ..models.vehicle import VehicleModel
+from ..numerics.methods import METHODS, get_method
+from ..ride import road as roads
+from ..studies.compare import (
     DEFAULT_H,
     DEFAULT_METHODS,
     DEFAULT_T_END,
@@ -66,11 +71,6 @@ from .compare import (
     MethodComparison,
     compare_methods,
 )
-from .halfcar import FullCarParams, HalfCarParams, full_car_model, half_car_model
-from .methods import METHODS, get_method
-from .model import QuarterCarParams, quarter_car_model
-from .nonlinear import BumpStop, nonlinear_quarter_car_model
-from .vehicle import VehicleModel
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -211,7 +211,7 @@ class Road:
     """Base of the road specs: the kind of road and all its parameters.
 
     Each kind is a frozen dataclass whose fields are its parameters, named
-    as the keyword arguments of its function in `qc_control.road`, with
+    as the keyword arguments of its function in `qc_control.ride.road`, with
     that function's defaults. `ROADS` maps each ``kind`` to its class.
     """
 
@@ -251,7 +251,7 @@ class NoRoad(Road):
 
 @dataclass(frozen=True)
 class StepRoad(Road):
-    """A road step (a kerb), `qc_control.road.step`."""
+    """A road step (a kerb), `qc_control.ride.road.step`."""
 
     kind: ClassVar[str] = "step"
     noun: ClassVar[str] = "a step road"
@@ -265,15 +265,15 @@ class StepRoad(Road):
         return f"a {_length(self.height)} road step at t = {self.t0:g} s"
 
 
-#: One speed default for every road that has a speed: `qc_control.road.iso8608`'s.
+#: One speed default for every road that has a speed: `qc_control.ride.road.iso8608`'s.
 _SPEED = _default(roads.iso8608, "speed")
 
 
 @dataclass(frozen=True)
 class BumpRoad(Road):
-    """A 1 − cos bump, `qc_control.road.bump`.
+    """A 1 − cos bump, `qc_control.ride.road.bump`.
 
-    Its speed defaults to the ISO 8608 road's (`qc_control.road.iso8608`),
+    Its speed defaults to the ISO 8608 road's (`qc_control.ride.road.iso8608`),
     so that every road with a speed has the same default; `road.bump`'s own
     default is not used.
     """
@@ -297,7 +297,7 @@ class BumpRoad(Road):
 
 @dataclass(frozen=True)
 class SineRoad(Road):
-    """A sinusoidal road ``zr = amplitude · sin(2π f t)``, `qc_control.road.sine`."""
+    """A sinusoidal road ``zr = amplitude · sin(2π f t)``, `qc_control.ride.road.sine`."""
 
     kind: ClassVar[str] = "sine"
     noun: ClassVar[str] = "a sine road"
@@ -317,7 +317,7 @@ class SineRoad(Road):
 
 @dataclass(frozen=True)
 class ISO8608Road(Road):
-    """A random ISO 8608 road driven at ``speed``, `qc_control.road.iso8608`."""
+    """A random ISO 8608 road driven at ``speed``, `qc_control.ride.road.iso8608`."""
 
     kind: ClassVar[str] = "iso8608"
     noun: ClassVar[str] = "an iso8608 road"
@@ -563,18 +563,18 @@ class Scenario:
         Initial state in the model's state order (the quarter car's
         ``[vs, vu, xs, xu]`` [m/s, m/s, m, m]). Default: the car at rest
         under a road, else the body released from 5 cm (the quarter car's
-        `qc_control.compare.DEFAULT_X0`).
+        `qc_control.studies.compare.DEFAULT_X0`).
     t_end : float, optional
         End time [s]; a whole number (at least 2) of steps ``h``. Default
-        `qc_control.compare.DEFAULT_T_END` (`NONLINEAR_T_END` for the
+        `qc_control.studies.compare.DEFAULT_T_END` (`NONLINEAR_T_END` for the
         nonlinear car).
     h : float, optional
-        Step [s]. Default `qc_control.compare.DEFAULT_H`; where the road
+        Step [s]. Default `qc_control.studies.compare.DEFAULT_H`; where the road
         needs a finer step (an ISO 8608 road, whose band must be sampled:
-        `qc_control.road.largest_step`), the largest step of the 1-2-5
+        `qc_control.ride.road.largest_step`), the largest step of the 1-2-5
         series (…, 10, 5, 2, 1, 0.5 ms, …) not above that limit, e.g. 5 ms
         at 20 m/s on the standard band (limit 8.8 ms).
-    methods : sequence of str, default `qc_control.compare.DEFAULT_METHODS`
+    methods : sequence of str, default `qc_control.studies.compare.DEFAULT_METHODS`
         Method names (`qc_control.METHODS`), distinct. A comma-separated
         string is split.
     max_steps : int, default `MAX_STEPS`
@@ -584,10 +584,10 @@ class Scenario:
         A name in `MODELS`: ``'quarter'`` (default), ``'half'`` or
         ``'full'``; by default read from the type of ``vehicle``. On a half
         or full car the road is under every wheel, the rear wheels meeting
-        it ``(a + b)/speed`` later (`qc_control.road.axle_inputs`), so the
+        it ``(a + b)/speed`` later (`qc_control.ride.road.axle_inputs`), so the
         road must have a speed (a bump or an ISO 8608 road); a full car's
         ISO 8608 road has correlated left and right tracks
-        (`qc_control.road.iso8608_tracks`, ``track_front`` apart).
+        (`qc_control.ride.road.iso8608_tracks`, ``track_front`` apart).
         ``'nonlinear'``: the quarter car's parameters, with gravity and a
         unilateral tire; its default road is `NONLINEAR_ROAD` (give
         ``road='none'`` for its free response), and a bump's parameters not
@@ -1092,7 +1092,7 @@ class Scenario:
 
 def _road_at(road: Road, t: float) -> float:
     """A road's height [m] at one time ``t`` [s], from its own function of time
-    (`qc_control.road`'s functions take a grid of at least two times)."""
+    (`qc_control.ride.road`'s functions take a grid of at least two times)."""
     return float(np.asarray(road.samples(np.array([t, t + 1.0])))[0])
 
 

@@ -373,7 +373,7 @@ class OutputStream:
     product stays small enough for one BLAS thread (a chunk of designs is
     the unit of parallelism). The carries ``c_b`` are one product of the same
     kind and the recurrence ``c_{b+1} = Φ^L c_b + …`` as a compiled loop per
-    design (`qc_control.recurrence.carry_scan`).
+    design (`qc_control.numerics.recurrence.carry_scan`).
     The work per sample and design is ``2(L+1)kp`` flops for the input and
     ``2np`` for the carries: the input's part bounds a forced sweep.
     """
@@ -512,7 +512,7 @@ class OutputStream:
 
         ``V_0 = c``, ``V_{i+1}`` = the input's effect over block ``b0 + i``,
         then ``V_{i+1} <- Q V_i + V_{i+1}`` with ``Q = Φ^L``, in order
-        (`qc_control.recurrence.carry_scan`). The same arithmetic on both
+        (`qc_control.numerics.recurrence.carry_scan`). The same arithmetic on both
         passes, so the same bits.
         """
         V = np.zeros((self.m, self.n, b1 - b0 + 1))
@@ -711,8 +711,8 @@ def lti_trajectory(
     """The method's states on a uniform grid T, shape ``(n, len(T))``.
 
     ``U`` is ``(ninputs, len(T))`` or None. The result equals
-    `qc_control.integrate` on ``f = A x + B u(t)`` up to rounding, on any
-    grid that `qc_control.integrate.uniform_step` accepts (the step is
+    `qc_control.numerics.integrate` on ``f = A x + B u(t)`` up to rounding, on any
+    grid that `qc_control.numerics.integrate.uniform_step` accepts (the step is
     taken as the mean ``(T[-1] - T[0]) / (len(T) - 1)``).
 
     Past the method's stability limit the states overflow to inf or nan
@@ -750,10 +750,10 @@ def lti_trajectory(
 
 
 def lti_solve(method, A, B, T, U, x0, substeps: int = 1, *, uniform: bool = False) -> Solution:
-    """The LTI engine as a `qc_control.integrate.Solution`, cut like `integrate`'s.
+    """The LTI engine as a `qc_control.numerics.integrate.Solution`, cut like `integrate`'s.
 
     `lti_trajectory` on the grid ``T``, which must be uniform by
-    `qc_control.integrate.uniform_step`. If a state is non-finite (a step
+    `qc_control.numerics.integrate.uniform_step`. If a state is non-finite (a step
     past the stability limit overflows), the solution ends at the last
     finite sample, a `DivergenceWarning` is issued and ``status`` is
     ``'diverged'``: the same contract as the generic stepper's, and no
@@ -771,7 +771,7 @@ def lti_solve(method, A, B, T, U, x0, substeps: int = 1, *, uniform: bool = Fals
     x0 : array_like, shape (n,)
     substeps : int, default 1
     uniform : bool, default False
-        The caller has checked ``T`` with `qc_control.integrate.uniform_step`
+        The caller has checked ``T`` with `qc_control.numerics.integrate.uniform_step`
         already (the responses do); skip checking it again.
 
     Returns

@@ -48,7 +48,7 @@ from control.nlsys import input_output_response as _control_io_response
 from control.timeresp import _check_convert_array, _default_time_vector, _timeresp_aliases
 from control.timeresp import forced_response as _control_forced_response
 
-from .integrate import (
+from ..numerics.integrate import (
     DivergenceWarning,
     check_substeps,
     check_time_grid,
@@ -58,11 +58,11 @@ from .integrate import (
     stage_times,
     uniform_step,
 )
-from .interconnect import compile_interconnect
-from .limits import check_memory
-from .lti import array_key, lti_states, memo
-from .methods import METHODS, ButcherTableau, get_method
-from .stability import max_stable_step, stability_coefficients, step_is_stable
+from ..numerics.interconnect import compile_interconnect
+from ..numerics.limits import check_memory
+from ..numerics.lti import array_key, lti_states, memo
+from ..numerics.methods import METHODS, ButcherTableau, get_method
+from ..numerics.stability import max_stable_step, stability_coefficients, step_is_stable
 
 __all__ = [
     "FixedStepResponse",
@@ -381,7 +381,7 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
     dt = checked_uniform_step(T)  # T passed check_time_grid in the caller
     H = dt if dt is not None else float(np.diff(T).max())
     # eigenvalues as computed: the stability functions settle those that rounding
-    # moved off the imaginary axis (qc_control.stability, MARGINAL_RTOL)
+    # moved off the imaginary axis (qc_control.numerics.stability, MARGINAL_RTOL)
     eig = (
         memo(("eig", array_key(A)), lambda: np.linalg.eigvals(A))
         if A.size
@@ -793,8 +793,8 @@ def forced_response(
     engine : {'auto', 'lti', 'generic'}, default 'auto', keyword-only
         How the method's trajectory is computed. ``'lti'``: the step map
         ``x_{k+1} = R(hA) x_k + Γ₀u_k + Γ₁u_{k+1}`` solved by a blocked scan
-        (`qc_control.lti`), no Python loop per step; needs a uniform ``T``.
-        ``'generic'``: `qc_control.integrate`, one step at a time. The two
+        (`qc_control.numerics.lti`), no Python loop per step; needs a uniform ``T``.
+        ``'generic'``: `qc_control.numerics.integrate`, one step at a time. The two
         agree to rounding (1e-12 relative). ``'auto'`` uses ``'lti'`` on a
         uniform grid within the stability limit, ``'generic'`` otherwise
         (it stops a blow-up at its first non-finite sample).
@@ -901,7 +901,7 @@ def initial_response(
     whenever the input is linear within each step, as python-control's
     sampled inputs are: Midpoint's ``u(t + h/2)`` equals Heun's
     ``(u(t) + u(t + h))/2``. They differ on nonlinear systems and on inputs
-    that curve within a step (see `qc_control.integrate`).
+    that curve within a step (see `qc_control.numerics.integrate`).
 
     Examples
     --------
@@ -1475,14 +1475,16 @@ def _io_response(
             return rhs(t, x, u_of_t(t))
 
         g, labels = _event_function(sys, events)
-        if compiled is not None:  # the interconnection solved once (qc_control.interconnect)
+        if (
+            compiled is not None
+        ):  # the interconnection solved once (qc_control.numerics.interconnect)
             stages = stage_times(grid, tab, substeps=n_sub)
             dt = uniform_step(grid)
             if g is None and dt is not None:
                 fused = compiled.fused(tab, dt / n_sub, stages, (T, u_samples), n_sub)
             if fused is None:
                 f = compiled.make_rhs(u_of_t, (T, u_samples), stages)
-        if fused is not None:  # whole steps at once (qc_control.interconnect.FusedSteps)
+        if fused is not None:  # whole steps at once (qc_control.numerics.interconnect.FusedSteps)
             sol = integrate_stepper(fused.stepper(), grid, x0, tab, substeps=n_sub)
         elif g is None:
             sol = integrate(f, grid, x0, tab, substeps=n_sub)
@@ -1572,7 +1574,7 @@ def input_output_response(
     `control.nlsys`, or a `control.StateSpace`), with the same
     `control.TimeResponseData` layout, labels and title. Instead of
     ``scipy.integrate.solve_ivp``, the state is stepped by the fixed-step
-    method (`qc_control.integrate`) on
+    method (`qc_control.numerics.integrate`) on
 
     .. math::
 
@@ -1633,14 +1635,14 @@ def input_output_response(
         Switching functions ``events(t, x, u, params) -> array_like`` whose
         sign changes are the kinks of the right-hand side (a wheel leaving
         the road, a bump stop engaging). Each crossing is located inside its
-        step and stepped to exactly (`qc_control.integrate`'s ``events``),
+        step and stepped to exactly (`qc_control.numerics.integrate`'s ``events``),
         which keeps the method's order across the kink; the times are in
         the result's ``t_events`` (and ``event_labels``). True: the
         system's own ``sys.switching`` (`qc_control.nonlinear_quarter_car`
         has them). None (default): no event handling, as control.
     fast : bool, default True, keyword-only
         For an `control.InterconnectedSystem`: solve the interconnection
-        once (`qc_control.interconnect`: linear subsystems eliminated as
+        once (`qc_control.numerics.interconnect`: linear subsystems eliminated as
         matrix products, the others' functions called directly) instead of
         calling ``sys._rhs``, which re-solves it at every stage. The same
         trajectory to rounding. Falls back to ``sys._rhs`` by itself where

@@ -10,8 +10,8 @@ import numpy as np
 import scipy.linalg
 import scipy.signal
 
-from .integrate import uniform_step
-from .lti import affine_scan
+from ..numerics.integrate import uniform_step
+from ..numerics.lti import affine_scan
 
 __all__ = ["wk_filter", "wk_weighted", "wk_discrete"]
 

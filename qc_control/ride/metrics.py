@@ -22,8 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..models.vehicle import Corner, SignalRoles
 from .iso2631 import wk_weighted
-from .vehicle import Corner, SignalRoles
 
 __all__ = [
     "Metric",
@@ -421,7 +421,7 @@ class MetricStream:
     def settled(self, bound: Mapping[str, np.ndarray], *, band: bool = True) -> np.ndarray:
         """Per design, ``(m,)``: whether no later sample can change a reduction,
         given that every later sample of each streamed label satisfies
-        ``|v| <= bound[label]`` (e.g. `qc_control.lti.TailBound`).
+        ``|v| <= bound[label]`` (e.g. `qc_control.numerics.lti.TailBound`).
 
         A peak stays when ``bound <= peak``; a lift-off count when ``bound <=``
         the threshold (no later ``v`` exceeds it); the settling time when
@@ -538,7 +538,7 @@ class MetricStream:
 
     def set_last_outside(self, label: str, last: np.ndarray) -> None:
         """Set the settling time's last sample outside the band (-1: none), found
-        by a search of its own (`qc_control.sweeps`' backward search)."""
+        by a search of its own (`qc_control.studies.sweeps`' backward search)."""
         self._acc[("settle", label)] = np.asarray(last)
 
     def _ends(self, label):

@@ -31,10 +31,10 @@ import control
 import numpy as np
 import scipy.linalg
 
+from ..models.vehicle import VehicleModel
 from .iso2631 import wk_filter
 from .metrics import metric_columns
 from .road import ISO8608_N0, positive, road_class_psd
-from .vehicle import VehicleModel
 
 __all__ = [
     "lyapunov_variances",
@@ -268,7 +268,7 @@ def white_velocity_variances(
 
     Examples
     --------
-    >>> from qc_control.model import quarter_car_model
+    >>> from qc_control.models.quarter import quarter_car_model
     >>> v = white_velocity_variances(quarter_car_model(road=True))
     >>> round(v["susp_travel"], 9)           # (ms + mu) / (2 cs)
     0.133466666
@@ -322,7 +322,7 @@ def iso8608_intensity(road_class, speed: float) -> float:
 def white_velocity_wk_variance(model: VehicleModel, *, intensity: float = 1.0, batch=None):
     """Stationary variance of the ISO 2631-1 Wk-weighted body acceleration on white road velocity.
 
-    The car of `white_velocity_system` in series with `qc_control.iso2631.wk_filter`
+    The car of `white_velocity_system` in series with `qc_control.ride.iso2631.wk_filter`
     (``x_w' = A_w x_w + B_w a``, ``a_w = C_w x_w + D_w a`` with ``a`` the body
     acceleration ``C_a x̃``):
 
@@ -414,7 +414,7 @@ def spectral_metrics(
 
     ``rms_body_acc``, ``rms_body_acc_wk``, ``rms_susp_travel`` and
     ``rms_tire_load / static`` (``kt σ(tire_defl) / static load``), under the
-    column names of `qc_control.metrics` (per corner for a wheel's metric),
+    column names of `qc_control.ride.metrics` (per corner for a wheel's metric),
     from `white_velocity_variances` and `white_velocity_wk_variance`: the
     Lyapunov values over the unbounded band.
 

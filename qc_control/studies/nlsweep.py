@@ -5,7 +5,7 @@ right-hand side over arrays of designs (``VehicleModel.batch_dynamics``, a
 `qc_control.NonlinearQuarterCarBatch`). This module steps it with any
 explicit tableau for ``m`` designs together: the Python loop runs over the
 steps, NumPy over the designs. One step is the generic stepper's
-(`qc_control.integrate`)
+(`qc_control.numerics.integrate`)
 
 .. math::
 
@@ -14,21 +14,21 @@ steps, NumPy over the designs. One step is the generic stepper's
     x \\leftarrow x + h \\textstyle\\sum_i b_i k_i ,
 
 with ``x`` of shape ``(n, m)``, the same stage times
-(`qc_control.integrate.stage_times`) and the input interpolated linearly
+(`qc_control.numerics.integrate.stage_times`) and the input interpolated linearly
 between its samples as python-control interpolates it
-(`qc_control.response.linear_input`), so that each design's trajectory is
+(`qc_control.responses.timeresp.linear_input`), so that each design's trajectory is
 `qc_control.input_output_response`'s on that design to rounding.
 
 **Compiled steps.** A batch that offers them
 (``dynamics.compiled_stepper()``: for `nonlinear_quarter_car`, the same step
-compiled with numba, `qc_control.nlkernel`) is stepped by them, a block of
+compiled with numba, `qc_control.models.nlkernel`) is stepped by them, a block of
 samples per call, instead of by NumPy calls: a dozen NumPy calls a stage
 cost about a microsecond each whatever the number of designs, which made
 the Python loop most of the time. The NumPy path stays for what has no
 compiled form (user callables) and to locate events.
 
 The registered metrics are reduced as the samples go by
-(`qc_control.metrics.MetricStream`, a block of samples at a time), so no
+(`qc_control.ride.metrics.MetricStream`, a block of samples at a time), so no
 ``(designs, samples, outputs)`` array is formed; a metric that needs the
 last sample before it can read the others (the settling time) keeps its one
 signal, ``(designs, samples)``.
@@ -39,7 +39,7 @@ stepper does: the trajectory is `input_output_response`'s without events,
 and near a kink the method loses its order (RK4 falls to about order 1-2 on
 a lift-off, see the README's nonlinear section). With ``events=True``, after
 each step the designs whose switching functions changed sign inside it
-(and only those) take the step again alone with `qc_control.integrate`'s
+(and only those) take the step again alone with `qc_control.numerics.integrate`'s
 event location (root finding on the method's own step, stepping to the
 kink exactly): each design's trajectory is then `input_output_response`'s
 with ``events=True`` to rounding, at the price of a Python call per event.
@@ -54,7 +54,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .integrate import (
+from ..models.vehicle import SignalRoles, VehicleModel
+from ..numerics.integrate import (
     DivergenceWarning,
     check_substeps,
     check_time_grid,
@@ -62,16 +63,15 @@ from .integrate import (
     stage_times,
     uniform_step,
 )
-from .limits import check_memory
-from .methods import ButcherTableau, get_method
-from .metrics import METRICS, Metric, MetricStream, RideSignals
-from .response import (
+from ..numerics.limits import check_memory
+from ..numerics.methods import ButcherTableau, get_method
+from ..responses.timeresp import (
     check_initial_state,
     check_input_samples,
     input_output_response,
     linear_input,
 )
-from .vehicle import SignalRoles, VehicleModel
+from ..ride.metrics import METRICS, Metric, MetricStream, RideSignals
 
 __all__ = ["simulate_batch", "BatchResponse", "nonlinear_sweep", "is_nonlinear", "BLOCK"]
 
@@ -117,7 +117,7 @@ def _tableau_rows(tab: ButcherTableau, h: float):
 
     Per stage: None (no ``a_ij``), ``(j, h a_ij)`` for one non-zero entry
     (RK4's), or the row ``h a_i,:i``, summed with the stored slopes in one
-    product; the weights likewise. The generic stepper (`qc_control.integrate`)
+    product; the weights likewise. The generic stepper (`qc_control.numerics.integrate`)
     sums the same terms in another order: the steps agree to rounding.
     """
     rows: list = []
@@ -133,7 +133,7 @@ def _tableau_rows(tab: ButcherTableau, h: float):
 
 
 def _inputs(dynamics, T: np.ndarray, U) -> np.ndarray:
-    """The input samples ``(k, N)`` (`qc_control.response.check_input_samples`:
+    """The input samples ``(k, N)`` (`qc_control.responses.timeresp.check_input_samples`:
     python-control's shapes; None is zero)."""
     return check_input_samples(U, len(dynamics.input_labels), T.size)
 
@@ -233,7 +233,7 @@ def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
 
 def _locate(dynamics, hit, ta, tb, x_a, x_b, tab, u_of, k, t_events):
     """Take the step ``ta -> tb`` again for the designs ``hit`` alone, with
-    `qc_control.integrate`'s event location; write their ends into ``x_b``."""
+    `qc_control.numerics.integrate`'s event location; write their ends into ``x_b``."""
     none = np.zeros(0)
     for j in hit.tolist():
         one = dynamics.take(np.array([j]))

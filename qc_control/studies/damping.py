@@ -1,7 +1,7 @@
 """Passive damper optimisation on exact spectral metrics, and the Pareto front.
 
 On white road velocity of intensity ``q`` (an ISO 8608 road of waviness 2
-at a constant speed, `qc_control.spectral.iso8608_intensity`), the quarter
+at a constant speed, `qc_control.ride.spectral.iso8608_intensity`), the quarter
 car's stationary variances are exact closed forms (Gobbi & Mastinu,
 "Analytical description and optimization of the dynamic behaviour of
 passively suspended road vehicles", J. Sound Vib. 245(3), 2001; Dahlberg,
@@ -31,7 +31,7 @@ is the larger of the two.
 Objectives without a closed form (the ISO 2631-1 Wk-weighted comfort, or a
 vehicle other than the quarter car) are minimised by
 ``scipy.optimize.minimize_scalar`` on the exact Lyapunov metric
-(`qc_control.spectral`).
+(`qc_control.ride.spectral`).
 """
 
 from __future__ import annotations
@@ -45,11 +45,11 @@ import numpy as np
 import pandas as pd
 import scipy.optimize
 
-from .model import QuarterCarParams, as_params, quarter_car_model
-from .road import positive
-from .spectral import iso8608_intensity, white_velocity_variances, white_velocity_wk_variance
+from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
+from ..models.vehicle import STANDARD_GRAVITY, VehicleModel
+from ..ride.road import positive
+from ..ride.spectral import iso8608_intensity, white_velocity_variances, white_velocity_wk_variance
 from .sweeps import design_grid
-from .vehicle import STANDARD_GRAVITY, VehicleModel
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

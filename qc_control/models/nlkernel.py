@@ -1,6 +1,6 @@
 """The nonlinear quarter car's batched steps, compiled (numba).
 
-`qc_control.nlsweep` steps many designs of `qc_control.nonlinear_quarter_car`
+`qc_control.studies.nlsweep` steps many designs of `qc_control.nonlinear_quarter_car`
 together. Written with NumPy over the designs, each stage of each step is a
 dozen NumPy calls on arrays of a thousand numbers, and the calls' fixed cost
 (about a microsecond each) is most of the time: 1,000 designs over 10 s at
@@ -10,17 +10,17 @@ with numba (LLVM), so that a step costs its arithmetic: the loops over the
 designs are simple enough for the compiler to vectorise.
 
 One step of an explicit tableau with the stepper's own ``h a_ij``, ``h b_i``
-(`qc_control.integrate`):
+(`qc_control.numerics.integrate`):
 
 .. math::
 
     k_i = f\\big(x + \\textstyle\\sum_{j<i} h a_{ij} k_j,\\; u(t + c_i h)\\big),
     \\qquad x \\leftarrow x + \\textstyle\\sum_i h b_i k_i ,
 
-with the inputs at the stage times given (`qc_control.nlsweep` interpolates
+with the inputs at the stage times given (`qc_control.studies.nlsweep` interpolates
 them as python-control does). The right-hand side is
 `NonlinearQuarterCarBatch`'s (the module docstring of
-`qc_control.nonlinear` has the equations) with the same folded constants:
+`qc_control.models.nonlinear` has the equations) with the same folded constants:
 ``-F/m_s`` as ``F·(-1/m_s)``, the tire's dynamic force ``F_t - k_u δ0`` as
 ``max(k_u (z_r - x_u), -k_u δ0)`` for a unilateral tire, the stops'
 ``F = q (k + k3 q²)`` with ``q = d - clip(d, -c_b, c_r)``, which is exactly
@@ -33,10 +33,10 @@ What has no compiled form: a callable spring, damper or road profile (user
 Python code), and event location (a Python call per event); the NumPy path
 takes those (`NonlinearQuarterCarBatch.compiled_stepper` returns None).
 
-numba is imported with this module (through `qc_control.recurrence`), which
-takes about half a second, so `qc_control.nonlinear` imports it only when a
+numba is imported with this module (through `qc_control.numerics.recurrence`), which
+takes about half a second, so `qc_control.models.nonlinear` imports it only when a
 batch is first stepped. The compiled code is cached on disk
-(`qc_control.recurrence.compiled`: beside this file, or in a per-user cache
+(`qc_control.numerics.recurrence.compiled`: beside this file, or in a per-user cache
 where the package is read-only), so the one-off compilation (about three
 seconds) is paid once per installation.
 """
@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .recurrence import compiled
+from ..numerics.recurrence import compiled
 
 __all__ = ["advance", "PARAMETER_ROWS", "OPTION_SLOTS"]
 

@@ -4,7 +4,7 @@ Exit status: 0 on success; 2 with one line on stderr for bad input (a bad
 option or config value, an unusable ``--out``); 130 with one line on Ctrl-C;
 1 with the traceback and a request to report it for anything else, which is
 a bug in qc-control and is never passed off as a usage error. The last two
-are `qc_control.console`'s, the entry point that imports this module.
+are `qc_control.cli.console`'s, the entry point that imports this module.
 """
 
 from __future__ import annotations
@@ -22,12 +22,12 @@ from typing import Any
 
 import pandas as pd
 
-from .control_study import DESIGNS, compare_controllers
-from .controllers import HINF_AVAILABLE
-from .modal import modal_analysis
-from .model import QuarterCarParams
-from .report import ReportError, check_target, write_report
-from .report.control import write_control_report
+from ..models.controllers import HINF_AVAILABLE
+from ..models.modal import modal_analysis
+from ..models.quarter import QuarterCarParams
+from ..report import ReportError, check_target, write_report
+from ..report.control import write_control_report
+from ..studies.control_study import DESIGNS, compare_controllers
 from .scenario import MODELS, ROADS, Scenario, ScenarioError, road_option, vehicle_keys
 
 __all__ = ["run", "build_parser", "scenario_from_args", "summarise_warnings", "UsageError"]
@@ -107,7 +107,7 @@ def _add_road(parser: argparse.ArgumentParser) -> None:
 
     group = parser.add_argument_group(
         "road input (default: none, the free response from --x0)",
-        "Each road parameter defaults to its function's default in qc_control.road, except "
+        "Each road parameter defaults to its function's default in qc_control.ride.road, except "
         "the speed, whose one default serves both bump and iso8608.",
     )
     group.add_argument(
@@ -518,7 +518,7 @@ def run(argv: list[str]) -> int:
     """Run ``qc-control`` with the arguments ``argv``; returns the exit status.
 
     Bad input (a `UsageError` or `ScenarioError`) is one line on stderr and
-    status 2. The entry point, `qc_control.console.main`, handles Ctrl-C and
+    status 2. The entry point, `qc_control.cli.console.main`, handles Ctrl-C and
     internal errors around this call and around importing this module.
     """
     parser = build_parser()

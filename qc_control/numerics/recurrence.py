@@ -1,7 +1,7 @@
 """Compiled recurrences of the LTI engine (numba); like every numerics module,
 they know no vehicle.
 
-`qc_control.lti.OutputStream` carries each design's state from block to
+`qc_control.numerics.lti.OutputStream` carries each design's state from block to
 block, ``c_{b+1} = Q c_b + w_{b+1}`` with ``Q = Φ^L`` the step map over a
 block and ``w`` the input's effect over it. Written with NumPy over the
 designs, that recurrence was a log-depth (Hillis–Steele) scan: about
@@ -10,7 +10,7 @@ fixed cost is most of its time for a chunk of a hundred designs. As a
 compiled loop it is the recurrence itself, ``n²`` multiply-adds per block
 and design, and its sums are the recurrence's own (no reassociation).
 
-numba is imported with this module, so `qc_control.lti` imports it only when
+numba is imported with this module, so `qc_control.numerics.lti` imports it only when
 a stream is first built (sweeps, never a single response); the compiled code
 is cached on disk (`compiled`).
 """

@@ -1,6 +1,6 @@
 """The nonlinear quarter car: wheel lift-off, bump stops, a nonlinear damper and spring.
 
-The seed's two masses (`qc_control.model`), with the force elements made
+The seed's two masses (`qc_control.models.quarter`), with the force elements made
 nonlinear one at a time. Displacements are measured from the static
 equilibrium (as in `qc_control.quarter_car`), so with every nonlinearity
 off the model *is* the seed's linear one. With ``d = xs - xu`` the
@@ -56,7 +56,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from .model import OUTPUTS, STATES, UNITS, as_params
+from .quarter import OUTPUTS, STATES, UNITS, as_params
 from .vehicle import STANDARD_GRAVITY, Corner, SignalRoles, VehicleModel
 
 __all__ = [
@@ -549,7 +549,7 @@ class NonlinearQuarterCarBatch:
     elements are the single car's (`BumpStop.forces`, `PiecewiseDamper.forces`
     are `BumpStop.force` and `PiecewiseDamper.__call__` elementwise), with
     the same operations in the same order, so a design's right-hand side
-    equals the single car's to rounding. `qc_control.nlsweep` steps it.
+    equals the single car's to rounding. `qc_control.studies.nlsweep` steps it.
 
     A user callable ``spring(d)`` or ``damper(v)`` must vectorise: called
     with an array, return the array of its values (NumPy ufuncs, ``np.where``;
@@ -719,7 +719,7 @@ class NonlinearQuarterCarBatch:
         """The compiled batched step of these designs, or None where an option has none.
 
         Returns ``step(x, out, first, count, start, substeps, a, b, stage_u)``:
-        `qc_control.nlkernel.advance` with these designs' parameters and
+        `qc_control.models.nlkernel.advance` with these designs' parameters and
         options bound (its docstring has the arguments). None for a callable
         spring, damper or road profile: user Python code, which only the
         NumPy path (`rhs`) can call.

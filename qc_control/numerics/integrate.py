@@ -42,7 +42,7 @@ class DivergenceWarning(RuntimeWarning):
 
 @dataclass(frozen=True, eq=False)
 class Solution:
-    """The result of `integrate` (and of the LTI engine, `qc_control.lti.lti_solve`).
+    """The result of `integrate` (and of the LTI engine, `qc_control.numerics.lti.lti_solve`).
 
     Attributes
     ----------
@@ -422,7 +422,7 @@ def integrate_stepper(stepper, t, x0, method="rk4", *, substeps: int = 1) -> Sol
     """`integrate`'s loop (divergence checks, `Solution`) around a specialised stepper.
 
     For a right-hand side that steps itself faster than ``f`` called
-    stage by stage can (`qc_control.interconnect`'s fused steps):
+    stage by stage can (`qc_control.numerics.interconnect`'s fused steps):
     ``stepper(x, out, start, stop)`` takes the steps from ``t[start]`` to
     ``t[stop]`` with ``method`` (``substeps`` per interval), writes the
     state at the end of each interval ``i`` into ``out[i + 1]`` and

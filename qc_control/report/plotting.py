@@ -18,7 +18,7 @@ import numpy as np
 
 __all__ = ["plot_outputs", "output_signal", "output_unit", "OUTPUT_UNITS"]
 
-#: Units of the quarter car's outputs (`qc_control.model.OUTPUTS`) and inputs.
+#: Units of the quarter car's outputs (`qc_control.models.quarter.OUTPUTS`) and inputs.
 OUTPUT_UNITS = {
     "xs": "m",
     "xu": "m",

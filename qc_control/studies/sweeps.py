@@ -14,12 +14,15 @@ import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
-from .integrate import check_substeps, check_time_grid, uniform_step
-from .iso2631 import wk_discrete
-from .limits import check_memory
-from .lti import OutputStream, TailBound, affine_scan, step_matrices
-from .methods import ButcherTableau, get_method
-from .metrics import (
+from ..models.quarter import SEED_X0, quarter_car_model
+from ..models.vehicle import BatchedModel, SignalRoles, VehicleModel
+from ..numerics.integrate import check_substeps, check_time_grid, uniform_step
+from ..numerics.limits import check_memory
+from ..numerics.lti import OutputStream, TailBound, affine_scan, step_matrices
+from ..numerics.methods import ButcherTableau, get_method
+from ..numerics.stability import step_is_stable
+from ..ride.iso2631 import wk_discrete
+from ..ride.metrics import (
     METRICS,
     SWEEP_METRICS,
     WEIGHTED_ACC,
@@ -27,11 +30,8 @@ from .metrics import (
     RideSignals,
     metric_columns,
 )
-from .model import SEED_X0, quarter_car_model
+from ..ride.spectral import SPECTRAL_METRICS, ISO8608Road, spectral_metrics
 from .nlsweep import is_nonlinear, nonlinear_sweep
-from .spectral import SPECTRAL_METRICS, ISO8608Road, spectral_metrics
-from .stability import step_is_stable
-from .vehicle import BatchedModel, SignalRoles, VehicleModel
 
 __all__ = [
     "sweep",
@@ -54,9 +54,9 @@ __all__ = [
 DASK_WORKER_ENV = {"MALLOC_TRIM_THRESHOLD_": 2**27, "MALLOC_MMAP_THRESHOLD_": 2**25}
 
 #: The columns a sweep of the quarter car computes unless told otherwise
-#: (`qc_control.metrics.SWEEP_METRICS`).
+#: (`qc_control.ride.metrics.SWEEP_METRICS`).
 DEFAULT_METRICS = tuple(METRICS[name].column() for name in SWEEP_METRICS)
-#: What a custom metric ``f(chunk) -> (m,)`` receives: `qc_control.metrics.RideSignals`.
+#: What a custom metric ``f(chunk) -> (m,)`` receives: `qc_control.ride.metrics.RideSignals`.
 SweepChunk = RideSignals
 
 
@@ -293,12 +293,12 @@ def _run_designs(
 
 
 def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps, items, eig=None):
-    """One chunk's registered metrics, streamed (`qc_control.lti.OutputStream`
-    into `qc_control.metrics.MetricStream`): no ``(designs, outputs, samples)``
+    """One chunk's registered metrics, streamed (`qc_control.numerics.lti.OutputStream`
+    into `qc_control.ride.metrics.MetricStream`): no ``(designs, outputs, samples)``
     array, only a segment of it at a time.
 
     When a metric reads the Wk-weighted acceleration, the filter (exact for
-    an input linear between samples, `qc_control.iso2631.wk_discrete`) runs
+    an input linear between samples, `qc_control.ride.iso2631.wk_discrete`) runs
     inside the scan: its state ``x̃`` joins the car's, so it is carried from
     block to block,
 
@@ -307,7 +307,7 @@ def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps
               \\begin{bmatrix} x \\\\ \\tilde x \\end{bmatrix}_k + \\dots, \\quad
               a_w = C_w \\tilde x + \\tilde D a, \\quad \\tilde x_0 = -B_1 a_0,
 
-    the same recursion `qc_control.iso2631.wk_weighted` evaluates by FFT.
+    the same recursion `qc_control.ride.iso2631.wk_weighted` evaluates by FFT.
 
     With ``eig = np.linalg.eig(A)`` (the sweep has it, for its ordering), its
     eigenvalues give ``stable`` and its eigenvectors, which the step map
@@ -403,7 +403,7 @@ def _last_outside(out: OutputStream, tail: TailBound, carries, row, final, band,
     backwards: from the first block after which `TailBound` proves every
     sample inside the band, ``width`` blocks at a time towards the start.
     The same samples, from the same block carries and products, as the
-    forward stream (`qc_control.metrics.MetricStream` finds the same index
+    forward stream (`qc_control.ride.metrics.MetricStream` finds the same index
     going forwards; the test suite checks both against whole trajectories).
     """
     m, L = carries.shape[0], out.L
@@ -489,7 +489,7 @@ def sweep(
         ``None`` for the free response.
     method : str or ButcherTableau, default ``'rk4'``
     metrics : sequence of str or dict of name -> callable, optional
-        Names from `qc_control.metrics.METRICS` (default `DEFAULT_METRICS`:
+        Names from `qc_control.ride.metrics.METRICS` (default `DEFAULT_METRICS`:
         all but the Wk-weighted ones, which cost as much as the simulation),
         or ``{column: f}`` with ``f(chunk: RideSignals) -> (m,)``; a chunk
         gives each output by label, ``chunk.output('xs')`` of shape ``(m, N)``.
@@ -503,7 +503,7 @@ def sweep(
         ``quarter_car_model(road=U is not None)``. Designs are rebuilt with
         its ``batch`` (vectorised for the quarter car). A nonlinear model
         (`qc_control.nonlinear_quarter_car_model`) is stepped for all
-        designs at once with its ``batch_dynamics`` (`qc_control.nlsweep`);
+        designs at once with its ``batch_dynamics`` (`qc_control.studies.nlsweep`);
         a nonlinear system without one (`qc_control.closed_loop` with a
         clipped controller) runs one `qc_control.input_output_response` per
         design: the same numbers, as slow as that many responses. For a
@@ -524,17 +524,17 @@ def sweep(
         outlasts 1 s, and never when standard error is not a terminal.
     road : ISO8608Road, optional
         A spectral sweep instead of a simulation: the exact stationary RMS
-        metrics on this road (`qc_control.spectral.spectral_metrics`, the
+        metrics on this road (`qc_control.ride.spectral.spectral_metrics`, the
         Lyapunov equation of each design on white road velocity, batched),
         for a linear model with road inputs (default
         ``quarter_car_model(road=True)``). Give no ``T``, ``U`` or ``X0``;
-        ``metrics`` among `qc_control.spectral.SPECTRAL_CAPABLE` (default
-        `qc_control.spectral.SPECTRAL_METRICS`). Runs here, vectorised over
+        ``metrics`` among `qc_control.ride.spectral.SPECTRAL_CAPABLE` (default
+        `qc_control.ride.spectral.SPECTRAL_METRICS`). Runs here, vectorised over
         all designs (``executor`` is not used).
     events : bool, default False
         Nonlinear models only: locate each kink (contact, stop, damper knee)
         inside its step, for the designs that have one in that step
-        (`qc_control.nlsweep`); by default the steps go through the kinks.
+        (`qc_control.studies.nlsweep`); by default the steps go through the kinks.
 
     Returns
     -------
@@ -542,14 +542,14 @@ def sweep(
 
     Notes
     -----
-    Each chunk builds every design's step map ``R(hA)`` (`qc_control.lti`)
+    Each chunk builds every design's step map ``R(hA)`` (`qc_control.numerics.lti`)
     and solves all trajectories together with one blocked scan, so the
     results equal `qc_control.initial_response` (and ``forced_response``)
     for each design to rounding. The metrics are those of
     `qc_control.ride_metrics`, column for column.
 
     Registered metrics are computed as the scan goes by
-    (`qc_control.lti.OutputStream` into `qc_control.metrics.MetricStream`):
+    (`qc_control.numerics.lti.OutputStream` into `qc_control.ride.metrics.MetricStream`):
     running sums of squares, peaks, counts and the settling time's last
     excursion, and the Wk filter's state carried inside the scan; no
     ``(designs × outputs × samples)`` array exists. The road ``U``, shared by
@@ -614,7 +614,7 @@ def sweep(
     )
 
     params, errors = _validate(designs, type(model.params))
-    if is_nonlinear(model):  # stepped in a batch (qc_control.nlsweep), or one by one
+    if is_nonlinear(model):  # stepped in a batch (qc_control.studies.nlsweep), or one by one
         stable, table, kept = nonlinear_sweep(
             model, params, T, X0, U, tab, substeps, metric_items, states,
             events=events, executor=executor, chunk_size=nl_chunk,
