@@ -152,13 +152,20 @@ def _velocity_law(name: str, gain_vs: float, gain_vu: float, semi_active, cmin, 
         c = semi_active_coefficient(gain_vs * vs + gain_vu * vu, vrel, lo, hi, semi_active)
         return np.array([-c * vrel])
 
+    return _damper_law(None, output, name, {"cmin": lo, "cmax": hi, "mode": semi_active})
+
+
+def _damper_law(update, output, name: str, params: dict, states=None):
+    """A semi-active law as a system: the body and wheel velocities in, the
+    force ``fa`` out (what `closed_loop` connects)."""
     return control.nlsys(
-        None,
+        update,
         output,
         inputs=list(_VELOCITIES),
+        states=states,
         outputs=["fa"],
         name=name,
-        params={"cmin": lo, "cmax": hi, "mode": semi_active},
+        params=params,
     )
 
 
@@ -289,15 +296,8 @@ def add_damper(cmin: float, cmax: float, *, sensor_hz: float = 50.0, name: str =
         c = semi_active_coefficient(-acc, vrel, lo, hi, "on-off")
         return np.array([-c * vrel])
 
-    return control.nlsys(
-        update,
-        output,
-        inputs=list(_VELOCITIES),
-        states=["acc_filter"],
-        outputs=["fa"],
-        name=name,
-        params={"cmin": lo, "cmax": hi, "sensor_hz": float(sensor_hz)},
-    )
+    params = {"cmin": lo, "cmax": hi, "sensor_hz": float(sensor_hz)}
+    return _damper_law(update, output, name, params, states=["acc_filter"])
 
 
 # ---------------------------------------------------------------- LQR

@@ -271,25 +271,21 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
     )
     fn_undamped = {n: math.sqrt(max(w, 0.0)) / (2 * math.pi) for n, w in zip(undamped_names, w2)}
 
-    modes = []
-    for name, (lams, v) in zip(names, groups):
-        lam, wn, zeta, fd = _mode_numbers(lams)
-        ratio = _shape(v)
-        modes.append(
-            Mode(
-                name,
-                lam,
-                wn,
-                zeta,
-                fd,
-                fn_undamped[name],
-                float(abs(ratio)),
-                float(np.degrees(np.angle(ratio))),
-                float(zeta_nominal),
-            )
-        )
+    modes = [
+        _mode(name, lams, _shape(v), fn_undamped[name], zeta_nominal=float(zeta_nominal))
+        for name, (lams, v) in zip(names, groups)
+    ]
     modes.sort(key=lambda m: m.name != BODY)
     return ModalAnalysis((modes[0], modes[1]), _damping_note(modes[0], MinvK))
+
+
+def _mode(name: str, lams, ratio: complex, fn_undamped: float, **extra) -> Mode:
+    """The `Mode` of eigenvalues ``lams`` whose shape has the ratio ``ratio``
+    (wheel to body for the quarter car, `_Shapes.ratio` for a vehicle)."""
+    lam, wn, zeta, fd = _mode_numbers(lams)
+    phase = float(np.degrees(np.angle(ratio)))
+    extra.setdefault("zeta_nominal", math.nan)
+    return Mode(name, lam, wn, zeta, fd, fn_undamped, float(abs(ratio)), phase, **extra)
 
 
 def _mode_numbers(lams) -> tuple[complex, float, float, float]:
@@ -581,22 +577,15 @@ def vehicle_modes(vehicle) -> ModalAnalysis:
 
     modes = []
     for name, (lams, v) in zip(names, groups):
-        lam, wn, zeta, fd = _mode_numbers(lams)
         v = v / v[np.argmax(np.abs(v))]
-        ratio = geo.ratio(v)
         modes.append(
-            Mode(
+            _mode(
                 name,
-                lam,
-                wn,
-                zeta,
-                fd,
+                lams,
+                geo.ratio(v),
                 float(undamped.get(name, math.nan)),
-                float(abs(ratio)),
-                float(np.degrees(np.angle(ratio))),
-                math.nan,
-                tuple(zip(geo.labels, (complex(x) for x in v))),
-                geo.node_x(v) if name in ("bounce", "pitch") else math.nan,
+                shape=tuple(zip(geo.labels, (complex(x) for x in v))),
+                node_x=geo.node_x(v) if name in ("bounce", "pitch") else math.nan,
             )
         )
     rank = {name: i for i, name in enumerate(geo.body_names + geo.wheel_names)}
