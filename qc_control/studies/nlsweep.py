@@ -4,8 +4,8 @@ A nonlinear model (`qc_control.nonlinear_quarter_car_model`) gives its
 right-hand side over arrays of designs (``VehicleModel.batch_dynamics``, a
 `qc_control.NonlinearQuarterCarBatch`). This module steps it with any
 explicit tableau for ``m`` designs together: the Python loop runs over the
-steps, NumPy over the designs. One step is the generic stepper's
-(`qc_control.numerics.integrate`)
+steps, NumPy over the designs. One step is the stage loop's
+(`qc_control.numerics.stepper.rk_steps`, on the ``(n, m)`` batch)
 
 .. math::
 
@@ -16,12 +16,13 @@ steps, NumPy over the designs. One step is the generic stepper's
 with ``x`` of shape ``(n, m)``, the same stage times
 (`qc_control.numerics.integrate.stage_times`) and the input interpolated linearly
 between its samples as python-control interpolates it
-(`qc_control.responses.timeresp.linear_input`), so that each design's trajectory is
+(`qc_control.numerics.sampled.linear_input`), so that each design's trajectory is
 `qc_control.input_output_response`'s on that design to rounding.
 
 **Compiled steps.** A batch that offers them
 (``dynamics.compiled_stepper()``: for `nonlinear_quarter_car`, the same step
-compiled with numba, `qc_control.models.nlkernel`) is stepped by them, a block of
+compiled with numba: `qc_control.models.nlkernel`'s right-hand side in
+`qc_control.numerics.compiled_stepper.stage_loop`) is stepped by them, a block of
 samples per call, instead of by NumPy calls: a dozen NumPy calls a stage
 cost about a microsecond each whatever the number of designs, which made
 the Python loop most of the time. The NumPy path stays for what has no
