@@ -386,11 +386,12 @@ class FusedSteps:
         """``run(x, out, start, stop)`` for `qc_control.numerics.integrate.integrate_stepper`.
 
         The steps are `qc_control.numerics.stepper.affine_rk_steps` with this
-        interconnection's fused stage (`_stage`); ``substeps`` steps per
-        interval of the grid, every ``substeps``-th kept
+        interconnection's fused stage (`_stage`), the value at each step's
+        first stage kept in ``yn``; ``substeps`` steps per interval of the
+        grid, every ``substeps``-th kept
         (`qc_control.numerics.stepper.sample_steps`), as `integrate` takes them.
         """
-        stage = self._stage()
+        stage, yn = self._stage(), self._yn_rows()
         G, pre, C, times, m, ns = self._G, self._pre, self._C, self._times, self._m, self._substeps
         if self._single and self._p == 1:
             C = [c[:, 0].copy() for c in C]  # one output: columns scaled by a number
@@ -399,38 +400,28 @@ class FusedSteps:
             q0, q1 = start * ns, stop * ns
 
             def advance(x, buf):
-                return affine_rk_steps(stage, G, pre, C, times, x, buf, q0, q0, q1, m)
+                return affine_rk_steps(stage, G, pre, C, times, x, buf, yn, q0, q0, q1, m)
 
             return sample_steps(advance, x, out[start:], stop - start, ns)
 
         return run
 
     def _stage(self):
-        """``stage(k, i, t, z)``: the nonlinear subsystems' outputs at stage ``i`` of step ``k``.
-
-        Step ``k``'s first stage is at the sample itself: its value is kept
-        in ``yn[k]`` (the outputs at the samples need no second call).
-        """
-        yn = self._yn_rows()
+        """``stage(t, z)``: the nonlinear subsystems' outputs at a stage with input ``z``."""
         if self._single and self._p == 1:
             # the common case (one static controller, one output): a number, no y vector
             sub = self._sub
             outfcn, params, empty = sub.outfcn, sub._current_params, np.empty(0)
 
-            def one(k, i, t, z):
+            def one(t, z):
                 r = outfcn(t, empty, z, params)
-                v = r[0] if type(r) is list and len(r) == 1 else _scalar(r)
-                if i == 0:
-                    yn[k] = v
-                return v
+                return r[0] if type(r) is list and len(r) == 1 else _scalar(r)
 
             return one
         phi, y = self._phi, np.empty(self._p)
 
-        def stage(k, i, t, z):
+        def stage(t, z):
             phi(t, z, y)
-            if i == 0:
-                yn[k] = y
             return y
 
         return stage

@@ -25,8 +25,8 @@ class SampledInput:
         u(t) = U_i + (t - T_i)\,\frac{U_{i+1} - U_i}{T_{i+1} - T_i}, \qquad
         T_i \le t < T_{i+1},
 
-    extended linearly beyond the ends by the first and last intervals (an
-    engine never asks there). At a sample time it is the sample itself.
+    held at the first and last samples beyond the ends (as `numpy.interp`;
+    an engine never asks there). At a sample time it is the sample itself.
 
     Parameters
     ----------
@@ -50,17 +50,24 @@ class SampledInput:
 
     def __call__(self, t: float) -> np.ndarray:
         """The inputs ``(k,)`` at the time ``t``."""
-        i = min(max(bisect.bisect_right(self._times, t) - 1, 0), self._last)
-        return self._rows[i] + (t - self._times[i]) * self._slopes[i]
+        i = bisect.bisect_right(self._times, t) - 1
+        if i > self._last:  # at (or past) the last sample: the sample, as np.interp
+            return self._rows[-1]
+        if i < 0:
+            return self._rows[0]
+        # np.interp's own expression, slope·(t - T_i) + U_i, so that `at` agrees to the bit
+        return self._slopes[i] * (t - self._times[i]) + self._rows[i]
 
     def at(self, times) -> np.ndarray:
         """The inputs at every time of ``times`` (any shape): ``(*times.shape, k)``.
 
-        The same formula as a call, element by element.
+        The same values as a call at each time, to the bit (`numpy.interp`
+        per input, whose formula the call repeats).
         """
         times = np.asarray(times, dtype=float)
-        i = np.clip(np.searchsorted(self.T, times, side="right") - 1, 0, self._last)
-        return self._rows[i] + (times - self.T[i])[..., None] * self._slopes[i]
+        if not self.size:
+            return np.zeros((*times.shape, 0))
+        return np.stack([np.interp(times, self.T, row) for row in self._rows.T], axis=-1)
 
 
 def linear_input(T: np.ndarray, U: np.ndarray) -> SampledInput:

@@ -154,7 +154,7 @@ def rk_steps(f, ts, rows, x, out, plan: StagePlan):
     return x
 
 
-def affine_rk_steps(stage, G, pre, C, times, x, out, base, start, stop, width):
+def affine_rk_steps(stage, G, pre, C, times, x, out, first, base, start, stop, width):
     r"""Steps ``start .. stop - 1`` of a plant linear in its state; step ``k``'s end in
     ``out[k + 1 - base]``.
 
@@ -163,24 +163,30 @@ def affine_rk_steps(stage, G, pre, C, times, x, out, base, start, stop, width):
     tableau composed with ``F`` once (`qc_control.numerics.interconnect.FusedSteps`),
     ``z = G x + pre[k]`` holds every stage's input ``z_i`` (``width`` rows
     each) and, last, the step's end before the stages' values are added.
-    Stage ``i`` is then the fused stage callback ``y_i = stage(i, t_i, z_i)``,
+    Stage ``i`` is then the fused stage callback ``y_i = stage(t_i, z_i)``,
     added to the later stages and the end through ``C[i]`` (``z += C_i y_i``).
+    The first stage is at the step's start: its value goes to ``first[k]``
+    (the nonlinear functions' value at each sample, kept for the outputs).
 
     ``C[i]`` may be a column (one scalar output) or a matrix; ``stage``
     returns a number or a vector to match.
     """
     columns = C[0].ndim == 1
-    stages = [(i, slice(i * width, (i + 1) * width), Ci) for i, Ci in enumerate(C)]
+    z0, C0 = slice(0, width), C[0]
+    later = [(i, slice(i * width, (i + 1) * width), Ci) for i, Ci in enumerate(C)][1:]
     end = len(C) * width
     for k in range(start, stop):
         z = G @ x + pre[k]
         ts = times[k]
-        for i, zi, Ci in stages:
-            y = stage(k, i, ts[i], z[zi])
-            if columns:
-                z += Ci * y
-            else:
-                z += Ci @ y
+        y = first[k] = stage(ts[0], z[z0])
+        if columns:
+            z += C0 * y
+            for i, zi, Ci in later:
+                z += Ci * stage(ts[i], z[zi])
+        else:
+            z += C0 @ y
+            for i, zi, Ci in later:
+                z += Ci @ stage(ts[i], z[zi])
         x = out[k + 1 - base] = z[end:]
     return x
 
