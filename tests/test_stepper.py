@@ -11,6 +11,9 @@ every path (plain, fused interconnection, batched NumPy, compiled).
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 
 import control
 import numpy as np
@@ -213,3 +216,28 @@ def test_the_substep_rule():
     assert substeps_for(0.1, 0.001) == 100  # 0.1 / 0.001 = 100.00000000000001
     assert substeps_for(0.01, 0.003) == 4
     assert substeps_for(0.001, 0.01) == 1
+
+
+_CACHED_RUN = """
+import numpy as np, qc_control as qc
+from qc_control.models import nlkernel
+from qc_control.studies.nlsweep import simulate_batch
+T = np.linspace(0.0, 0.1, 101)
+design = dict(ms=300.0, mu=40.0, ks=2e4, ku=2e5, cs=1e3)
+simulate_batch(qc.nonlinear_quarter_car_model().batch_dynamics([design]), T, np.zeros(4), 0.01 * T)
+print(sum(nlkernel.advance.stats.cache_hits.values()))
+"""
+
+
+@pytest.mark.slow  # compiles the nonlinear car's steps once (several seconds)
+def test_the_compiled_steps_are_cached_on_disk(tmp_path):
+    """The model's function with the numerics' stage loop inlined is cached by numba:
+    a second process loads its machine code (a cache hit) instead of compiling."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    hits = []
+    for _ in range(2):
+        args = [sys.executable, "-c", _CACHED_RUN]
+        run = subprocess.run(args, capture_output=True, text=True, env=env, timeout=300)
+        assert run.returncode == 0, run.stderr
+        hits.append(int(run.stdout.split()[-1]))
+    assert hits == [0, 1]

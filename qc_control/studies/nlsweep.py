@@ -136,7 +136,7 @@ def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
     if compiled is not None:
         advance = _compiled_advance(compiled, tab, dt / substeps, substeps, u_of.at(ts))
     else:
-        advance = _NumpySteps(dynamics, T, tab, substeps, dt, ts, u_of, events, t_events)
+        advance = _NumpySteps(dynamics, T, x, tab, substeps, dt, ts, u_of, events, t_events)
     buf = np.empty((n, block, m))  # a sample's states are contiguous rows: cheap to store
     buf[:, 0] = x
     filled, done, total = 1, 0, T.size - 1
@@ -176,7 +176,7 @@ class _NumpySteps:
     (`_locate`).
     """
 
-    def __init__(self, dynamics, T, tab, substeps, dt, ts, u_of, events, t_events):
+    def __init__(self, dynamics, T, x0, tab, substeps, dt, ts, u_of, events, t_events):
         self.grid = GridSteps(tab, T.tolist(), substeps, dt)
         self.dynamics, self.tab, self.u_of, self.t_events = dynamics, tab, u_of, t_events
         self.events, self.substeps = events, substeps
@@ -189,7 +189,8 @@ class _NumpySteps:
 
         self.f = f
         self.ends = np.append(ts[1:, 0], T[-1]).tolist()  # each step's end
-        self._g = None
+        # the switching functions at the last step's end
+        self._g = dynamics.switching(float(T[0]), x0, u_of(float(T[0]))) if events else None
 
     def __call__(self, x, buf, first, count, done):
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
@@ -198,9 +199,6 @@ class _NumpySteps:
                 x = self.grid.run(self.f, x, out, done, done + count)
                 buf[:, first : first + count] = np.swapaxes(out[1:], 0, 1)
                 return x
-            if self._g is None:
-                t0 = float(self.grid.t[0])
-                self._g = self.dynamics.switching(t0, x, self.u_of(t0))
             for sample in range(done, done + count):
                 ts, rows = self.grid.steps(sample, sample + 1)
                 for q in range(self.substeps):
@@ -217,7 +215,7 @@ class _NumpySteps:
         sw = self.dynamics.switching
         g_b = sw(tb, x_new, ub)
         s_b = np.sign(g_b)
-        hit = np.flatnonzero(np.any((s_b != np.sign(self._g)) & (s_b != 0), axis=0))
+        hit = np.flatnonzero(np.any((s_b != np.sign(np.asarray(self._g))) & (s_b != 0), axis=0))
         if hit.size:
             _locate(self.dynamics, hit, float(ta), tb, x, x_new, self.tab, self.u_of, self.t_events)
             g_b = sw(tb, x_new, ub)
