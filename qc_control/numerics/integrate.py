@@ -308,8 +308,9 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
 
     Notes
     -----
-    The loop is scipy's plain stage loop (``rk_step`` in
-    ``scipy/integrate/_ivp/rk.py``) over the tableau as data, with the
+    The loop (`qc_control.numerics.stepper.rk_steps`) is scipy's plain
+    stage loop (``rk_step`` in ``scipy/integrate/_ivp/rk.py``) over the
+    tableau as data, with the
     non-zero ``h a_ij``, ``h b_i`` and ``c_i h`` computed once per step
     size and zero entries skipped; stages of equal weight are summed
     before they are scaled.

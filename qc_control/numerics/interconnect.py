@@ -32,8 +32,10 @@ sums in another order).
 
 When every state is a linear subsystem's and the nonlinear subsystems are
 static (a car and a static controller), a whole Runge–Kutta step is linear
-in the state and in the controller's stage values: `FusedSteps` takes each
-step as one matrix product plus the controller's calls, with the input's
+in the state and in the controller's stage values: `FusedSteps` composes the
+tableau with the linear part once, and the stage loop for such plants
+(`qc_control.numerics.stepper.affine_rk_steps`) takes each step as one
+matrix product plus the controller's calls (its fused stage), with the input's
 terms of all steps computed at once, and keeps the controller's value at
 each sample for the outputs. When ``M`` is singular, or the nonlinear subsystems
 feed each other (or themselves) through a direct path, there is an
