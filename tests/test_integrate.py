@@ -11,6 +11,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from qc_control import METHODS, DivergenceWarning, integrate, quarter_car
+from qc_control.numerics import stepper as stepper_module
 from qc_control.numerics.integrate import Solution, integrate_stepper, uniform_step
 from qc_control.numerics.lti import lti_trajectory
 from qc_control.numerics.methods import RK4
@@ -220,7 +221,7 @@ def test_a_traceback_through_the_loop_shows_source():
     with pytest.raises(RuntimeError, match="boom") as info:
         integrate(f, np.linspace(0, 1, 11), [1.0])
     frames = traceback.extract_tb(info.tb)
-    loop = [fr for fr in frames if fr.filename == integrate_module.__file__ and fr.name == "_steps"]
+    loop = [fr for fr in frames if fr.filename == stepper_module.__file__ and fr.name == "rk_steps"]
     assert loop and loop[0].line  # a real file and line, not "<qc_control loop: rk4>"
     assert "f(" in linecache.getline(loop[0].filename, loop[0].lineno)
 

@@ -119,7 +119,8 @@ def test_every_numerics_module_is_kept_from_the_vehicle():
     numerics = {p.stem for p in (PACKAGE / "numerics").glob("*.py")} - {"__init__"}
     assert numerics == {
         "integrate", "interconnect", "limits", "lti", "messages", "methods",
-        "order_conditions", "recurrence", "stability",
+        "order_conditions", "recurrence", "stability", "stepper", "compiled_stepper",
+        "sampled",
     }  # fmt: skip
     vehicle = {p.stem for p in (PACKAGE / "models").glob("*.py")}
     assert {"vehicle", "quarter", "halfcar", "nonlinear", "nlkernel"} <= vehicle

@@ -1,25 +1,19 @@
-"""The nonlinear quarter car's batched steps, compiled (numba).
+"""The nonlinear quarter car's right-hand side over batches of designs, compiled (numba).
 
 `qc_control.studies.nlsweep` steps many designs of `qc_control.nonlinear_quarter_car`
 together. Written with NumPy over the designs, each stage of each step is a
 dozen NumPy calls on arrays of a thousand numbers, and the calls' fixed cost
 (about a microsecond each) is most of the time: 1,000 designs over 10 s at
 1 ms took 1-2.5 s, whatever the machine's arithmetic could do. This
-module writes the same step as loops over the designs and compiles them
-with numba (LLVM), so that a step costs its arithmetic: the loops over the
-designs are simple enough for the compiler to vectorise.
+module writes the right-hand side as a loop over the designs
+(`_accelerations`) and hands it to the compiled stage loop of the numerics
+(`qc_control.numerics.compiled_stepper.stage_loop`), compiled together with
+numba (LLVM), so that a step costs its arithmetic: the loops over the
+designs are simple enough for the compiler to vectorise. `advance` is
+that binding; the stage loop itself is the numerics', as for every
+compiled right-hand side.
 
-One step of an explicit tableau with the stepper's own ``h a_ij``, ``h b_i``
-(`qc_control.numerics.integrate`):
-
-.. math::
-
-    k_i = f\\big(x + \\textstyle\\sum_{j<i} h a_{ij} k_j,\\; u(t + c_i h)\\big),
-    \\qquad x \\leftarrow x + \\textstyle\\sum_i h b_i k_i ,
-
-with the inputs at the stage times given (`qc_control.studies.nlsweep` interpolates
-them as python-control does). The right-hand side is
-`NonlinearQuarterCarBatch`'s (the module docstring of
+The right-hand side is `NonlinearQuarterCarBatch`'s (the module docstring of
 `qc_control.models.nonlinear` has the equations) with the same folded constants:
 ``-F/m_s`` as ``F·(-1/m_s)``, the tire's dynamic force ``F_t - k_u δ0`` as
 ``max(k_u (z_r - x_u), -k_u δ0)`` for a unilateral tire, the stops'
@@ -43,8 +37,7 @@ seconds) is paid once per installation.
 
 from __future__ import annotations
 
-import numpy as np
-
+from ..numerics.compiled_stepper import stage_loop
 from ..numerics.recurrence import compiled
 
 __all__ = ["advance", "PARAMETER_ROWS", "OPTION_SLOTS"]
@@ -113,57 +106,8 @@ def _accelerations(x, u, p, o, out):  # pragma: no cover - compiled (tested thro
 
 @compiled()
 def advance(x, out, first, count, step, substeps, a, b, stage_u, p, o):  # pragma: no cover
-    """Step the designs ``x`` ``(4, m)`` (in place) over ``count`` samples.
-
-    Whole arrays and offsets, not slices, so that numba compiles one
-    specialisation (a slice's layout would depend on where it falls).
-
-    Parameters
-    ----------
-    x : ndarray (4, m)
-        The states at the first sample's start; on return, at the last one's end.
-    out : ndarray (4, B, m)
-        Written: ``out[:, first + l]`` is the state after sample ``l`` (``l < count``).
-    first, count : int
-    step : int
-        The index in ``stage_u`` of the first step.
-    substeps : int
-        Steps of the tableau per sample.
-    a : ndarray (s, s)
-        ``h a_ij`` (strictly lower triangular).
-    b : ndarray (s,)
-        ``h b_i``.
-    stage_u : ndarray (steps, s, k)
-        The inputs at every step's stage times.
-    p : ndarray (7, m)
-        The designs' parameters (`PARAMETER_ROWS`).
-    o : ndarray (11,)
-        The options (`OPTION_SLOTS`).
-    """
-    n, m = x.shape
-    s = b.size
-    K = np.empty((s, n, m))
-    xi = np.empty((n, m))
-    # flat views: the stage sums as loops of unit stride over all n·m numbers
-    x_flat, xi_flat, K_flat = x.reshape(n * m), xi.reshape(n * m), K.reshape(s, n * m)
-    for sample in range(first, first + count):
-        for _ in range(substeps):
-            for i in range(s):
-                for j in range(n * m):
-                    xi_flat[j] = x_flat[j]
-                for q in range(i):
-                    c = a[i, q]
-                    if c != 0.0:
-                        k_q = K_flat[q]
-                        for j in range(n * m):
-                            xi_flat[j] = xi_flat[j] + c * k_q[j]
-                _accelerations(xi, stage_u[step, i], p, o, K[i])
-            for j in range(n * m):
-                acc = 0.0
-                for i in range(s):
-                    acc = acc + b[i] * K_flat[i, j]
-                x_flat[j] = x_flat[j] + acc
-            step += 1
-        for r in range(n):  # (explicit loops: numba compiles a slice assignment slowly)
-            for j in range(m):
-                out[r, sample, j] = x[r, j]
+    """Step the designs ``x`` ``(4, m)`` (in place) over ``count`` samples: the
+    compiled stage loop (`qc_control.numerics.compiled_stepper.stage_loop`, whose
+    docstring has the arguments) on `_accelerations`, with ``p`` the designs'
+    parameters (`PARAMETER_ROWS`) and ``o`` the options (`OPTION_SLOTS`)."""
+    stage_loop(_accelerations, x, out, first, count, step, substeps, a, b, stage_u, p, o)

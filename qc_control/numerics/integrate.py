@@ -1,4 +1,14 @@
-"""The one fixed-step loop that runs every Butcher tableau."""
+"""Fixed-step solutions of ``x' = f(t, x)`` with any explicit Butcher tableau.
+
+`integrate` checks its arguments, steps the grid block by block with the
+stage loop of `qc_control.numerics.stepper` (the one place a tableau's
+stages are evaluated in Python), cuts a run that becomes non-finite and
+returns a `Solution`; with ``events`` it steps to each sign change of the
+switching functions. `integrate_stepper` gives the same checks and result
+to a specialised stepper (`qc_control.numerics.interconnect.FusedSteps`,
+itself built on the stage loop). The time-grid rules live here too
+(`check_time_grid`, `uniform_step`, `stage_times`).
+"""
 
 from __future__ import annotations
 
@@ -11,6 +21,7 @@ from scipy.optimize import brentq
 
 from .messages import show
 from .methods import ButcherTableau, get_method
+from .stepper import GridSteps, stage_plan
 
 __all__ = [
     "Solution",
@@ -197,92 +208,6 @@ def _line(t0: float, dt: float, n: int) -> np.ndarray:
     return line
 
 
-@functools.lru_cache(maxsize=64)
-def _structure(tab: ButcherTableau):
-    """The tableau's non-zero entries as loop data: ``(coefficients, stages, first, others)``.
-
-    ``coefficients`` lists the non-zero ``c_i``, ``a_ij`` and ``b`` values
-    once; the rest refers to them by position ``p``. ``stages`` holds, for
-    each stage ``i >= 1``, ``(p of c_i, ((j, p of a_ij), ...))`` over
-    ``a_ij != 0`` (a zero ``c_i`` points at the appended 0.0). The weights
-    are groups ``(p of b, i0, (i, ...))`` of the stages with equal ``b``,
-    summed before they are scaled (RK4's step is
-    ``x + h/6 (k1 + k4) + h/3 (k2 + k3)``), the first group apart.
-    """
-    a, b, c = tab.a.tolist(), tab.b.tolist(), tab.c.tolist()
-    coefficients: list[float] = [0.0]
-
-    def at(value: float) -> int:
-        coefficients.append(value)
-        return len(coefficients) - 1
-
-    stages = tuple(
-        (at(c[i]) if c[i] else 0, tuple((j, at(a[i][j])) for j in range(i) if a[i][j] != 0))
-        for i in range(1, tab.stages)
-    )
-    groups: dict[float, list[int]] = {}
-    for i, bi in enumerate(b):
-        if bi != 0:
-            groups.setdefault(bi, []).append(i)
-    weights = tuple((at(bi), idx[0], tuple(idx[1:])) for bi, idx in groups.items())
-    return np.array(coefficients), stages, weights[0], weights[1:]
-
-
-def _steps(f, ts, rows, x, buf, structure):
-    """One step from each time ``ts[m]`` with coefficients ``rows[m]``; ``buf[m + 1]`` its end.
-
-    The plain stage loop of scipy's ``rk_step`` (integrate/_ivp/rk.py) over
-    the tableau as data: ``rows[m]`` holds the non-zero coefficients times
-    the step ``h`` (`_structure`), so zero entries cost nothing.
-    """
-    _, stages, (pb, i0, rest), others = structure
-    m = 0
-    for t, v in zip(ts, rows):
-        k = [f(t, x)]
-        for pc, terms in stages:
-            xi = x
-            for j, pa in terms:
-                xi = xi + v[pa] * k[j]
-            k.append(f(t + v[pc], xi))
-        ks = k[i0]
-        for i in rest:
-            ks = ks + k[i]
-        x = x + v[pb] * ks
-        for pb_, i0_, rest_ in others:
-            ks = k[i0_]
-            for i in rest_:
-                ks = ks + k[i]
-            x = x + v[pb_] * ks
-        m += 1
-        buf[m] = x
-    return x
-
-
-def _run(f, tab, tt, x, out, start, stop, substeps, dt):
-    """Step from ``tt[start]`` to ``tt[stop]``, writing ``out[n + 1]``; return x.
-
-    The coefficients times ``h`` are formed once for a uniform grid (``dt``
-    its step), else once per interval in one vectorised product. With
-    substeps, the steps inside the intervals go to a scratch buffer and
-    every ``substeps``-th is kept.
-    """
-    structure = _structure(tab)
-    coefficients, n = structure[0], stop - start
-    if dt is not None:
-        rows = [(coefficients * (dt / substeps)).tolist()] * (n * substeps)
-        hs = [dt / substeps] * n
-    else:
-        hs = [(tt[i + 1] - tt[i]) / substeps for i in range(start, stop)]
-        rows = (np.repeat(hs, substeps)[:, None] * coefficients).tolist()
-    if substeps == 1:
-        return _steps(f, tt[start:stop], rows, x, out[start:], structure)
-    ts = [tt[i] + sub * h for i, h in zip(range(start, stop), hs) for sub in range(substeps)]
-    buf = np.empty((len(ts) + 1,) + x.shape, dtype=out.dtype)
-    x = _steps(f, ts, rows, x, buf, structure)
-    out[start + 1 : stop + 1] = buf[substeps::substeps]
-    return x
-
-
 def stage_times(t, method="rk4", *, substeps: int = 1) -> np.ndarray:
     """Every time at which `integrate` evaluates ``f`` on the grid ``t`` (no events).
 
@@ -294,7 +219,7 @@ def stage_times(t, method="rk4", *, substeps: int = 1) -> np.ndarray:
     tab = get_method(method)
     t = check_time_grid(t, "t")
     substeps = check_substeps(substeps)
-    coefficients, stages, _, _ = _structure(tab)
+    plan = stage_plan(tab)
     dt = uniform_step(t)
     tt = t.tolist()
     if dt is not None:
@@ -302,8 +227,8 @@ def stage_times(t, method="rk4", *, substeps: int = 1) -> np.ndarray:
     else:
         hs = [(tt[i + 1] - tt[i]) / substeps for i in range(t.size - 1)]
     starts = np.array([tt[i] + sub * h for i, h in enumerate(hs) for sub in range(substeps)])
-    v = np.repeat(hs, substeps)[:, None] * coefficients
-    pcs = [pc for pc, _ in stages]
+    v = np.repeat(hs, substeps)[:, None] * plan.coefficients
+    pcs = plan.time_positions
     return np.column_stack([starts, starts[:, None] + v[:, pcs]]) if pcs else starts[:, None]
 
 
@@ -383,8 +308,9 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
 
     Notes
     -----
-    The loop is scipy's plain stage loop (``rk_step`` in
-    ``scipy/integrate/_ivp/rk.py``) over the tableau as data, with the
+    The loop (`qc_control.numerics.stepper.rk_steps`) is scipy's plain
+    stage loop (``rk_step`` in ``scipy/integrate/_ivp/rk.py``) over the
+    tableau as data, with the
     non-zero ``h a_ij``, ``h b_i`` and ``c_i h`` computed once per step
     size and zero entries skipped; stages of equal weight are summed
     before they are scaled.
@@ -409,11 +335,11 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
             raise ValueError(f"events need a single initial state of shape (n,), got {x.shape}")
         return _integrate_events(f, t, x, tab, substeps, events)
 
-    dt = uniform_step(t)  # a uniform grid is stepped with its one step, like the LTI engine
-    tt = t.tolist()
+    # a uniform grid is stepped with its one step, like the LTI engine
+    grid = GridSteps(tab, t.tolist(), substeps, uniform_step(t))
 
     def run(x, out, start, stop):
-        return _run(f, tab, tt, x, out, start, stop, substeps, dt)
+        return grid.run(f, x, out[start:], start, stop)
 
     return _blocks(run, t, x, tab, substeps, stacklevel=3)
 
@@ -518,95 +444,112 @@ _MAX_EVENTS_PER_STEP = 16
 
 def _integrate_events(f, t, x, tab, substeps, events) -> Solution:
     """`integrate` with switching functions: step to each sign change exactly."""
-    structure = _structure(tab)
-    coefficients = structure[0]
-    calls = [0]
-
-    def counted(tt, xx):
-        calls[0] += 1
-        return f(tt, xx)
-
-    buf = np.empty((2,) + x.shape, dtype=x.dtype)
-
-    def step(t0, x0, h):
-        return _steps(counted, [t0], [(coefficients * h).tolist()], x0, buf, structure).copy()
-
-    def switch(tt, xx):
-        return np.atleast_1d(np.asarray(events(tt, xx), dtype=float))
-
     out = np.empty((t.size,) + x.shape, dtype=x.dtype)
     out[0] = x
     dt = uniform_step(t)
     tt = t.tolist()
-    sign = np.sign(switch(tt[0], x))
-    t_ev: list[float] = []
-    i_ev: list[int] = []
-    steps, n_last, status, message = 0, t.size - 1, "success", ""
+    run = _EventSteps(f, tab, x, events)
+    sign = np.sign(run.switch(tt[0], x))
+    n_last, status, message = t.size - 1, "success", ""
     with np.errstate(over="ignore", invalid="ignore"):
         for i in range(t.size - 1):
-            h_int = (tt[i + 1] - tt[i]) if dt is None else dt
-            h = h_int / substeps
+            h = ((tt[i + 1] - tt[i]) if dt is None else dt) / substeps
             for sub in range(substeps):
                 ta = tt[i] + sub * h
-                tb = tt[i + 1] if sub == substeps - 1 else ta + h
-                for located in range(_MAX_EVENTS_PER_STEP + 1):
-                    xb = step(ta, x, tb - ta)
-                    steps += 1
-                    gb = switch(tb, xb)
-                    sb = np.sign(gb)
-                    unset = sign == 0
-                    sign[unset] = sb[unset]
-                    changed = np.flatnonzero((sb != sign) & (sb != 0))
-                    if (
-                        changed.size == 0
-                        or located == _MAX_EVENTS_PER_STEP
-                        or not np.all(np.isfinite(xb))
-                    ):
-                        sign[changed] = sb[changed]
-                        break
-                    ga = switch(ta, x)
-                    roots = []
-                    for k in changed.tolist():
-                        if np.sign(ga[k]) != sign[k]:  # on its new side already (rounding)
-                            sign[k] = sb[k]
-                            continue
-
-                        def phi(s, k=k):
-                            return switch(ta + s, step(ta, x, s))[k]
-
-                        s_root = brentq(phi, 0.0, tb - ta, xtol=1e-12 * (tb - ta))
-                        roots.append((s_root, k))
-                    if not roots:
-                        break
-                    s_root, k = min(roots)
-                    if s_root <= 0.0:  # at the step's start: nothing to step to
-                        sign[k] = sb[k]
-                        continue
-                    x = step(ta, x, s_root)
-                    steps += 1
-                    ta = ta + s_root
-                    t_ev.append(ta)
-                    i_ev.append(k)
-                    sign[k] = sb[k]
-                    if ta >= tb:
-                        xb = x
-                        break
-                x = xb
+                x = run.across(ta, tt[i + 1] if sub == substeps - 1 else ta + h, x, sign)
             out[i + 1] = x
             if not np.all(np.isfinite(x)):
-                n_last = i
-                status = "diverged"
+                n_last, status = i, "diverged"
                 message = _non_finite_message(tab, t, n_last)
                 warnings.warn(message, DivergenceWarning, stacklevel=3)
                 break
     return Solution(
         t=t[: n_last + 1],
         x=np.moveaxis(out[: n_last + 1], 0, -1),
-        nfev=calls[0],
-        steps=steps,
+        nfev=run.calls,
+        steps=run.steps,
         method=tab,
         status=status,
         message=message,
-        t_events=np.array(t_ev),
-        i_events=np.array(i_ev, dtype=int),
+        t_events=np.array(run.t_events),
+        i_events=np.array(run.i_events, dtype=int),
     )
+
+
+class _EventSteps:
+    """The steps of an `integrate` run with events: each step cut at the sign changes.
+
+    Counts the right-hand side's calls (``calls``) and the steps taken
+    (``steps``: a step cut at an event counts as two), and collects the
+    located events (``t_events``, ``i_events``).
+    """
+
+    def __init__(self, f, tab, x, events):
+        self._f, self._events = f, events
+        self._grid = GridSteps(tab, [])
+        self._buf = np.empty((2,) + x.shape, dtype=x.dtype)
+        self.calls = self.steps = 0
+        self.t_events: list[float] = []
+        self.i_events: list[int] = []
+
+    def _counted(self, t, x):
+        self.calls += 1
+        return self._f(t, x)
+
+    def step(self, t0, x0, h):
+        """The method's own step of length ``h`` from ``(t0, x0)``."""
+        return self._grid.step(self._counted, t0, x0, h, self._buf)
+
+    def switch(self, t, x):
+        return np.atleast_1d(np.asarray(self._events(t, x), dtype=float))
+
+    def across(self, ta, tb, x, sign):
+        """The state at ``tb`` from ``(ta, x)``, stepping to each event inside first.
+
+        ``sign`` (the switching functions' signs at ``ta``) is updated to ``tb``.
+        """
+        for located in range(_MAX_EVENTS_PER_STEP + 1):
+            xb = self.step(ta, x, tb - ta)
+            self.steps += 1
+            sb = np.sign(self.switch(tb, xb))
+            unset = sign == 0
+            sign[unset] = sb[unset]
+            changed = np.flatnonzero((sb != sign) & (sb != 0))
+            if changed.size == 0 or located == _MAX_EVENTS_PER_STEP or not np.all(np.isfinite(xb)):
+                sign[changed] = sb[changed]
+                return xb
+            root = self._first_root(ta, tb, x, changed, sign, sb)
+            if root is None:
+                return xb
+            s_root, k = root
+            sign[k] = sb[k]
+            if s_root <= 0.0:  # at the step's start: nothing to step to
+                continue
+            x = self.step(ta, x, s_root)
+            self.steps += 1
+            ta = ta + s_root
+            self.t_events.append(ta)
+            self.i_events.append(k)
+            if ta >= tb:
+                return x
+        return xb
+
+    def _first_root(self, ta, tb, x, changed, sign, sb):
+        """``(s, k)``: the earliest crossing ``ta + s`` among the functions ``changed``, or None.
+
+        Brent's method on ``s ↦ events(ta + s, Φ_s(x))``, to ``1e-12`` of the
+        step; a function already on its new side at ``ta`` (rounding) only
+        has its sign updated.
+        """
+        ga = self.switch(ta, x)
+        roots = []
+        for k in changed.tolist():
+            if np.sign(ga[k]) != sign[k]:  # on its new side already (rounding)
+                sign[k] = sb[k]
+                continue
+
+            def phi(s, k=k):
+                return self.switch(ta + s, self.step(ta, x, s))[k]
+
+            roots.append((brentq(phi, 0.0, tb - ta, xtol=1e-12 * (tb - ta)), k))
+        return min(roots) if roots else None

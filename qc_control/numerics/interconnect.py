@@ -32,8 +32,10 @@ sums in another order).
 
 When every state is a linear subsystem's and the nonlinear subsystems are
 static (a car and a static controller), a whole Runge–Kutta step is linear
-in the state and in the controller's stage values: `FusedSteps` takes each
-step as one matrix product plus the controller's calls, with the input's
+in the state and in the controller's stage values: `FusedSteps` composes the
+tableau with the linear part once, and the stage loop for such plants
+(`qc_control.numerics.stepper.affine_rk_steps`) takes each step as one
+matrix product plus the controller's calls (its fused stage), with the input's
 terms of all steps computed at once, and keeps the controller's value at
 each sample for the outputs. When ``M`` is singular, or the nonlinear subsystems
 feed each other (or themselves) through a direct path, there is an
@@ -47,6 +49,9 @@ from collections.abc import Callable
 
 import control
 import numpy as np
+
+from .sampled import linear_input
+from .stepper import affine_rk_steps, sample_steps
 
 __all__ = ["CompiledInterconnect", "FusedSteps", "compile_interconnect"]
 
@@ -164,9 +169,9 @@ class CompiledInterconnect:
 
         With ``inputs = (T, U)`` (the samples ``u_of_t`` interpolates
         linearly) and ``times`` (every stage time the stepper will ask for,
-        `qc_control.numerics.integrate.stage_times`), the input's terms are computed
-        for all stages at once (``np.interp``), and a stage at one of those
-        times looks them up; any other time (an event's root finding)
+        `qc_control.numerics.integrate.stage_times`), the input's terms are
+        computed for all stages at once (`qc_control.numerics.sampled.linear_input`),
+        and a stage at one of those times looks them up; any other time (an event's root finding)
         computes them from ``u_of_t``.
         """
         rhs_ = self._rhs
@@ -181,7 +186,7 @@ class CompiledInterconnect:
             return direct
         T, U = inputs
         flat = np.asarray(times, dtype=float).reshape(-1)
-        W = np.array([np.interp(flat, T, row) for row in U]).reshape(len(U), flat.size)
+        W = linear_input(T, U).at(flat).T  # (k, K): every stage's input
         uw, fw = self.rhs_terms(W)
         index = dict(zip(flat.tolist(), range(flat.size)))
         fw_rows = list(fw.T)
@@ -330,8 +335,8 @@ class FusedSteps:
         # the input's terms at every stage of every step: gamma_l (n, K) and q_l (m, K)
         T, U = inputs
         K = stages.shape[0]
-        Wst = [np.array([np.interp(stages[:, l], T, row) for row in U]) for l in range(s)]
-        Wst = [w.reshape(len(U), K) for w in Wst]
+        u_of_t = linear_input(T, U)
+        Wst = [u_of_t.at(stages[:, l]).T for l in range(s)]  # (k, K) per stage
         gam = [np.zeros((n, K))]
         for i, coef in enumerate(rows, start=1):
             gi = np.zeros((n, K))
@@ -382,71 +387,46 @@ class FusedSteps:
     def stepper(self):
         """``run(x, out, start, stop)`` for `qc_control.numerics.integrate.integrate_stepper`.
 
-        ``substeps`` steps per interval of the grid, as `qc_control.numerics.integrate.integrate`
-        takes them: into a scratch buffer, every ``substeps``-th kept.
+        The steps are `qc_control.numerics.stepper.affine_rk_steps` with this
+        interconnection's fused stage (`_stage`), the value at each step's
+        first stage kept in ``yn``; ``substeps`` steps per interval of the
+        grid, every ``substeps``-th kept
+        (`qc_control.numerics.stepper.sample_steps`), as `integrate` takes them.
         """
-        steps = self._steps()
-        ns, n = self._substeps, self._n
-        if ns == 1:
-            return lambda x, out, start, stop: steps(x, out, start, stop, 0)
+        stage, yn = self._stage(), self._yn_rows()
+        G, pre, C, times, m, ns = self._G, self._pre, self._C, self._times, self._m, self._substeps
+        if self._single and self._p == 1:
+            C = [c[:, 0].copy() for c in C]  # one output: columns scaled by a number
 
         def run(x, out, start, stop):
             q0, q1 = start * ns, stop * ns
-            buf = np.empty((q1 - q0 + 1, n))
-            x = steps(x, buf, q0, q1, q0)
-            out[start + 1 : stop + 1] = buf[ns::ns]
-            return x
+
+            def advance(x, buf):
+                return affine_rk_steps(stage, G, pre, C, times, x, buf, yn, q0, q0, q1, m)
+
+            return sample_steps(advance, x, out[start:], stop - start, ns)
 
         return run
 
-    def _steps(self):
-        """``steps(x, out, start, stop, base)``: steps ``start`` to ``stop``, step ``k``'s
-        end in ``out[k + 1 - base]``."""
-        G, pre, times, yn = self._G, self._pre, self._times, self._yn_rows()
-        m, p, s = self._m, self._p, self._s
-        sm = s * m
-        # stage i reads z[i m : (i + 1) m]; C_r y_r is added to z once y_r is known
-        zs = [slice(i * m, (i + 1) * m) for i in range(s)]
-        C = self._C
-        if self._single and p == 1:
-            # the common case (one static controller, one output): scalars, no y vector
+    def _stage(self):
+        """``stage(t, z)``: the nonlinear subsystems' outputs at a stage with input ``z``."""
+        if self._single and self._p == 1:
+            # the common case (one static controller, one output): a number, no y vector
             sub = self._sub
             outfcn, params, empty = sub.outfcn, sub._current_params, np.empty(0)
-            cols = [c[:, 0].copy() for c in C]
-            later = list(zip(range(1, s), zs[1:], cols[1:]))
-            z0, c0 = zs[0], cols[0]
 
-            def run_one(x, out, start, stop, base):
-                for k in range(start, stop):
-                    z = G @ x + pre[k]
-                    ts = times[k]
-                    r = outfcn(ts[0], empty, z[z0], params)
-                    v = yn[k] = r[0] if type(r) is list and len(r) == 1 else _scalar(r)
-                    z += c0 * v
-                    for i, zi, ci in later:
-                        r = outfcn(ts[i], empty, z[zi], params)
-                        z += ci * (r[0] if type(r) is list and len(r) == 1 else _scalar(r))
-                    x = out[k + 1 - base] = z[sm:]
-                return x
+            def one(t, z):
+                r = outfcn(t, empty, z, params)
+                return r[0] if type(r) is list and len(r) == 1 else _scalar(r)
 
-            return run_one
-        phi = self._phi
-        y = np.empty(p)
+            return one
+        phi, y = self._phi, np.empty(self._p)
 
-        def run(x, out, start, stop, base):
-            for k in range(start, stop):
-                z = G @ x + pre[k]
-                ts = times[k]
-                phi(ts[0], z[zs[0]], y)
-                yn[k] = y
-                z += C[0] @ y
-                for i in range(1, s):
-                    phi(ts[i], z[zs[i]], y)
-                    z += C[i] @ y
-                x = out[k + 1 - base] = z[sm:]
-            return x
+        def stage(t, z):
+            phi(t, z, y)
+            return y
 
-        return run
+        return stage
 
     def nonlinear_outputs(self, index: np.ndarray, t_out, X: np.ndarray, W: np.ndarray):
         """The nonlinear subsystems' outputs ``(p, K)`` at grid samples ``index``.

@@ -425,36 +425,46 @@ class OutputStream:
         self._forced = U is not None
         self._k = 0
         if self._forced:
-            U = np.asarray(U, dtype=float)
-            k = self._k = U.shape[0]
-            g0 = np.asarray(g0, dtype=float).reshape(m, n, k)
-            g1 = np.asarray(g1, dtype=float).reshape(m, n, k)
-            D = np.broadcast_to(np.asarray(D, dtype=float), self.batch + (p, k)).reshape(m, p, k)
-            self._padded = np.zeros((k, nb * L + 1))
-            self._padded[:, :N] = U
-            PG0 = P[:, :L] @ g0[:, None]  # Φ^i Γ₀, i < L: (m, L, n, k)
-            PG1 = P[:, :L] @ g1[:, None]
-            E = np.zeros((m, L + 1, n, k))  # E_r = Φ^{L-1-r}Γ₀ [r<L] + Φ^{L-r}Γ₁ [r>=1]
-            E[:, :L] += PG0[:, ::-1]
-            E[:, 1:] += PG1[:, ::-1]
-            self._E_mat = np.ascontiguousarray(E.transpose(0, 2, 1, 3)).reshape(m, n, (L + 1) * k)
-            CPG0, CPG1 = C[:, None] @ PG0, C[:, None] @ PG1  # (m, L, p, k)
-            j, r = np.meshgrid(np.arange(L), np.arange(L + 1), indexing="ij")
-            G = np.zeros((m, L, L + 1, p, k))
-            before, after = r < j, (r >= 1) & (r <= j)
-            G[:, j[before], r[before]] += CPG0[:, (j - 1 - r)[before]]
-            G[:, j[after], r[after]] += CPG1[:, (j - r)[after]]
-            G[:, np.arange(L), np.arange(L)] += D[:, None]
-            self._G = G
-            # (m, p L, (L+1) k) @ windows (L+1) k x S: row (output, j), column (r, i)
-            self._G_mat = np.ascontiguousarray(G.transpose(0, 3, 1, 2, 4)).reshape(
-                m, p * L, (L + 1) * k
-            )
+            self._input_maps(P, C, D, g0, g1, U)
         self._Q = np.ascontiguousarray(P[:, L])
         #: while iterating: the state where the next segment starts (its first block's carry)
         self.carry: np.ndarray | None = None
-        # first pass: the carries segment by segment, keeping only where each
-        # segment starts (memory: designs × n × segments, not × blocks)
+        self._first_pass(x0, C)
+
+    def _input_maps(self, P, C, D, g0, g1, U) -> None:
+        """The input's maps over a block: ``E`` (to the next carry) and ``G`` (to the outputs)."""
+        m, n, p, L, nb, N = self.m, self.n, self.p, self.L, self.nb, self.N
+        U = np.asarray(U, dtype=float)
+        k = self._k = U.shape[0]
+        g0 = np.asarray(g0, dtype=float).reshape(m, n, k)
+        g1 = np.asarray(g1, dtype=float).reshape(m, n, k)
+        D = np.broadcast_to(np.asarray(D, dtype=float), self.batch + (p, k)).reshape(m, p, k)
+        self._padded = np.zeros((k, nb * L + 1))
+        self._padded[:, :N] = U
+        PG0 = P[:, :L] @ g0[:, None]  # Φ^i Γ₀, i < L: (m, L, n, k)
+        PG1 = P[:, :L] @ g1[:, None]
+        E = np.zeros((m, L + 1, n, k))  # E_r = Φ^{L-1-r}Γ₀ [r<L] + Φ^{L-r}Γ₁ [r>=1]
+        E[:, :L] += PG0[:, ::-1]
+        E[:, 1:] += PG1[:, ::-1]
+        self._E_mat = np.ascontiguousarray(E.transpose(0, 2, 1, 3)).reshape(m, n, (L + 1) * k)
+        CPG0, CPG1 = C[:, None] @ PG0, C[:, None] @ PG1  # (m, L, p, k)
+        j, r = np.meshgrid(np.arange(L), np.arange(L + 1), indexing="ij")
+        G = np.zeros((m, L, L + 1, p, k))
+        before, after = r < j, (r >= 1) & (r <= j)
+        G[:, j[before], r[before]] += CPG0[:, (j - 1 - r)[before]]
+        G[:, j[after], r[after]] += CPG1[:, (j - r)[after]]
+        G[:, np.arange(L), np.arange(L)] += D[:, None]
+        self._G, self._D = G, D
+        # (m, p L, (L+1) k) @ windows (L+1) k x S: row (output, j), column (r, i)
+        self._G_mat = np.ascontiguousarray(G.transpose(0, 3, 1, 2, 4)).reshape(
+            m, p * L, (L + 1) * k
+        )
+
+    def _first_pass(self, x0, C) -> None:
+        """The carries segment by segment, keeping only where each segment starts
+        (memory: designs × n × segments, not × blocks), their Gram sum and the last sample."""
+        m, n, p, L, nb, N = self.m, self.n, self.p, self.L, self.nb, self.N
+        obs = self._obs
         starts = np.empty((m, n, -(-nb // self.run) + 1))
         c = np.asarray(x0, dtype=float).copy()
         self._gram_K = np.zeros((m, n, n))  # Σ c_b c_bᵀ over the whole blocks b < nb - 1
@@ -481,7 +491,7 @@ class OutputStream:
         if jl == 0:
             last = (C @ carry_last[..., None])[..., 0]
             if self._forced:
-                last = last + D @ U[:, -1]
+                last = last + self._D @ self._padded[:, N - 1]
         else:
             last = (obs[:, :, jl] @ carry_last[..., None])[..., 0]
             if self._forced:

@@ -28,7 +28,6 @@ Which systems go where:
 
 from __future__ import annotations
 
-import bisect
 import inspect
 import math
 import warnings
@@ -62,7 +61,9 @@ from ..numerics.interconnect import compile_interconnect
 from ..numerics.limits import check_memory
 from ..numerics.lti import array_key, lti_states, memo
 from ..numerics.methods import METHODS, ButcherTableau, get_method
+from ..numerics.sampled import linear_input
 from ..numerics.stability import max_stable_step, stability_coefficients, step_is_stable
+from ..numerics.stepper import substeps_for
 
 __all__ = [
     "FixedStepResponse",
@@ -300,24 +301,6 @@ def auto_step(method, eigenvalues) -> tuple[float, str]:
 # ---------------------------------------------------------------- engines
 
 
-def linear_input(T: np.ndarray, U: np.ndarray):
-    """``u(t)``, linear between the samples ``U[:, i]`` at ``T[i]``.
-
-    This is python-control's own assumption for `forced_response`, so a
-    stage at ``t + c_i h`` sees ``u(t + c_i h)``.
-    """
-    times = T.tolist()
-    last = len(times) - 2
-    rows = np.ascontiguousarray(U.T)
-    slopes = np.diff(rows, axis=0) / np.diff(T)[:, None]
-
-    def u(t):
-        i = min(max(bisect.bisect_right(times, t) - 1, 0), last)
-        return rows[i] + (t - times[i]) * slopes[i]
-
-    return u
-
-
 def _generic(A, B, T, u_samples, x0, tab, substeps, warn):
     """The generic stepper on ``f(t, x) = A x + B u(t)``."""
     AT, BT = A.T.copy(), B.T.copy()
@@ -392,7 +375,7 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
         h_rule, step_rule = auto_step(tab, eig)
         if math.isfinite(h_rule):
             # the smallest count whose step meets the rule (never fewer than asked)
-            substeps = max(substeps, math.ceil(H / h_rule * (1 - 1e-12)))
+            substeps = max(substeps, substeps_for(H, h_rule))
     h = H / substeps
     meta = {"method": tab, "h": h, "substeps": substeps, "step_rule": step_rule, "eig": eig}
     if not eig.size:  # a static gain: nothing to integrate
@@ -1439,11 +1422,11 @@ def _io_response(
             h_rule, rule = auto_step(tab, eig)
             step_rule = f"{rule}, on the linearisation at the initial point"
             if math.isfinite(h_rule):
-                substeps = max(substeps, math.ceil(H / h_rule * (1 - 1e-12)))
+                substeps = max(substeps, substeps_for(H, h_rule))
     if max_step is not None:
         if not (isinstance(max_step, (int, float, np.number)) and 0 < max_step < math.inf):
             raise ValueError(f"max_step must be a positive number of seconds, got {max_step!r}")
-        substeps = max(substeps, math.ceil(H / float(max_step) * (1 - 1e-12)))
+        substeps = max(substeps, substeps_for(H, float(max_step)))
     sys._update_params(params)  # linearize may have reset them
 
     if isinstance(t_eval, str) and t_eval == "T":

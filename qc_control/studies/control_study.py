@@ -41,6 +41,7 @@ from ..models.controllers import (
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
 from ..models.vehicle import VehicleModel
 from ..numerics.integrate import check_time_grid
+from ..numerics.stepper import substeps_for
 from ..responses.timeresp import auto_step, forced_response, input_output_response
 from ..ride import road
 from ..ride.comfort import ride_metrics
@@ -189,7 +190,7 @@ def _run(model: VehicleModel, T, U, method: str):
     """
     if isinstance(model.system, control.StateSpace):
         h, _ = auto_step(method, model.system.poles())
-        substeps = max(1, math.ceil(float(T[1] - T[0]) / h * (1 - 1e-12)))
+        substeps = substeps_for(float(T[1] - T[0]), h)
         return forced_response(model.system, T, U, method=method, substeps=substeps)
     return input_output_response(model.system, T, U, method=method)
 

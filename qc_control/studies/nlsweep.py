@@ -4,8 +4,8 @@ A nonlinear model (`qc_control.nonlinear_quarter_car_model`) gives its
 right-hand side over arrays of designs (``VehicleModel.batch_dynamics``, a
 `qc_control.NonlinearQuarterCarBatch`). This module steps it with any
 explicit tableau for ``m`` designs together: the Python loop runs over the
-steps, NumPy over the designs. One step is the generic stepper's
-(`qc_control.numerics.integrate`)
+steps, NumPy over the designs. One step is the stage loop's
+(`qc_control.numerics.stepper.rk_steps`, on the ``(n, m)`` batch)
 
 .. math::
 
@@ -16,12 +16,13 @@ steps, NumPy over the designs. One step is the generic stepper's
 with ``x`` of shape ``(n, m)``, the same stage times
 (`qc_control.numerics.integrate.stage_times`) and the input interpolated linearly
 between its samples as python-control interpolates it
-(`qc_control.responses.timeresp.linear_input`), so that each design's trajectory is
+(`qc_control.numerics.sampled.linear_input`), so that each design's trajectory is
 `qc_control.input_output_response`'s on that design to rounding.
 
 **Compiled steps.** A batch that offers them
 (``dynamics.compiled_stepper()``: for `nonlinear_quarter_car`, the same step
-compiled with numba, `qc_control.models.nlkernel`) is stepped by them, a block of
+compiled with numba: `qc_control.models.nlkernel`'s right-hand side in
+`qc_control.numerics.compiled_stepper.stage_loop`) is stepped by them, a block of
 samples per call, instead of by NumPy calls: a dozen NumPy calls a stage
 cost about a microsecond each whatever the number of designs, which made
 the Python loop most of the time. The NumPy path stays for what has no
@@ -65,11 +66,12 @@ from ..numerics.integrate import (
 )
 from ..numerics.limits import check_memory
 from ..numerics.methods import ButcherTableau, get_method
+from ..numerics.sampled import linear_input
+from ..numerics.stepper import GridSteps, rk_steps
 from ..responses.timeresp import (
     check_initial_state,
     check_input_samples,
     input_output_response,
-    linear_input,
 )
 from ..ride.metrics import METRICS, Metric, MetricStream, RideSignals
 
@@ -112,26 +114,6 @@ def is_nonlinear(model: VehicleModel) -> bool:
     return model.batch_dynamics is not None or not hasattr(model.system, "A")
 
 
-def _tableau_rows(tab: ButcherTableau, h: float):
-    """Each stage's ``h a_ij`` and the weights ``h b``, as the batch step uses them.
-
-    Per stage: None (no ``a_ij``), ``(j, h a_ij)`` for one non-zero entry
-    (RK4's), or the row ``h a_i,:i``, summed with the stored slopes in one
-    product; the weights likewise. The generic stepper (`qc_control.numerics.integrate`)
-    sums the same terms in another order: the steps agree to rounding.
-    """
-    rows: list = []
-    for i in range(tab.stages):
-        nonzero = [j for j in range(i) if tab.a[i, j] != 0]
-        if not nonzero:
-            rows.append(None)
-        elif len(nonzero) == 1:
-            rows.append((nonzero[0], float(tab.a[i, nonzero[0]] * h)))
-        else:
-            rows.append(np.array(tab.a[i, : nonzero[-1] + 1] * h))
-    return rows, np.asarray(tab.b * h)
-
-
 def _inputs(dynamics, T: np.ndarray, U) -> np.ndarray:
     """The input samples ``(k, N)`` (`qc_control.responses.timeresp.check_input_samples`:
     python-control's shapes; None is zero)."""
@@ -145,104 +127,113 @@ def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
     dt = uniform_step(T)
     if dt is None:
         raise ValueError("T must be uniformly spaced for a batched nonlinear run")
-    h = dt / substeps
-    single, weights = _tableau_rows(tab, h)
     ts = stage_times(T, tab, substeps=substeps)  # (steps, s): the stepper's own times
     u_of = linear_input(T, U)
-    k = U.shape[0]
-    none = np.zeros(0)
-    # the inputs at every stage time, linear between the samples (np.interp: the
-    # same formula as control's interpolation): (steps, s, k)
-    at = np.stack([np.interp(ts, T, row) for row in U], axis=-1) if k else np.zeros((*ts.shape, 0))
     x = np.array(np.broadcast_to(np.asarray(X0, dtype=float)[:, None], (n, m)))
-    buf = np.empty((n, block, m))  # a sample's states are contiguous rows: cheap to store
-    buf[:, 0] = x
-    filled = 1
     # a batch that has compiled steps (`NonlinearQuarterCarBatch.compiled_stepper`)
     # takes them, except to locate events (a Python call per event)
     compiled = None if events else getattr(dynamics, "compiled_stepper", lambda: None)()
     if compiled is not None:
-        a_h, b_h = np.ascontiguousarray(tab.a * h), np.ascontiguousarray(tab.b * h)
-        done, total = 0, T.size - 1
-        while done < total:
-            count = min(block - filled, total - done)
-            compiled(x, buf, filled, count, done * substeps, substeps, a_h, b_h, at)
-            filled += count
-            done += count
-            if filled == block or done == total:
-                yield done + 1 - filled, np.swapaxes(buf[:, :filled], 1, 2)
-                filled = 0
-        return
-    # NumPy over the designs: one (k,) view of the inputs per stage
-    stage_u = [list(row) for row in at] if k else [[none] * ts.shape[1]] * ts.shape[0]
-    ends = np.append(ts[1:, 0], T[-1])
-    sw = dynamics.switching
-    g_a = sw(float(T[0]), x, u_of(float(T[0])) if k else none) if events else none
-    step = 0
-    rhs = dynamics.rhs
-    times_list = ts.tolist()
-    K = np.empty((tab.stages, n, m))  # the stages' slopes, written in place
-    flat = K.reshape(tab.stages, n * m)  # a view: Σ_i w_i K_i as one vector-matrix product
-    xi = np.empty((n, m))  # a stage's state, written in place (rhs reads it before the next)
-    xi_flat = xi.reshape(n * m)
-    # per stage: (0, ·) the step's start; (1, j, h a_ij) one non-zero a_ij (RK4's);
-    # (2, row) a row of h a_ij summed with the stored slopes in one product
-    plan = [
-        (0, 0, 0.0) if rows is None else (1, *rows) if isinstance(rows, tuple) else (2, rows, 0.0)
-        for rows in single
-    ]
-    multiply, add, matmul = np.multiply, np.add, np.matmul
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        for sample in range(1, T.size):
-            for _ in range(substeps):
-                times = times_list[step]
-                us = stage_u[step]
-                for i, (kind, j, a) in enumerate(plan):
-                    if kind == 0:
-                        rhs(times[i], x, us[i], K[i])
-                        continue
-                    if kind == 1:
-                        multiply(K[j], a, out=xi)
-                    else:
-                        matmul(j, flat[: j.size], out=xi_flat)
-                    add(xi, x, out=xi)
-                    rhs(times[i], xi, us[i], K[i])
-                x_new = matmul(weights, flat).reshape(n, m)
-                add(x_new, x, out=x_new)
-                if events:
-                    tb = float(ends[step])
-                    ub = u_of(tb) if k else none
-                    g_b = sw(tb, x_new, ub)
-                    s_b = np.sign(g_b)
-                    hit = np.flatnonzero(np.any((s_b != np.sign(g_a)) & (s_b != 0), axis=0))
-                    if hit.size:
-                        x_new = x_new.copy()
-                        _locate(
-                            dynamics, hit, float(times[0]), tb, x, x_new, tab, u_of, k, t_events
-                        )
-                        g_b = sw(tb, x_new, ub)
-                    g_a = g_b
-                x = x_new
-                step += 1
-            buf[:, filled] = x
-            filled += 1
-            if filled == block or sample == T.size - 1:
-                yield sample + 1 - filled, np.swapaxes(buf[:, :filled], 1, 2)
-                filled = 0
+        advance = _compiled_advance(compiled, tab, dt / substeps, substeps, u_of.at(ts))
+    else:
+        advance = _NumpySteps(dynamics, T, x, tab, substeps, dt, ts, u_of, events, t_events)
+    buf = np.empty((n, block, m))  # a sample's states are contiguous rows: cheap to store
+    buf[:, 0] = x
+    filled, done, total = 1, 0, T.size - 1
+    while done < total:
+        count = min(block - filled, total - done)
+        x = advance(x, buf, filled, count, done)
+        filled += count
+        done += count
+        if filled == block or done == total:
+            yield done + 1 - filled, np.swapaxes(buf[:, :filled], 1, 2)
+            filled = 0
 
 
-def _locate(dynamics, hit, ta, tb, x_a, x_b, tab, u_of, k, t_events):
+def _compiled_advance(compiled, tab, h, substeps, stage_u):
+    """``advance(x, buf, first, count, done)`` by the batch's compiled steps.
+
+    ``stage_u`` ``(steps, s, k)``: the inputs at every stage time.
+    """
+    a_h, b_h = np.ascontiguousarray(tab.a * h), np.ascontiguousarray(tab.b * h)
+    stage_u = np.ascontiguousarray(stage_u)
+
+    def advance(x, buf, first, count, done):
+        compiled(x, buf, first, count, done * substeps, substeps, a_h, b_h, stage_u)
+        return x
+
+    return advance
+
+
+class _NumpySteps:
+    """``advance(x, buf, first, count, done)`` by the stage loop on the batch's ``rhs``.
+
+    The samples ``done + 1 .. done + count`` into ``buf[:, first ..]``:
+    `qc_control.numerics.stepper`'s loop over the ``(n, m)`` batch, the
+    inputs at the stage times precomputed (`stage_times`: the loop's own
+    times) and looked up by time. With events, step by step: the designs
+    whose switching functions changed sign in a step take it again alone
+    (`_locate`).
+    """
+
+    def __init__(self, dynamics, T, x0, tab, substeps, dt, ts, u_of, events, t_events):
+        self.grid = GridSteps(tab, T.tolist(), substeps, dt)
+        self.dynamics, self.tab, self.u_of, self.t_events = dynamics, tab, u_of, t_events
+        self.events, self.substeps = events, substeps
+        known = dict(zip(ts.reshape(-1).tolist(), u_of.at(ts.reshape(-1))))
+        rhs = dynamics.rhs
+
+        def f(t, x):
+            u = known.get(t)
+            return rhs(t, x, u_of(t) if u is None else u)
+
+        self.f = f
+        self.ends = np.append(ts[1:, 0], T[-1]).tolist()  # each step's end
+        # the switching functions at the last step's end
+        self._g = dynamics.switching(float(T[0]), x0, u_of(float(T[0]))) if events else None
+
+    def __call__(self, x, buf, first, count, done):
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            if not self.events:
+                out = np.empty((count + 1,) + x.shape)
+                x = self.grid.run(self.f, x, out, done, done + count)
+                buf[:, first : first + count] = np.swapaxes(out[1:], 0, 1)
+                return x
+            for sample in range(done, done + count):
+                ts, rows = self.grid.steps(sample, sample + 1)
+                for q in range(self.substeps):
+                    x = self._event_step(sample * self.substeps + q, ts[q], rows[q], x)
+                buf[:, first + sample - done] = x
+        return x
+
+    def _event_step(self, step, ta, row, x):
+        """One step from ``(ta, x)``; the designs with a sign change inside it located."""
+        out = np.empty((2,) + x.shape)
+        x_new = rk_steps(self.f, [ta], [row], x, out, self.grid.plan)
+        tb = self.ends[step]
+        ub = self.u_of(tb)
+        sw = self.dynamics.switching
+        g_b = sw(tb, x_new, ub)
+        s_b = np.sign(g_b)
+        hit = np.flatnonzero(np.any((s_b != np.sign(np.asarray(self._g))) & (s_b != 0), axis=0))
+        if hit.size:
+            _locate(self.dynamics, hit, float(ta), tb, x, x_new, self.tab, self.u_of, self.t_events)
+            g_b = sw(tb, x_new, ub)
+        self._g = g_b
+        return x_new
+
+
+def _locate(dynamics, hit, ta, tb, x_a, x_b, tab, u_of, t_events):
     """Take the step ``ta -> tb`` again for the designs ``hit`` alone, with
     `qc_control.numerics.integrate`'s event location; write their ends into ``x_b``."""
-    none = np.zeros(0)
     for j in hit.tolist():
         one = dynamics.take(np.array([j]))
 
         def f(t, x, one=one):
-            return one.rhs(t, x[:, None], u_of(t) if k else none)[:, 0]
+            return one.rhs(t, x[:, None], u_of(t))[:, 0]
 
         def g(t, x, one=one):
-            return one.switching(t, x[:, None], u_of(t) if k else none)[:, 0]
+            return one.switching(t, x[:, None], u_of(t))[:, 0]
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DivergenceWarning)

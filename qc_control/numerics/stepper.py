@@ -1,0 +1,263 @@
+"""The stage loop: every explicit Runge–Kutta step taken in Python is taken here.
+
+One step of a tableau ``(A, b, c)`` from ``(t, x)`` with step ``h`` is
+
+.. math::
+
+    k_i = f\\big(t + c_i h,\\; x + h \\textstyle\\sum_{j<i} a_{ij} k_j\\big), \\qquad
+    x \\leftarrow x + h \\textstyle\\sum_i b_i k_i ,
+
+scipy's ``rk_step`` (``scipy/integrate/_ivp/rk.py``) over the tableau as
+data. The tableau's structure is computed once per tableau (`stage_plan`:
+its non-zero entries, so zero entries cost nothing) and scaled by ``h``
+once per step size (`GridSteps`). The state may be one state ``(n,)`` or a
+batch ``(n, m)`` of ``m`` designs: the loop only adds and scales whole
+arrays, so a batched right-hand side steps every design at once with the
+same operations, in the same order, as a single one.
+
+Two kinds of right-hand side use the loop:
+
+* a callable ``f(t, x)``, evaluated stage by stage (`rk_steps`): plain
+  responses, `qc_control.numerics.integrate.integrate` (and its events),
+  the batched nonlinear sweeps' NumPy path;
+* a plant that is linear in its state, closed by static nonlinear
+  functions (`affine_rk_steps`): the tableau's stage sums are composed with
+  the linear part once (`qc_control.numerics.interconnect.FusedSteps`), and
+  each stage is then one call of the nonlinear functions, the fused stage
+  callback.
+
+Compiled right-hand sides take the same loop compiled
+(`qc_control.numerics.compiled_stepper`). `GridSteps.run` takes whole
+intervals of an output grid (``substeps`` steps each, every
+``substeps``-th state kept) for both Python kinds.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .methods import ButcherTableau
+
+__all__ = [
+    "StagePlan",
+    "stage_plan",
+    "rk_steps",
+    "affine_rk_steps",
+    "GridSteps",
+    "sample_steps",
+    "substeps_for",
+]
+
+#: Relative slack of `substeps_for`: an interval that holds the step an integer
+#: number of times up to rounding is split into exactly that many steps.
+_SUBSTEP_SLACK = 1e-12
+
+
+def substeps_for(H: float, h: float) -> int:
+    """The fewest equal steps, at least 1, that split an interval ``H`` into steps ``<= h``.
+
+    ``ceil(H/h (1 - 1e-12))``: an ``H`` that is ``h`` times an integer up
+    to rounding (``0.1 / 0.001``) gives that integer, not one more.
+
+    Examples
+    --------
+    >>> substeps_for(0.01, 0.001), substeps_for(0.01, 0.003)
+    (10, 4)
+    """
+    return max(1, math.ceil(H / h * (1 - _SUBSTEP_SLACK)))
+
+
+@dataclass(frozen=True, eq=False)
+class StagePlan:
+    """A tableau's non-zero entries as loop data (`stage_plan`).
+
+    Attributes
+    ----------
+    coefficients : ndarray
+        The non-zero ``c_i``, ``a_ij`` and ``b_i`` values, each once, after
+        a leading 0.0; the rest refers to them by position ``p``. Times
+        ``h``, they are one step's row (`GridSteps`).
+    stages : tuple
+        For each stage ``i >= 1``: ``(p of c_i, ((j, p of a_ij), ...))`` over
+        the non-zero ``a_ij`` (a zero ``c_i`` points at the leading 0.0).
+    first, others : tuple
+        The weights as groups ``(p of b, i0, (i, ...))`` of the stages with
+        equal ``b``, summed before they are scaled (RK4's step is
+        ``x + h/6 (k1 + k4) + h/3 (k2 + k3)``); the first group apart.
+    """
+
+    coefficients: np.ndarray
+    stages: tuple
+    first: tuple
+    others: tuple
+
+    @property
+    def time_positions(self) -> list[int]:
+        """The positions of ``c_i`` (``i >= 1``) in a row: where each stage's time offset is."""
+        return [pc for pc, _ in self.stages]
+
+
+@functools.lru_cache(maxsize=64)
+def stage_plan(tab: ButcherTableau) -> StagePlan:
+    """The `StagePlan` of ``tab`` (computed once per tableau)."""
+    a, b, c = tab.a.tolist(), tab.b.tolist(), tab.c.tolist()
+    coefficients: list[float] = [0.0]
+
+    def at(value: float) -> int:
+        coefficients.append(value)
+        return len(coefficients) - 1
+
+    stages = tuple(
+        (at(c[i]) if c[i] else 0, tuple((j, at(a[i][j])) for j in range(i) if a[i][j] != 0))
+        for i in range(1, tab.stages)
+    )
+    groups: dict[float, list[int]] = {}
+    for i, bi in enumerate(b):
+        if bi != 0:
+            groups.setdefault(bi, []).append(i)
+    weights = tuple((at(bi), idx[0], tuple(idx[1:])) for bi, idx in groups.items())
+    return StagePlan(np.array(coefficients), stages, weights[0], weights[1:])
+
+
+def rk_steps(f, ts, rows, x, out, plan: StagePlan):
+    """One step from each time ``ts[k]`` with the row ``rows[k]``; ``out[k + 1]`` its end.
+
+    The stage loop for a callable right-hand side ``f(t, x)``. ``rows[k]``
+    is the plan's coefficients times the step's ``h`` (`GridSteps`); ``x``
+    is ``(n,)`` or a batch ``(n, m)`` (``f`` then returns ``(n, m)``).
+    Returns the last state.
+    """
+    stages, (pb, i0, rest), others = plan.stages, plan.first, plan.others
+    m = 0
+    for t, v in zip(ts, rows):
+        k = [f(t, x)]
+        for pc, terms in stages:
+            xi = x
+            for j, pa in terms:
+                xi = xi + v[pa] * k[j]
+            k.append(f(t + v[pc], xi))
+        ks = k[i0]
+        for i in rest:
+            ks = ks + k[i]
+        x = x + v[pb] * ks
+        for pb_, i0_, rest_ in others:
+            ks = k[i0_]
+            for i in rest_:
+                ks = ks + k[i]
+            x = x + v[pb_] * ks
+        m += 1
+        out[m] = x
+    return x
+
+
+def affine_rk_steps(stage, G, pre, C, times, x, out, first, base, start, stop, width):
+    r"""Steps ``start .. stop - 1`` of a plant linear in its state; step ``k``'s end in
+    ``out[k + 1 - base]``.
+
+    For ``x' = F x + g(t) + N φ(t, P x + q(t))`` every stage's input is
+    affine in the step's start and the earlier stages' values: with the
+    tableau composed with ``F`` once (`qc_control.numerics.interconnect.FusedSteps`),
+    ``z = G x + pre[k]`` holds every stage's input ``z_i`` (``width`` rows
+    each) and, last, the step's end before the stages' values are added.
+    Stage ``i`` is then the fused stage callback ``y_i = stage(t_i, z_i)``,
+    added to the later stages and the end through ``C[i]`` (``z += C_i y_i``).
+    The first stage is at the step's start: its value goes to ``first[k]``
+    (the nonlinear functions' value at each sample, kept for the outputs).
+
+    ``C[i]`` may be a column (one scalar output) or a matrix; ``stage``
+    returns a number or a vector to match.
+    """
+    columns = C[0].ndim == 1
+    z0, C0 = slice(0, width), C[0]
+    later = [(i, slice(i * width, (i + 1) * width), Ci) for i, Ci in enumerate(C)][1:]
+    end = len(C) * width
+    for k in range(start, stop):
+        z = G @ x + pre[k]
+        ts = times[k]
+        y = first[k] = stage(ts[0], z[z0])
+        if columns:
+            z += C0 * y
+            for i, zi, Ci in later:
+                z += Ci * stage(ts[i], z[zi])
+        else:
+            z += C0 @ y
+            for i, zi, Ci in later:
+                z += Ci @ stage(ts[i], z[zi])
+        x = out[k + 1 - base] = z[end:]
+    return x
+
+
+class GridSteps:
+    """A tableau's steps over the intervals of an output grid.
+
+    Each interval ``[t[i], t[i+1]]`` is split into ``substeps`` equal steps
+    ``h``; on a uniform grid (``dt`` its step, `qc_control.numerics.integrate.uniform_step`)
+    every interval is taken as ``dt``. The rows of coefficients times ``h``
+    are formed once for a uniform grid, else once per block of intervals in
+    one vectorised product.
+
+    Parameters
+    ----------
+    tab : ButcherTableau
+    t : list of float
+        The grid.
+    substeps : int
+    dt : float or None
+    """
+
+    def __init__(self, tab: ButcherTableau, t, substeps: int = 1, dt: float | None = None):
+        self.plan = stage_plan(tab)
+        self.t, self.substeps, self.dt = t, substeps, dt
+        if dt is not None:
+            self._row = (self.plan.coefficients * (dt / substeps)).tolist()
+
+    def steps(self, start: int, stop: int):
+        """``(ts, rows)``: every step's start time and row for intervals ``start .. stop - 1``."""
+        tt, ns = self.t, self.substeps
+        if self.dt is not None:
+            hs = [self.dt / ns] * (stop - start)
+            rows = [self._row] * ((stop - start) * ns)
+        else:
+            hs = [(tt[i + 1] - tt[i]) / ns for i in range(start, stop)]
+            rows = (np.repeat(hs, ns)[:, None] * self.plan.coefficients).tolist()
+        if ns == 1:
+            return tt[start:stop], rows
+        return [tt[i] + sub * h for i, h in zip(range(start, stop), hs) for sub in range(ns)], rows
+
+    def run(self, f, x, out, start: int, stop: int):
+        """Step ``f`` from ``t[start]`` to ``t[stop]``; ``out[l + 1]`` at ``t[start + l + 1]``.
+
+        Returns the last state (`sample_steps`).
+        """
+        ts, rows = self.steps(start, stop)
+        return sample_steps(
+            lambda x, buf: rk_steps(f, ts, rows, x, buf, self.plan),
+            x,
+            out,
+            stop - start,
+            self.substeps,
+        )
+
+    def step(self, f, t: float, x, h: float, buf):
+        """One step of length ``h`` from ``(t, x)`` (event location); ``buf`` ``(2, *x.shape)``."""
+        return rk_steps(f, [t], [(self.plan.coefficients * h).tolist()], x, buf, self.plan).copy()
+
+
+def sample_steps(advance, x, out, intervals: int, substeps: int):
+    """Keep the state at the end of each interval: ``out[l + 1]`` for ``l < intervals``.
+
+    ``advance(x, buf)`` takes ``intervals · substeps`` steps, writing step
+    ``q``'s end into ``buf[q + 1]``, and returns the last state. With one
+    step per interval ``buf`` is ``out``; otherwise a scratch buffer of
+    which every ``substeps``-th state is kept.
+    """
+    if substeps == 1:
+        return advance(x, out)
+    buf = np.empty((intervals * substeps + 1,) + x.shape, dtype=out.dtype)
+    x = advance(x, buf)
+    out[1 : intervals + 1] = buf[substeps::substeps]
+    return x
