@@ -25,6 +25,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 from matplotlib.ticker import NullFormatter
 
+from ..models.registry import model_for_params, model_for_system
 from ..numerics.stability import stability_function
 from .findings import coincidence_groups
 from .plotting import output_signal, output_unit
@@ -101,14 +102,19 @@ def _legend(fig, note: str = "", **kw):
     return fig.legend(**kw)
 
 
-def _body_wheel(cmp) -> tuple[str, str, str | None]:
-    """(body displacement, first wheel's displacement, first road input) labels:
+def _body_wheel(cmp) -> tuple[str, str | None, str | None]:
+    """(body displacement, wheel displacement, first road input) labels:
     ``xs``, ``xu``, ``zr`` on a quarter car, ``z``, ``xu_front``, ``zr_front``
-    on a half car."""
+    on a half car. The wheel is the model's registry entry's ``wheel_disp``
+    (None when the model has no entry or no such output: the body alone)."""
     model = getattr(cmp, "model", None)
     outputs = list(cmp.system.output_labels)
     body = model.body_disp if model is not None else "xs"
-    wheel = "xu" if "xu" in outputs else next(o for o in outputs if o.startswith("xu_"))
+    entry = None if model is None else model_for_params(model.params)
+    if entry is None:
+        entry = model_for_system(cmp.system)
+    wheel = None if entry is None else entry.wheel_disp
+    wheel = wheel if wheel in outputs else None
     roads = model.road_inputs() if model is not None else ["zr"]
     road = next((r for r in roads if r in cmp.system.input_labels), None)
     return body, wheel, road
@@ -124,9 +130,10 @@ def reference_figure(cmp) -> Figure:
         zr = np.asarray(cmp.U)[list(cmp.system.input_labels).index(road)]
         ax.plot(cmp.T, zr * _MM, color="tab:brown", lw=0.9, label=f"road {road}")
     ax.plot(ref.time, output_signal(ref, body) * _MM, "r-", lw=1.3, label=f"body {body} (exact)")
-    ax.plot(
-        ref.time, output_signal(ref, wheel) * _MM, "b--", lw=1.1, label=f"wheel {wheel} (exact)"
-    )
+    if wheel is not None:
+        ax.plot(
+            ref.time, output_signal(ref, wheel) * _MM, "b--", lw=1.1, label=f"wheel {wheel} (exact)"
+        )
     ax.set(
         xlabel="time [s]",
         ylabel="displacement [mm]",
@@ -148,11 +155,12 @@ def method_figure(cmp, method: str) -> Figure:
     body, wheel, _ = _body_wheel(cmp)
     fig = Figure(figsize=(8, 3.4), layout="constrained")
     ax = fig.subplots()
-    for name, style in ((body, "xs"), (wheel, "xu")):
+    drawn = ((body, "xs", "r-", "suspension (sprung mass)"), (wheel, "xu", "b--", "wheel"))
+    drawn = tuple(d for d in drawn if d[0] is not None)
+    for name, style, _, _ in drawn:
         ax.plot(ref.time, output_signal(ref, name) * _MM, label=f"exact {name}", **_EXACT[style])
-    xs, xu = output_signal(resp, body), output_signal(resp, wheel)
-    ax.plot(resp.time, xs * _MM, "r-", lw=1.2, label=f"suspension (sprung mass) {body}")
-    ax.plot(resp.time, xu * _MM, "b--", lw=1.2, label=f"wheel {wheel}")
+    for name, _, line, what in drawn:
+        ax.plot(resp.time, output_signal(resp, name) * _MM, line, lw=1.2, label=f"{what} {name}")
     title = f"{method}, h = {cmp.h:g} s"
     same = [g for g in coincidence_groups(cmp) if method in g]
     if same:
@@ -430,7 +438,7 @@ def transmissibility_figure(cmp) -> Figure:
     fig = Figure(figsize=(10, 6.5), layout="constrained")
     axes = fig.subplots(2, 2, sharex=True).ravel()
     for ax, (name, h) in zip(axes, tr.response.items()):
-        unit = output_unit(name)
+        unit = output_unit(name, getattr(getattr(cmp, "model", None), "units", None))
         gain = f"({unit})/m" if "/" in unit else f"{unit}/m"
         ax.loglog(tr.freqs_hz, np.abs(h), color="tab:blue", lw=1.6)
         ax.set(title=f"{name} / zr", ylabel=f"|H| [{gain}]")
