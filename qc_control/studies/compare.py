@@ -760,7 +760,7 @@ def compare_methods(
             "events and levels apply to nonlinear systems only: a linear comparison has "
             "no switching and always refines h five times"
         )
-    modes = modal_analysis(sys)
+    modes = modal_analysis(model)  # its corners name the modes of any registered model
     eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
     metres = [label for label in sys.output_labels if model.unit(label) == "m"]
     reference = exact_reference(sys, T, X0, U, outputs=metres, repeats=repeats if timing else 0)
