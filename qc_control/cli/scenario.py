@@ -51,7 +51,7 @@ import math
 import shlex
 import sys
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, ClassVar, cast
 
@@ -62,6 +62,7 @@ from ..models.registry import MODELS, ModelEntry, get_model, model_for_params, p
 from ..models.vehicle import VehicleModel
 from ..numerics.methods import METHODS, get_method
 from ..ride import road as roads
+from ..ride.spectral import ISO8608Road, road_parameter
 from ..studies.compare import DEFAULT_METHODS, MethodComparison, compare_methods
 
 if sys.version_info >= (3, 11):
@@ -156,45 +157,10 @@ def _length(metres: float) -> str:
 _ROAD_SECTION = "scenario.road"
 
 
-def _road_field(default, check: str, unit: str, help: str, option: str | None = None):
-    """A road parameter: its default, its check, its unit and its CLI option."""
-    return field(
-        default=default, metadata={"check": check, "unit": unit, "help": help, "option": option}
-    )
-
-
 def _road_value(f, value):
     """A road parameter's value, checked by its kind of check, or a ScenarioError."""
     check, unit, key = f.metadata["check"], f.metadata["unit"], f.name
-    if check in ("finite", "positive"):
-        return _number(_ROAD_SECTION, key, value, unit, positive=check == "positive")
-    if check == "class":
-        name = value.strip().upper() if isinstance(value, str) else None
-        if name not in roads.ISO8608_CLASSES:
-            raise ScenarioError(
-                f"unknown ISO 8608 road class {value!r}; expected one of "
-                f"{', '.join(roads.ISO8608_CLASSES)}",
-                _ROAD_SECTION,
-                key,
-            )
-        return name
-    if check == "seed":
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-            raise ScenarioError(
-                f"{key} must be a non-negative integer, got {value!r}", _ROAD_SECTION, key
-            )
-        return int(value)
-    if check == "band":
-        ok = isinstance(value, (list, tuple, np.ndarray)) and len(value) == 2
-        ok = ok and all(_is_number(v) and math.isfinite(v) for v in value)
-        if not ok or not 0 < value[0] < value[1]:
-            raise ScenarioError(
-                f"{key} must be [n_min, n_max] in {unit} with 0 < n_min < n_max, got {value!r}",
-                _ROAD_SECTION,
-                key,
-            )
-        return (float(value[0]), float(value[1]))
-    raise AssertionError(f"unknown check {check!r}")  # pragma: no cover - a bug here
+    return _number(_ROAD_SECTION, key, value, unit, positive=check == "positive")
 
 
 #: Help of the parameters that step and bump share.
@@ -250,8 +216,8 @@ class StepRoad(Road):
 
     kind: ClassVar[str] = "step"
     noun: ClassVar[str] = "a step road"
-    height: float = _road_field(_default(roads.step, "height"), "finite", "m", _HEIGHT)
-    t0: float = _road_field(_default(roads.step, "t0"), "finite", "s", _T0)
+    height: float = road_parameter(_default(roads.step, "height"), "finite", "m", _HEIGHT)
+    t0: float = road_parameter(_default(roads.step, "t0"), "finite", "s", _T0)
 
     def samples(self, T) -> np.ndarray:
         return roads.step(T, height=self.height, t0=self.t0)
@@ -275,10 +241,10 @@ class BumpRoad(Road):
 
     kind: ClassVar[str] = "bump"
     noun: ClassVar[str] = "a bump road"
-    height: float = _road_field(_default(roads.bump, "height"), "finite", "m", _HEIGHT)
-    length: float = _road_field(_default(roads.bump, "length"), "positive", "m", "bump length")
-    speed: float = _road_field(_SPEED, "positive", "m/s", "vehicle speed", "--speed")
-    t0: float = _road_field(_default(roads.bump, "t0"), "finite", "s", _T0)
+    height: float = road_parameter(_default(roads.bump, "height"), "finite", "m", _HEIGHT)
+    length: float = road_parameter(_default(roads.bump, "length"), "positive", "m", "bump length")
+    speed: float = road_parameter(_SPEED, "positive", "m/s", "vehicle speed", "--speed")
+    t0: float = road_parameter(_default(roads.bump, "t0"), "finite", "s", _T0)
 
     def samples(self, T) -> np.ndarray:
         return roads.bump(T, height=self.height, length=self.length, speed=self.speed, t0=self.t0)
@@ -296,10 +262,10 @@ class SineRoad(Road):
 
     kind: ClassVar[str] = "sine"
     noun: ClassVar[str] = "a sine road"
-    amplitude: float = _road_field(
+    amplitude: float = road_parameter(
         _default(roads.sine, "amplitude"), "finite", "m", "sine amplitude"
     )
-    frequency: float = _road_field(
+    frequency: float = road_parameter(
         _default(roads.sine, "frequency"), "positive", "Hz", "sine frequency"
     )
 
@@ -310,42 +276,10 @@ class SineRoad(Road):
         return f"a sinusoidal road, {_length(self.amplitude)} amplitude at {self.frequency:g} Hz"
 
 
-@dataclass(frozen=True)
-class ISO8608Road(Road):
-    """A random ISO 8608 road driven at ``speed``, `qc_control.ride.road.iso8608`."""
-
-    kind: ClassVar[str] = "iso8608"
-    noun: ClassVar[str] = "an iso8608 road"
-    road_class: str = _road_field(
-        _default(roads.iso8608, "road_class"), "class", "", "ISO 8608 class A-H", "--road-class"
-    )
-    speed: float = _road_field(_SPEED, "positive", "m/s", "vehicle speed", "--speed")
-    seed: int = _road_field(_default(roads.iso8608, "seed"), "seed", "", "road seed", "--seed")
-    band: tuple[float, float] = _road_field(
-        _default(roads.iso8608, "band"), "band", "cycles/m", "ISO 8608 band n_min,n_max"
-    )
-
-    def samples(self, T) -> np.ndarray:
-        return roads.iso8608(T, self.road_class, speed=self.speed, seed=self.seed, band=self.band)
-
-    def describe(self) -> str:
-        lo, hi = self.band
-        return (
-            f"an ISO 8608 class {self.road_class} road at {self.speed:g} m/s "
-            f"(seed {self.seed}, band {lo:g}–{hi:g} cycles/m)"
-        )
-
-    def largest_step(self) -> float:
-        return roads.largest_step(self.speed, self.band)
-
-    def sampled(self) -> str:
-        return (
-            f"an ISO 8608 road at {self.speed:g} m/s, whose band reaches {self.band[1]:g} cycles/m"
-        )
-
-
-#: Every kind of road, by its ``kind``.
-ROADS: dict[str, type[Road]] = {
+#: Every kind of road, by its ``kind``. The ISO 8608 road is the ride layer's
+#: (`qc_control.ride.spectral.ISO8608Road`): one class for the Scenario's
+#: sampled road and for the spectral sweep's white road velocity.
+ROADS: dict[str, type[Road] | type[ISO8608Road]] = {
     cls.kind: cls for cls in (NoRoad, StepRoad, BumpRoad, SineRoad, ISO8608Road)
 }
 
@@ -391,7 +325,13 @@ def road_from_mapping(values: Mapping[str, Any]) -> Road:
                 key,
             )
         raise ScenarioError(f"unknown [scenario.road] key {key!r}; {takes}", None, key)
-    return cls(**values)
+    try:
+        return cls(**values)
+    except ScenarioError:
+        raise
+    except ValueError as exc:  # the ride layer's road: its message starts with the name
+        key = next((k for k in allowed if str(exc).startswith(k + " ")), None)
+        raise ScenarioError(str(exc), _ROAD_SECTION, key) from None
 
 
 # ------------------------------------------------------------- scenario
@@ -513,7 +453,7 @@ def _road(road: Any, default: Mapping[str, Any] | None) -> Road:
         if default and road.get("kind", default["kind"]) == default["kind"]:
             road = {**default, **road}
         road = road_from_mapping(road)
-    if not isinstance(road, Road):
+    if not isinstance(road, (Road, ISO8608Road)):
         raise ScenarioError(
             f"road must be a Road (e.g. BumpRoad(height=0.1)) or a table with 'kind', got {road!r}",
             "scenario",
