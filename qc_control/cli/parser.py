@@ -379,7 +379,10 @@ def _in_options(exc, doc: dict) -> str:
 
 def _cmd_modes(args) -> int:
 
-    print(modal_analysis(scenario_from_args(args).vehicle))
+    scenario = scenario_from_args(args)
+    model = scenario.vehicle_model()
+    # a nonlinear car has no matrix: its modes are those of the linear car of its parameters
+    print(modal_analysis(model if hasattr(model.system, "A") else scenario.vehicle))
     return 0
 
 

@@ -13,8 +13,9 @@ The TOML layout (every key optional)::
     zeta = 0.25           # ms, mu, ks, ku and zeta or cs (QuarterCarParams)
 
     [scenario]
-    model = "quarter"     # or "half", "full" (qc_control.cli.scenario.MODELS); the
-                          # top-level keys are then HalfCarParams' or FullCarParams'
+    model = "quarter"     # or "half", "full", "nonlinear", or any registered model
+                          # (qc_control.register_model); the top-level keys are
+                          # then that model's parameters
     t_end = 10.0          # end time [s]
     h = 0.01              # step [s]
     x0 = [0.0, 0.0, 0.05, 0.0]          # [vs, vu, xs, xu] in m/s, m/s, m, m
@@ -82,6 +83,7 @@ __all__ = [
     "SineRoad",
     "ISO8608Road",
     "ROADS",
+    "RoadSpec",
     "MAX_STEPS",
     "road_from_mapping",
     "MODELS",
@@ -284,12 +286,16 @@ ROADS: dict[str, type[Road] | type[ISO8608Road]] = {
 }
 
 
+#: A road spec: one of `ROADS`' classes.
+RoadSpec = Road | ISO8608Road
+
+
 def road_option(f) -> str:
     """The ``qc-control report`` option of a road parameter (a field of a `Road`)."""
     return f.metadata["option"] or "--road-" + f.name.replace("_", "-")
 
 
-def road_from_mapping(values: Mapping[str, Any]) -> Road:
+def road_from_mapping(values: Mapping[str, Any]) -> RoadSpec:
     """A `Road` from ``{'kind': ..., parameter: value, ...}``.
 
     A missing ``kind`` means no road. A key that is a parameter of another
@@ -330,8 +336,8 @@ def road_from_mapping(values: Mapping[str, Any]) -> Road:
     except ScenarioError:
         raise
     except ValueError as exc:  # the ride layer's road: its message starts with the name
-        key = next((k for k in allowed if str(exc).startswith(k + " ")), None)
-        raise ScenarioError(str(exc), _ROAD_SECTION, key) from None
+        culprit = next((k for k in allowed if str(exc).startswith(k + " ")), None)
+        raise ScenarioError(str(exc), _ROAD_SECTION, culprit) from None
 
 
 # ------------------------------------------------------------- scenario
@@ -341,10 +347,12 @@ def road_from_mapping(values: Mapping[str, Any]) -> Road:
 MAX_STATE = 1e150
 
 
+#: The model of a scenario that names none (not written in its TOML or command).
+DEFAULT_MODEL = "quarter"
 #: Kept for the name of earlier versions: a model the Scenario runs is a registry entry.
 ModelKind = ModelEntry
 #: The nonlinear car's default road and run, as its registry entry states them.
-NONLINEAR_ROAD: Road = road_from_mapping(get_model("nonlinear").defaults.road or {})
+NONLINEAR_ROAD: RoadSpec = road_from_mapping(get_model("nonlinear").defaults.road or {})
 NONLINEAR_T_END = get_model("nonlinear").defaults.t_end
 NONLINEAR_H = get_model("nonlinear").defaults.h
 
@@ -365,7 +373,7 @@ def _model_name(model, vehicle) -> str:
     """The model's name: given, or read from the vehicle's type, else ``'quarter'``."""
     if model is None:
         entry = model_for_params(vehicle)
-        return "quarter" if entry is None else entry.name
+        return DEFAULT_MODEL if entry is None else entry.name
     try:
         return get_model(model).name
     except ValueError as exc:
@@ -436,7 +444,7 @@ def _sequence(value) -> list | None:
     return None
 
 
-def _road(road: Any, default: Mapping[str, Any] | None) -> Road:
+def _road(road: Any, default: Mapping[str, Any] | None) -> RoadSpec:
     """The scenario's road from what was given, over the model's default road.
 
     None (or an empty table) is the model's default road; a table of the
@@ -535,7 +543,7 @@ class Scenario:
     """
 
     vehicle: Any = None
-    road: Road = None  # type: ignore[assignment]  # resolved: NoRoad, or the nonlinear default
+    road: RoadSpec = None  # type: ignore[assignment]  # resolved: NoRoad, or the nonlinear default
     # None resolves to the default in __post_init__: the attribute is always set
     x0: tuple[float, ...] = None  # type: ignore[assignment]
     t_end: float = None  # type: ignore[assignment]
@@ -740,7 +748,7 @@ class Scenario:
         if isinstance(self.road, ISO8608Road):
             r = self.road
             left, right = roads.iso8608_tracks(
-                T, r.road_class, speed, v.track_front, r.seed, r.band
+                T, str(r.road_class), speed, v.track_front, r.seed, r.band
             )
             description += f", left and right tracks {v.track_front:g} m apart (isotropic road)"
         else:
@@ -963,10 +971,6 @@ class Scenario:
                 (road_option(f), _cli_text(getattr(self.road, f.name))) for f in fields(self.road)
             ]
         return options
-
-
-#: The model of a scenario that names none (not written in its TOML or command).
-DEFAULT_MODEL = "quarter"
 
 
 def _cli_name(key: str) -> str:

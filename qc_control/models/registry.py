@@ -164,7 +164,7 @@ class ModelEntry:
     """
 
     name: str
-    params: type
+    params: Any  # a parameter dataclass (its class)
     build: Callable[..., VehicleModel]
     description: str
     options: tuple[ModelOption, ...] = ()

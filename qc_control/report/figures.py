@@ -59,8 +59,8 @@ _OVERLAY_STYLES = ("-", (0, (5, 4)), (0, (1, 2.5)), (0, (8, 3, 1, 3)))
 _MARKERS = ("o", "s", "^", "v", "D")
 #: Exact responses: two greys and two styles, under the methods' colours.
 _EXACT: dict[str, dict[str, Any]] = {
-    "xs": {"color": "0.55", "lw": 4.0, "ls": "-", "alpha": 0.7},
-    "xu": {"color": "0.8", "lw": 4.0, "ls": (0, (2, 1)), "alpha": 0.9},
+    "body": {"color": "0.55", "lw": 4.0, "ls": "-", "alpha": 0.7},
+    "wheel": {"color": "0.8", "lw": 4.0, "ls": (0, (2, 1)), "alpha": 0.9},
 }
 
 
@@ -147,16 +147,18 @@ def reference_figure(cmp) -> Figure:
 def method_figure(cmp, method: str) -> Figure:
     """One method's displacements against time, as in the seed's Figures 3-6.
 
-    Sprung mass ``xs`` in red (solid), wheel ``xu`` in blue (dashed); the
-    exact ``xs`` (dark grey, solid) and ``xu`` (light grey, dashed) are
-    drawn wide underneath.
+    The body displacement (``xs`` on a quarter car) in red (solid), the
+    wheel's (the model entry's ``wheel_disp``, ``xu``) in blue (dashed); the
+    exact ones (dark grey, solid; light grey, dashed) are drawn wide
+    underneath.
     """
     resp, ref = cmp.responses[method], cmp.reference
     body, wheel, _ = _body_wheel(cmp)
     fig = Figure(figsize=(8, 3.4), layout="constrained")
     ax = fig.subplots()
-    drawn = ((body, "xs", "r-", "suspension (sprung mass)"), (wheel, "xu", "b--", "wheel"))
-    drawn = tuple(d for d in drawn if d[0] is not None)
+    drawn = [(body, "body", "r-", "suspension (sprung mass)")]
+    if wheel is not None:
+        drawn.append((wheel, "wheel", "b--", "wheel"))
     for name, style, _, _ in drawn:
         ax.plot(ref.time, output_signal(ref, name) * _MM, label=f"exact {name}", **_EXACT[style])
     for name, _, line, what in drawn:

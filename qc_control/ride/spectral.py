@@ -471,6 +471,11 @@ class ISO8608Road:
 
     def samples(self, T) -> np.ndarray:
         """The road height zr [m] on the time grid ``T`` [s] (`qc_control.ride.road.iso8608`)."""
+        if not isinstance(self.road_class, str):
+            raise ValueError(
+                f"road_class must be a class A-H to sample a road, got Gd(n0) = "
+                f"{self.road_class!r} m³ (a spectral road only)"
+            )
         return road.iso8608(T, self.road_class, speed=self.speed, seed=self.seed, band=self.band)
 
     def describe(self) -> str:
