@@ -23,6 +23,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import shlex
 import sys
 from dataclasses import dataclass, fields
 
@@ -33,6 +34,7 @@ import pytest
 
 import qc_control as qc
 from qc_control.cli.console import main
+from qc_control.cli.parser import build_parser, scenario_from_args
 from qc_control.models.registry import MODELS
 
 if sys.version_info >= (3, 11):
@@ -103,10 +105,14 @@ class SeatedCarParams:
         return [(n, *meaning[n][:1], getattr(self, n), meaning[n][1]) for n in meaning]
 
 
-def seated_car_model(params=None, *, road=False) -> qc.VehicleModel:
-    """The seated quarter car as a VehicleModel, its A written from Newton's law per mass."""
+def seated_car_model(params=None, *, road=False, cushion_scale=1.0) -> qc.VehicleModel:
+    """The seated quarter car as a VehicleModel, its A written from Newton's law per mass.
+
+    ``cushion_scale`` scales the cushion's stiffness and damping (a worn cushion: < 1).
+    """
     p = SeatedCarParams() if params is None else params
     md, kd, cd, ms, mu, ks, cs, ku = (getattr(p, f.name) for f in fields(p))
+    kd, cd = kd * cushion_scale, cd * cushion_scale
     # rows: md·ad = kd(xs - xd) + cd(vs - vd); ms·as = -that - ks(xs - xu) - cs(vs - vu);
     # mu·au = ks(xs - xu) + cs(vs - vu) - ku(xu - zr); states [vd, vs, vu, xd, xs, xu]
     acc = np.array(
@@ -142,8 +148,14 @@ def seated_car_model(params=None, *, road=False) -> qc.VehicleModel:
         p,
         UNITS,
         qc.SignalRoles("driver_acc", "xs", (corner,)),
-        functools.partial(seated_car_model, road=road),
+        functools.partial(seated_car_model, road=road, cushion_scale=cushion_scale),
     )
+
+
+def _scale(value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+        raise ValueError(f"cushion_scale must be a number > 0, got {value!r}")
+    return float(value)
 
 
 ENTRY = qc.ModelEntry(
@@ -151,6 +163,11 @@ ENTRY = qc.ModelEntry(
     SeatedCarParams,
     seated_car_model,
     "a quarter car with a driver on a seat cushion",
+    options=(
+        qc.ModelOption(
+            "cushion_scale", 1.0, _scale, "scales the cushion's stiffness and damping", parse=float
+        ),
+    ),
     wheel_disp="xu",
 )
 
@@ -199,6 +216,22 @@ def test_registration_is_undone_after_each_test(seated):
     assert "seated" in MODELS and qc.get_model("seated") is ENTRY
     with pytest.raises(ValueError, match="a model named 'seated' is registered already"):
         qc.register_model(ENTRY)
+
+
+def test_its_option_goes_from_toml_and_command_line_to_the_model(seated):
+    sc = qc.Scenario.from_mapping({"scenario": {"model": "seated", "cushion_scale": 0.5}})
+    assert sc.option("cushion_scale") == 0.5
+    # a worn cushion: the model's cushion is that of kd/2 and cd/2
+    half = SeatedCarParams(kd=30000.0, cd=600.0)
+    np.testing.assert_array_equal(sc.vehicle_model().system.A, seated.model(half).system.A)
+    assert qc.Scenario.from_toml_string(sc.to_toml()) == sc
+    assert "--cushion-scale 0.5" in sc.command()
+    args = build_parser().parse_args(shlex.split(sc.command())[1:])
+    assert scenario_from_args(args) == sc
+    with pytest.raises(qc.ScenarioError, match="cushion_scale must be a number > 0, got -1"):
+        qc.Scenario(model="seated", model_options={"cushion_scale": -1})
+    with pytest.raises(qc.ScenarioError, match="cushion_scale = 2.0 applies to the seated car"):
+        qc.Scenario(model_options={"cushion_scale": 2.0})
 
 
 def test_no_other_test_sees_it():

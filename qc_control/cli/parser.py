@@ -32,11 +32,13 @@ from ..studies.control_study import DESIGNS, compare_controllers
 from .scenario import (
     DEFAULT_MODEL,
     ROADS,
-    RUN_KEYS,
     Scenario,
     ScenarioError,
     command_line,
+    option_flag,
+    option_name,
     road_option,
+    run_keys,
     vehicle_keys,
 )
 
@@ -87,7 +89,7 @@ def _add_vehicle(parser: argparse.ArgumentParser, shown: str) -> None:
     )
     for key in parameter_keys():
         group.add_argument(
-            _cli_name(key),  # one spelling for options: --ks-front, as --t-end
+            option_name(key),  # one spelling for options: --ks-front, as --t-end
             dest=key,
             type=float,
             metavar="X",
@@ -102,10 +104,6 @@ def _add_vehicle(parser: argparse.ArgumentParser, shown: str) -> None:
         "[scenario] table (model = NAME ...) and a [scenario.road] table (a report's "
         "scenario.toml)",
     )
-
-
-def _cli_name(key: str) -> str:
-    return "--" + key.replace("_", "-")
 
 
 def _add_road(parser: argparse.ArgumentParser) -> None:
@@ -175,7 +173,7 @@ def _add_model_options(parser: argparse.ArgumentParser, shown: str) -> None:
         help = option.help if entry.option(option.name) is not None else argparse.SUPPRESS
         if isinstance(option.default, bool):
             group.add_argument(
-                "--" + ("no-" if option.default else "") + option.name.replace("_", "-"),
+                option_flag(option.name, option.default),
                 dest=option.name,
                 action="store_false" if option.default else "store_true",
                 default=None,
@@ -183,7 +181,7 @@ def _add_model_options(parser: argparse.ArgumentParser, shown: str) -> None:
             )
             continue
         group.add_argument(
-            _cli_name(option.name),
+            option_name(option.name),
             type=str if option.parse is None else _parse(option),
             metavar=option.metavar,
             help=help if help is argparse.SUPPRESS else f"{help} (default {option.default})",
@@ -311,7 +309,7 @@ def _add_control_report(sub, shown: str) -> None:
         help=f"designs to compare (default all: {', '.join(DESIGNS)}; 'hinf' for H∞)",
     )
     for name, kind, default, metavar, help in _CONTROL_OPTIONS:
-        ctl.add_argument(_cli_name(name), type=kind, default=default, metavar=metavar, help=help)
+        ctl.add_argument(option_name(name), type=kind, default=default, metavar=metavar, help=help)
     ctl.add_argument("--out", default="control-report", metavar="DIR", help="report directory")
     ctl.add_argument("-q", "--quiet", action="store_true", help="no progress line on stderr")
     ctl.set_defaults(run=_cmd_control_report)
@@ -322,7 +320,7 @@ def scenario_from_args(args: argparse.Namespace):
     doc: dict = {
         key: getattr(args, key) for key in vehicle_keys() if getattr(args, key, None) is not None
     }
-    run = {k: getattr(args, k) for k in RUN_KEYS if getattr(args, k, None) is not None}
+    run = {k: getattr(args, k) for k in run_keys() if getattr(args, k, None) is not None}
     road = {"kind": args.road_kind} if getattr(args, "road_kind", None) is not None else {}
     for cls in ROADS.values():
         for f in fields(cls):
@@ -360,7 +358,7 @@ def _in_options(exc, doc: dict) -> str:
     if section is None and key in doc and key != "scenario":
         option = f"--{key}"
     elif section == "scenario" and key in run:
-        option = "--no-events" if key == "events" else "--" + key.replace("_", "-")
+        option = _run_option(key)
     elif section == "scenario.road" and key in run.get("road", {}):
         option = (
             "--road"
@@ -375,6 +373,15 @@ def _in_options(exc, doc: dict) -> str:
         if exc.detail.startswith(lead):
             return option + lead[len(key) :].replace(" = ", " ") + exc.detail[len(lead) :]
     return str(exc)
+
+
+def _run_option(key: str) -> str:
+    """The option of a ``[scenario]`` key: ``--t-end``, or a model option's flag
+    (``--no-events``) when the option is a boolean one."""
+    flags = [o for e in MODELS.values() for o in e.options if o.name == key]
+    if flags and isinstance(flags[0].default, bool):
+        return option_flag(key, flags[0].default)
+    return option_name(key)
 
 
 def _cmd_modes(args) -> int:
@@ -473,9 +480,9 @@ def _control_command(args, designs: list[str]) -> str:
         options.append(("--config", str(args.config)))
     for f in fields(QuarterCarParams):
         if getattr(args, f.name, None) is not None:
-            options.append((_cli_name(f.name), repr(getattr(args, f.name))))
+            options.append((option_name(f.name), repr(getattr(args, f.name))))
     options.append(("--designs", ",".join("hinf" if d == "H∞" else d for d in designs)))
-    options += [(_cli_name(name), str(getattr(args, name))) for name, *_ in _CONTROL_OPTIONS]
+    options += [(option_name(name), str(getattr(args, name))) for name, *_ in _CONTROL_OPTIONS]
     return command_line(["control-report"], [*options, ("--out", str(args.out))])
 
 

@@ -94,6 +94,9 @@ __all__ = [
     "DEFAULT_MODEL",
     "command_line",
     "RUN_KEYS",
+    "run_keys",
+    "option_name",
+    "option_flag",
 ]
 
 #: The default limit on ``t_end / h``, the steps each method takes at h. The
@@ -362,9 +365,18 @@ def vehicle_keys() -> tuple[str, ...]:
     return tuple(parameter_keys())
 
 
-#: The Scenario's fields that hold a model's own options (`ModelOption`).
+#: The Scenario's fields that hold a model's own options (`ModelOption`) by name;
+#: the options of other registered models are held in ``model_options``.
 _OPTION_KEYS = ("tire", "bump_stop", "events")
 RUN_KEYS = ("t_end", "h", "x0", "methods", "max_steps", "model", *_OPTION_KEYS)
+
+
+def run_keys() -> tuple[str, ...]:
+    """The ``[scenario]`` keys: `RUN_KEYS` and every registered model's options."""
+    options = (o.name for e in MODELS.values() for o in e.options)
+    return tuple(dict.fromkeys((*RUN_KEYS, *options)))
+
+
 #: The flat road keys of the ``[scenario]`` table of earlier versions.
 _LEGACY_ROAD_KEYS = ("road", "road_class", "speed", "seed")
 
@@ -530,6 +542,10 @@ class Scenario:
     events : bool, optional
         Whether the nonlinear car's methods step to each switching time
         (default True; the convergence study runs both ways regardless).
+    model_options : mapping, optional
+        The options of a registered model that are not fields here
+        (`qc_control.ModelOption`), by name; each checked by its option and
+        defaulted. Held as ``((name, value), ...)``; `option` reads one.
 
     Examples
     --------
@@ -554,6 +570,7 @@ class Scenario:
     tire: str | None = None
     bump_stop: tuple[float, float] | None = None
     events: bool | None = None
+    model_options: Any = None  # resolved: a tuple of (name, value) pairs, hashable
 
     def __post_init__(self):
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
@@ -596,31 +613,46 @@ class Scenario:
         return get_model(self.model)
 
     def _model_options(self) -> None:
-        """Check (and default) the keys that apply to some models only (`ModelOption`)."""
+        """Check (and default) the keys that apply to some models only (`ModelOption`):
+        the fields ``tire``, ``bump_stop``, ``events`` and ``model_options``' entries."""
         entry = self.entry
-        for key in _OPTION_KEYS:
-            value, option = getattr(self, key), entry.option(key)
-            if option is None:
-                if value is not None:
-                    users = [e.name for e in MODELS.values() if e.option(key) is not None]
-                    raise ScenarioError(
-                        f"{key} = {value!r} applies to the {' and '.join(users)} car only: "
-                        f"choose it (model = {users[0]!r} in [scenario], --model {users[0]})",
-                        "scenario",
-                        key,
-                    )
-                continue
+        given = dict(self.model_options or {})
+        given.update({k: getattr(self, k) for k in _OPTION_KEYS if getattr(self, k) is not None})
+        for key, value in given.items():
+            if entry.option(key) is None:
+                users = [e.name for e in MODELS.values() if e.option(key) is not None]
+                if not users:
+                    raise ScenarioError(f"unknown [scenario] key {key!r}", "scenario", key)
+                raise ScenarioError(
+                    f"{key} = {value!r} applies to the {' and '.join(users)} car only: "
+                    f"choose it (model = {users[0]!r} in [scenario], --model {users[0]})",
+                    "scenario",
+                    key,
+                )
+        extra = []
+        for option in entry.options:
+            value = given.get(option.name, option.default)
             try:
-                checked = option.check(option.default if value is None else value)
+                checked = option.check(value)
             except ValueError as exc:
-                raise ScenarioError(str(exc), "scenario", key) from None
-            object.__setattr__(self, key, checked)
+                raise ScenarioError(str(exc), "scenario", option.name) from None
+            if option.name in _OPTION_KEYS:
+                object.__setattr__(self, option.name, checked)
+            else:
+                extra.append((option.name, checked))
+        object.__setattr__(self, "model_options", tuple(extra))
 
-    def options(self, target: str) -> dict[str, Any]:
+    def option(self, name: str) -> Any:
+        """The value of the model option ``name`` (a `ModelOption` of its entry)."""
+        if name in _OPTION_KEYS:
+            return getattr(self, name)
+        return dict(self.model_options)[name]
+
+    def option_arguments(self, target: str) -> dict[str, Any]:
         """This scenario's model options bound for ``target`` (``'build'`` or
         ``'compare'``), as the keyword arguments that take them."""
         return {
-            o.name: o.argument(getattr(self, o.name))
+            o.name: o.argument(self.option(o.name))
             for o in self.entry.options
             if o.target == target
         }
@@ -767,7 +799,7 @@ class Scenario:
         profile: Any = bool(road)
         if road and self.entry.road_function and not isinstance(self.road, (NoRoad, ISO8608Road)):
             profile = functools.partial(_road_at, self.road)
-        return self.entry.model(self.vehicle, road=profile, **self.options("build"))
+        return self.entry.model(self.vehicle, road=profile, **self.option_arguments("build"))
 
     def run(self, progress: Callable[[str], None] | None = None) -> MethodComparison:
         """Run the comparison: `qc_control.compare_methods` on this scenario.
@@ -788,7 +820,7 @@ class Scenario:
             methods=self.methods,
             progress=progress,
             input_description=description,
-            **self.options("compare"),
+            **self.option_arguments("compare"),
         )
         cmp.scenario = self
         return cmp
@@ -844,7 +876,14 @@ class Scenario:
             road = {**road, **over["road"]}
         given = {None: over["vehicle"], "scenario": over["run"], _ROAD_SECTION: over["road"]}
         try:
-            return cls(vehicle=cast(Any, vehicle), road=cast(Any, road), **run)
+            fixed = {k: v for k, v in run.items() if k in RUN_KEYS}
+            extra = {k: v for k, v in run.items() if k not in RUN_KEYS}
+            return cls(
+                vehicle=cast(Any, vehicle),
+                road=cast(Any, road),
+                model_options=extra or None,
+                **fixed,
+            )
         except ScenarioError as exc:
             from_overrides = exc.key is not None and exc.key in given.get(exc.section, {})
             section = exc.section
@@ -912,7 +951,7 @@ class Scenario:
         if self.max_steps != MAX_STEPS:
             lines.append(f"max_steps = {self.max_steps}")
         for option in self.entry.options:
-            value = getattr(self, option.name)
+            value = self.option(option.name)
             if value is not None:
                 lines.append(f"{option.name} = {_toml_value(value)}")
         if self.entry.defaults.road and isinstance(self.road, NoRoad):
@@ -951,18 +990,18 @@ class Scenario:
         options: list[tuple[str, str | None]] = []
         if self.model != DEFAULT_MODEL:
             options.append(("--model", self.model))
-        options += [(_cli_name(k), repr(v)) for k, v in self.vehicle.to_dict().items()]
+        options += [(option_name(k), repr(v)) for k, v in self.vehicle.to_dict().items()]
         options += [("--t-end", repr(self.t_end)), ("--h", repr(self.h))]
         options += [("--x0", ",".join(map(repr, self.x0))), ("--methods", ",".join(self.methods))]
         if self.max_steps != MAX_STEPS:
             options.append(("--max-steps", str(self.max_steps)))
         for option in self.entry.options:
-            value = getattr(self, option.name)
+            value = self.option(option.name)
             if isinstance(value, bool):
                 if value != option.default:
-                    options.append((_cli_flag(option.name, option.default), None))
+                    options.append((option_flag(option.name, option.default), None))
             elif value is not None:
-                options.append((_cli_name(option.name), _cli_text(value)))
+                options.append((option_name(option.name), _cli_text(value)))
         if self.entry.defaults.road and isinstance(self.road, NoRoad):
             options.append(("--road", NoRoad.kind))
         if not isinstance(self.road, NoRoad):
@@ -973,14 +1012,14 @@ class Scenario:
         return options
 
 
-def _cli_name(key: str) -> str:
+def option_name(key: str) -> str:
     """A key's option: ``--ks-front`` for ``ks_front`` (one spelling, as ``--t-end``)."""
     return "--" + key.replace("_", "-")
 
 
-def _cli_flag(key: str, default: bool) -> str:
+def option_flag(key: str, default: bool) -> str:
     """The flag that turns a boolean option away from its default: ``--no-events``."""
-    return _cli_name(f"no_{key}" if default else key)
+    return option_name(f"no_{key}" if default else key)
 
 
 def _cli_text(value) -> str:
@@ -1055,10 +1094,10 @@ def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
             )
     road, section = table.pop("road", None), _ROAD_SECTION
     legacy = {k: table.pop(k) for k in _LEGACY_ROAD_KEYS[1:] if k in table}
-    unknown = sorted(set(table) - set(RUN_KEYS))
+    unknown = sorted(set(table) - set(run_keys()))
     if unknown:
         raise ScenarioError(
-            f"unknown [scenario] key {unknown[0]!r}; expected {', '.join(RUN_KEYS)} and a "
+            f"unknown [scenario] key {unknown[0]!r}; expected {', '.join(run_keys())} and a "
             f"road (a [scenario.road] table with kind and its parameters)",
             None,
             unknown[0],
