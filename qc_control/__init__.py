@@ -106,6 +106,14 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         quarter_car,
         quarter_car_model,
     )
+    from .models.registry import (
+        DefaultRun,
+        ModelEntry,
+        ModelOption,
+        get_model,
+        register_model,
+        unregister_model,
+    )
     from .models.vehicle import Corner, SignalRoles, VehicleModel
     from .numerics.integrate import DivergenceWarning, Solution
     from .numerics.methods import METHODS, ButcherTableau, get_method
@@ -193,6 +201,12 @@ _LAZY: dict[str, str] = {
     "Scenario": "cli.scenario",
     "ScenarioError": "cli.scenario",
     "Corner": "models.vehicle",
+    "ModelEntry": "models.registry",
+    "ModelOption": "models.registry",
+    "DefaultRun": "models.registry",
+    "register_model": "models.registry",
+    "unregister_model": "models.registry",
+    "get_model": "models.registry",
     "SignalRoles": "models.vehicle",
     "VehicleModel": "models.vehicle",
     "FixedStepResponse": "responses.timeresp",
@@ -264,6 +278,12 @@ __all__ = [
     "VehicleModel",
     "SignalRoles",
     "Corner",
+    "ModelEntry",
+    "ModelOption",
+    "DefaultRun",
+    "register_model",
+    "unregister_model",
+    "get_model",
     "Metric",
     "RideSignals",
     "write_report",

@@ -25,26 +25,26 @@ import pandas as pd
 from ..models.controllers import HINF_AVAILABLE
 from ..models.modal import modal_analysis
 from ..models.quarter import QuarterCarParams
+from ..models.registry import MODELS, ModelOption, get_model, parameter_help, parameter_keys
 from ..report import ReportError, check_target, write_report
 from ..report.control import write_control_report
 from ..studies.control_study import DESIGNS, compare_controllers
-from .scenario import MODELS, ROADS, Scenario, ScenarioError, road_option, vehicle_keys
+from .scenario import (
+    DEFAULT_MODEL,
+    ROADS,
+    Scenario,
+    ScenarioError,
+    command_line,
+    option_flag,
+    option_name,
+    road_option,
+    run_keys,
+    vehicle_keys,
+)
 
 __all__ = ["run", "build_parser", "scenario_from_args", "summarise_warnings", "UsageError"]
 
 _PROG = "qc-control"
-#: The run's options of ``report``, as fields of `qc_control.Scenario`.
-_RUN_OPTIONS = (
-    "model",
-    "t_end",
-    "h",
-    "x0",
-    "methods",
-    "max_steps",
-    "tire",
-    "bump_stop",
-    "events",
-)
 #: ``--bump-height`` and ``--bump-length``: the nonlinear car's words for the bump road's
 #: ``--road-height`` and ``--road-length`` (the same fields of the Scenario's road).
 _BUMP_ALIASES = {"bump_height": "height", "bump_length": "length"}
@@ -69,36 +69,40 @@ def _floats(text: str) -> list[float]:
         ) from None
 
 
-def _add_vehicle(parser: argparse.ArgumentParser) -> None:
+def _add_vehicle(parser: argparse.ArgumentParser, shown: str) -> None:
+    """``--model``, every registered model's parameters and ``--config``.
 
+    Every parameter of every model is an option (``--config`` may choose
+    the model), but ``--help`` lists the ``shown`` model's only.
+    """
+    entry = get_model(shown)
     group = parser.add_argument_group(
-        "vehicle (SI units; defaults: the seed's Table 1 for the quarter car)"
+        f"vehicle: the {shown} car's parameters (SI units; default: {entry.description}; "
+        "--model NAME --help lists another model's)"
     )
     group.add_argument(
         "--model",
         choices=list(MODELS),
         help="the vehicle: "
         + ", ".join(f"{name} ({kind.description})" for name, kind in MODELS.items())
-        + "; default quarter",
+        + f"; default {DEFAULT_MODEL}",
     )
-    users: dict[str, list[str]] = {}
-    for name, kind in MODELS.items():
-        for f in fields(kind.params):
-            users.setdefault(f.name, []).append(name)
-    for key in vehicle_keys():
-        which = "" if len(users[key]) == len(MODELS) else f" ({', '.join(users[key])} car)"
+    for key in parameter_keys():
         group.add_argument(
-            "--" + key.replace("_", "-"),  # one spelling for options: --ks-front, as --t-end
+            option_name(key),  # one spelling for options: --ks-front, as --t-end
             dest=key,
             type=float,
             metavar="X",
-            help=f"{key}{which}, overrides the config file",
+            help=f"{parameter_help(entry, key)}, overrides the config file"
+            if key in entry.keys()
+            else argparse.SUPPRESS,
         )
     group.add_argument(
         "--config",
         metavar="FILE.toml",
-        help="TOML file: the vehicle's ms, mu, ks, ku, zeta or cs at the top level, and for "
-        "'report' a [scenario] table and a [scenario.road] table (a report's scenario.toml)",
+        help="TOML file: the vehicle's parameters at the top level, and for 'report' a "
+        "[scenario] table (model = NAME ...) and a [scenario.road] table (a report's "
+        "scenario.toml)",
     )
 
 
@@ -141,40 +145,77 @@ def _add_road(parser: argparse.ArgumentParser) -> None:
         )
 
 
-def _add_nonlinear(parser: argparse.ArgumentParser) -> None:
-    """The nonlinear car's options (--model nonlinear)."""
+def _parse(option: ModelOption) -> Callable[[str], Any]:
+    """The option's reader of text, its complaint in argparse's words."""
+
+    def read(text: str):
+        try:
+            return option.parse(text)  # type: ignore[misc]  # only called when set
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    read.__name__ = option.name
+    return read
+
+
+def _add_model_options(parser: argparse.ArgumentParser, shown: str) -> None:
+    """Each registered model's own options (`ModelOption`), listed for the ``shown`` model."""
+    entry = get_model(shown)
     group = parser.add_argument_group(
-        "nonlinear car (--model nonlinear: gravity and a unilateral tire, so the wheel can "
-        "leave the road)",
-        "Default: the lift-off case, a 20 cm high, 8 m long 1 - cos bump at 20 m/s met at "
-        "0.1 s, over 0-0.8 s at h = 2 ms; --road none for the free response.",
+        f"the {shown} car's options",
+        "Default run: " + _default_run(shown),
     )
-    group.add_argument("--tire", metavar="unilateral|linear", help="the tire (default unilateral)")
+    added: set[str] = set()
+    for option in (o for e in MODELS.values() for o in e.options):
+        if option.name in added:
+            continue
+        added.add(option.name)
+        help = option.help if entry.option(option.name) is not None else argparse.SUPPRESS
+        if isinstance(option.default, bool):
+            group.add_argument(
+                option_flag(option.name, option.default),
+                dest=option.name,
+                action="store_false" if option.default else "store_true",
+                default=None,
+                help=help if help is argparse.SUPPRESS else f"not: {help}",
+            )
+            continue
+        group.add_argument(
+            option_name(option.name),
+            type=str if option.parse is None else _parse(option),
+            metavar=option.metavar,
+            help=help if help is argparse.SUPPRESS else f"{help} (default {option.default})",
+        )
     group.add_argument(
-        "--bump-stop",
-        type=_floats,
-        metavar="CLEARANCE,STIFFNESS",
-        help="a bump stop: travel in compression before it touches [m], stiffness [N/m] "
-        "(default none)",
+        "--bump-height", type=float, metavar="M", help="the bump's height [m], as --road-height"
     )
     group.add_argument(
-        "--no-events",
-        dest="events",
-        action="store_false",
-        default=None,
-        help="step across the contact events instead of to them (the convergence study "
-        "runs both ways regardless)",
-    )
-    group.add_argument(
-        "--bump-height", type=float, metavar="M", help="the bump's height [m] (default 0.2)"
-    )
-    group.add_argument(
-        "--bump-length", type=float, metavar="M", help="the bump's length [m] (default 8)"
+        "--bump-length", type=float, metavar="M", help="the bump's length [m], as --road-length"
     )
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of ``qc-control``."""
+def _default_run(name: str) -> str:
+    """A model's default run in words, for ``--help``."""
+    run = get_model(name).defaults
+    road = run.road or {"kind": "none"}
+    words = ", ".join(f"{k} {v}" for k, v in road.items() if k != "kind")
+    return (
+        f"0-{run.t_end:g} s at h = {run.h:g} s, road {road['kind']}"
+        + (f" ({words})" if words else "")
+        + ("; --road none for the free response" if run.road else "")
+    )
+
+
+def build_parser(model: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser of ``qc-control``.
+
+    Parameters
+    ----------
+    model : str, optional
+        The model whose parameters and options ``--help`` lists (default
+        the quarter car); every registered model's are parsed regardless.
+    """
+    shown = model if model in MODELS else DEFAULT_MODEL
     parser = _Parser(
         prog=_PROG,
         description="Quarter-car suspension tools on python-control.",
@@ -189,32 +230,35 @@ def build_parser() -> argparse.ArgumentParser:
     modes = sub.add_parser(
         "modes", help="print the modal table (frequencies, damping, shapes)", allow_abbrev=False
     )
-    _add_vehicle(modes)
+    _add_vehicle(modes, shown)
     modes.set_defaults(run=_cmd_modes)
+    _add_report(sub, shown)
+    _add_control_report(sub, shown)
+    return parser
 
+
+def _add_report(sub, shown: str) -> None:
+    """``qc-control report``: the scenario's options."""
     report = sub.add_parser(
         "report",
         help="compare the methods against the exact response and write the report",
         allow_abbrev=False,
     )
-    _add_vehicle(report)
-    sc = report.add_argument_group(
-        "scenario (defaults: the seed's, body released from 5 cm, 0-10 s at h = 0.01 s)"
-    )
+    _add_vehicle(report, shown)
+    sc = report.add_argument_group(f"scenario (the {shown} car's default: {_default_run(shown)})")
     sc.add_argument(
         "--h",
         type=float,
         metavar="S",
-        help="step size [s] (default 0.01, 0.002 for --model nonlinear; under an ISO 8608 "
-        "road, the largest of 10, 5, 2, 1, 0.5, ... ms that samples the road)",
+        help="step size [s] (default the model's; under an ISO 8608 road, the largest of "
+        "10, 5, 2, 1, 0.5, ... ms that samples the road)",
     )
-    sc.add_argument(
-        "--t-end", type=float, metavar="S", help="end time [s] (default 10; 0.8 nonlinear)"
-    )
+    sc.add_argument("--t-end", type=float, metavar="S", help="end time [s]")
     sc.add_argument(
         "--x0",
-        metavar="VS,VU,XS,XU",
-        help="initial state [m/s, m/s, m, m] (default 0,0,0.05,0; at rest under a road)",
+        metavar=",".join(get_model(shown).model().system.state_labels).upper(),
+        help="initial state, in the model's state order (default: the body released from "
+        "5 cm; at rest under a road)",
     )
     sc.add_argument(
         "--methods", metavar="A,B,...", help="methods to compare (default euler,midpoint,heun,rk4)"
@@ -226,7 +270,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="refuse a run of more than N steps t_end/h per method (default 100000)",
     )
     _add_road(report)
-    _add_nonlinear(report)
+    _add_model_options(report, shown)
     report.add_argument(
         "--out",
         default="report",
@@ -238,38 +282,37 @@ def build_parser() -> argparse.ArgumentParser:
     )
     report.set_defaults(run=_cmd_report)
 
+
+#: ``control-report``'s own options: (name, type, default, metavar, help).
+_CONTROL_OPTIONS: tuple[tuple[str, Callable[[str], Any], Any, str, str], ...] = (
+    ("road_class", str, "C", "A-H", "ISO 8608 class (default C)"),
+    ("speed", float, 20.0, "M/S", "default 20"),
+    ("road_duration", float, 10.0, "S", "road run [s] (default 10)"),
+    ("bump_duration", float, 15.0, "S", "bump run [s] (default 15)"),
+    ("method", str, "rk4", "NAME", "fixed-step method (default rk4)"),
+    ("cmax", float, 4000.0, "N·S/M", "semi-active damper's largest damping (default 4000)"),
+)
+
+
+def _add_control_report(sub, shown: str) -> None:
+    """``qc-control control-report``: the controller comparison's options."""
     ctl = sub.add_parser(
         "control-report",
         help="compare passive, semi-active and active suspensions (skyhook ... H∞) and "
         "write the report",
         allow_abbrev=False,
     )
-    _add_vehicle(ctl)
+    _add_vehicle(ctl, shown)
     ctl.add_argument(
         "--designs",
         metavar="A,B,...",
         help=f"designs to compare (default all: {', '.join(DESIGNS)}; 'hinf' for H∞)",
     )
-    ctl.add_argument("--road-class", default="C", metavar="A-H", help="ISO 8608 class (default C)")
-    ctl.add_argument("--speed", type=float, default=20.0, metavar="M/S", help="default 20")
-    ctl.add_argument(
-        "--road-duration", type=float, default=10.0, metavar="S", help="road run [s] (default 10)"
-    )
-    ctl.add_argument(
-        "--bump-duration", type=float, default=15.0, metavar="S", help="bump run [s] (default 15)"
-    )
-    ctl.add_argument("--method", default="rk4", help="fixed-step method (default rk4)")
-    ctl.add_argument(
-        "--cmax",
-        type=float,
-        default=4000.0,
-        metavar="N·S/M",
-        help="semi-active damper's largest damping (default 4000)",
-    )
+    for name, kind, default, metavar, help in _CONTROL_OPTIONS:
+        ctl.add_argument(option_name(name), type=kind, default=default, metavar=metavar, help=help)
     ctl.add_argument("--out", default="control-report", metavar="DIR", help="report directory")
     ctl.add_argument("-q", "--quiet", action="store_true", help="no progress line on stderr")
     ctl.set_defaults(run=_cmd_control_report)
-    return parser
 
 
 def scenario_from_args(args: argparse.Namespace):
@@ -277,7 +320,7 @@ def scenario_from_args(args: argparse.Namespace):
     doc: dict = {
         key: getattr(args, key) for key in vehicle_keys() if getattr(args, key, None) is not None
     }
-    run = {k: getattr(args, k) for k in _RUN_OPTIONS if getattr(args, k, None) is not None}
+    run = {k: getattr(args, k) for k in run_keys() if getattr(args, k, None) is not None}
     road = {"kind": args.road_kind} if getattr(args, "road_kind", None) is not None else {}
     for cls in ROADS.values():
         for f in fields(cls):
@@ -315,7 +358,7 @@ def _in_options(exc, doc: dict) -> str:
     if section is None and key in doc and key != "scenario":
         option = f"--{key}"
     elif section == "scenario" and key in run:
-        option = "--no-events" if key == "events" else "--" + key.replace("_", "-")
+        option = _run_option(key)
     elif section == "scenario.road" and key in run.get("road", {}):
         option = (
             "--road"
@@ -332,9 +375,21 @@ def _in_options(exc, doc: dict) -> str:
     return str(exc)
 
 
+def _run_option(key: str) -> str:
+    """The option of a ``[scenario]`` key: ``--t-end``, or a model option's flag
+    (``--no-events``) when the option is a boolean one."""
+    flags = [o for e in MODELS.values() for o in e.options if o.name == key]
+    if flags and isinstance(flags[0].default, bool):
+        return option_flag(key, flags[0].default)
+    return option_name(key)
+
+
 def _cmd_modes(args) -> int:
 
-    print(modal_analysis(scenario_from_args(args).vehicle))
+    scenario = scenario_from_args(args)
+    model = scenario.vehicle_model()
+    # a nonlinear car has no matrix: its modes are those of the linear car of its parameters
+    print(modal_analysis(model if hasattr(model.system, "A") else scenario.vehicle))
     return 0
 
 
@@ -420,16 +475,15 @@ def _designs(text: str | None) -> list[str]:
 
 def _control_command(args, designs: list[str]) -> str:
     """The command line that redoes this control report."""
-    parts = [_PROG, "control-report"]
+    options: list[tuple[str, str | None]] = []
     if getattr(args, "config", None):
-        parts += ["--config", str(args.config)]
+        options.append(("--config", str(args.config)))
     for f in fields(QuarterCarParams):
         if getattr(args, f.name, None) is not None:
-            parts += ["--" + f.name.replace("_", "-"), repr(getattr(args, f.name))]
-    parts += ["--designs", "'" + ",".join("hinf" if d == "H∞" else d for d in designs) + "'"]
-    for option in ("road_class", "speed", "road_duration", "bump_duration", "method", "cmax"):
-        parts += ["--" + option.replace("_", "-"), str(getattr(args, option))]
-    return " ".join(parts + ["--out", str(args.out)])
+            options.append((option_name(f.name), repr(getattr(args, f.name))))
+    options.append(("--designs", ",".join("hinf" if d == "H∞" else d for d in designs)))
+    options += [(option_name(name), str(getattr(args, name))) for name, *_ in _CONTROL_OPTIONS]
+    return command_line(["control-report"], [*options, ("--out", str(args.out))])
 
 
 def _cmd_control_report(args) -> int:
@@ -514,6 +568,16 @@ def summarise_warnings(caught) -> list[str]:
     return lines
 
 
+def _model_named(argv: list[str]) -> str | None:
+    """The ``--model`` of the command line, read ahead so that ``--help`` lists its options."""
+    for i, word in enumerate(argv):
+        if word == "--model" and i + 1 < len(argv):
+            return argv[i + 1]
+        if word.startswith("--model="):
+            return word.partition("=")[2]
+    return None
+
+
 def run(argv: list[str]) -> int:
     """Run ``qc-control`` with the arguments ``argv``; returns the exit status.
 
@@ -521,7 +585,8 @@ def run(argv: list[str]) -> int:
     status 2. The entry point, `qc_control.cli.console.main`, handles Ctrl-C and
     internal errors around this call and around importing this module.
     """
-    parser = build_parser()
+    model = _model_named(argv)
+    parser = build_parser() if model is None else build_parser(model)
     try:
         args = parser.parse_args(argv)
         with warnings.catch_warnings(record=True) as caught:

@@ -13,8 +13,9 @@ The TOML layout (every key optional)::
     zeta = 0.25           # ms, mu, ks, ku and zeta or cs (QuarterCarParams)
 
     [scenario]
-    model = "quarter"     # or "half", "full" (qc_control.cli.scenario.MODELS); the
-                          # top-level keys are then HalfCarParams' or FullCarParams'
+    model = "quarter"     # or "half", "full", "nonlinear", or any registered model
+                          # (qc_control.register_model); the top-level keys are
+                          # then that model's parameters
     t_end = 10.0          # end time [s]
     h = 0.01              # step [s]
     x0 = [0.0, 0.0, 0.05, 0.0]          # [vs, vu, xs, xu] in m/s, m/s, m, m
@@ -51,26 +52,19 @@ import math
 import shlex
 import sys
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, ClassVar, cast
 
 import numpy as np
 
-from ..models.halfcar import FullCarParams, HalfCarParams, full_car_model, half_car_model
-from ..models.nonlinear import BumpStop, nonlinear_quarter_car_model
-from ..models.quarter import QuarterCarParams, quarter_car_model
+from ..models.quarter import QuarterCarParams
+from ..models.registry import MODELS, ModelEntry, get_model, model_for_params, parameter_keys
 from ..models.vehicle import VehicleModel
 from ..numerics.methods import METHODS, get_method
 from ..ride import road as roads
-from ..studies.compare import (
-    DEFAULT_H,
-    DEFAULT_METHODS,
-    DEFAULT_T_END,
-    DEFAULT_X0,
-    MethodComparison,
-    compare_methods,
-)
+from ..ride.spectral import ISO8608Road, road_parameter
+from ..studies.compare import DEFAULT_METHODS, MethodComparison, compare_methods
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -89,6 +83,7 @@ __all__ = [
     "SineRoad",
     "ISO8608Road",
     "ROADS",
+    "RoadSpec",
     "MAX_STEPS",
     "road_from_mapping",
     "MODELS",
@@ -96,6 +91,12 @@ __all__ = [
     "NONLINEAR_ROAD",
     "NONLINEAR_T_END",
     "NONLINEAR_H",
+    "DEFAULT_MODEL",
+    "command_line",
+    "RUN_KEYS",
+    "run_keys",
+    "option_name",
+    "option_flag",
 ]
 
 #: The default limit on ``t_end / h``, the steps each method takes at h. The
@@ -161,45 +162,10 @@ def _length(metres: float) -> str:
 _ROAD_SECTION = "scenario.road"
 
 
-def _road_field(default, check: str, unit: str, help: str, option: str | None = None):
-    """A road parameter: its default, its check, its unit and its CLI option."""
-    return field(
-        default=default, metadata={"check": check, "unit": unit, "help": help, "option": option}
-    )
-
-
 def _road_value(f, value):
     """A road parameter's value, checked by its kind of check, or a ScenarioError."""
     check, unit, key = f.metadata["check"], f.metadata["unit"], f.name
-    if check in ("finite", "positive"):
-        return _number(_ROAD_SECTION, key, value, unit, positive=check == "positive")
-    if check == "class":
-        name = value.strip().upper() if isinstance(value, str) else None
-        if name not in roads.ISO8608_CLASSES:
-            raise ScenarioError(
-                f"unknown ISO 8608 road class {value!r}; expected one of "
-                f"{', '.join(roads.ISO8608_CLASSES)}",
-                _ROAD_SECTION,
-                key,
-            )
-        return name
-    if check == "seed":
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-            raise ScenarioError(
-                f"{key} must be a non-negative integer, got {value!r}", _ROAD_SECTION, key
-            )
-        return int(value)
-    if check == "band":
-        ok = isinstance(value, (list, tuple, np.ndarray)) and len(value) == 2
-        ok = ok and all(_is_number(v) and math.isfinite(v) for v in value)
-        if not ok or not 0 < value[0] < value[1]:
-            raise ScenarioError(
-                f"{key} must be [n_min, n_max] in {unit} with 0 < n_min < n_max, got {value!r}",
-                _ROAD_SECTION,
-                key,
-            )
-        return (float(value[0]), float(value[1]))
-    raise AssertionError(f"unknown check {check!r}")  # pragma: no cover - a bug here
+    return _number(_ROAD_SECTION, key, value, unit, positive=check == "positive")
 
 
 #: Help of the parameters that step and bump share.
@@ -255,8 +221,8 @@ class StepRoad(Road):
 
     kind: ClassVar[str] = "step"
     noun: ClassVar[str] = "a step road"
-    height: float = _road_field(_default(roads.step, "height"), "finite", "m", _HEIGHT)
-    t0: float = _road_field(_default(roads.step, "t0"), "finite", "s", _T0)
+    height: float = road_parameter(_default(roads.step, "height"), "finite", "m", _HEIGHT)
+    t0: float = road_parameter(_default(roads.step, "t0"), "finite", "s", _T0)
 
     def samples(self, T) -> np.ndarray:
         return roads.step(T, height=self.height, t0=self.t0)
@@ -280,10 +246,10 @@ class BumpRoad(Road):
 
     kind: ClassVar[str] = "bump"
     noun: ClassVar[str] = "a bump road"
-    height: float = _road_field(_default(roads.bump, "height"), "finite", "m", _HEIGHT)
-    length: float = _road_field(_default(roads.bump, "length"), "positive", "m", "bump length")
-    speed: float = _road_field(_SPEED, "positive", "m/s", "vehicle speed", "--speed")
-    t0: float = _road_field(_default(roads.bump, "t0"), "finite", "s", _T0)
+    height: float = road_parameter(_default(roads.bump, "height"), "finite", "m", _HEIGHT)
+    length: float = road_parameter(_default(roads.bump, "length"), "positive", "m", "bump length")
+    speed: float = road_parameter(_SPEED, "positive", "m/s", "vehicle speed", "--speed")
+    t0: float = road_parameter(_default(roads.bump, "t0"), "finite", "s", _T0)
 
     def samples(self, T) -> np.ndarray:
         return roads.bump(T, height=self.height, length=self.length, speed=self.speed, t0=self.t0)
@@ -301,10 +267,10 @@ class SineRoad(Road):
 
     kind: ClassVar[str] = "sine"
     noun: ClassVar[str] = "a sine road"
-    amplitude: float = _road_field(
+    amplitude: float = road_parameter(
         _default(roads.sine, "amplitude"), "finite", "m", "sine amplitude"
     )
-    frequency: float = _road_field(
+    frequency: float = road_parameter(
         _default(roads.sine, "frequency"), "positive", "Hz", "sine frequency"
     )
 
@@ -315,44 +281,16 @@ class SineRoad(Road):
         return f"a sinusoidal road, {_length(self.amplitude)} amplitude at {self.frequency:g} Hz"
 
 
-@dataclass(frozen=True)
-class ISO8608Road(Road):
-    """A random ISO 8608 road driven at ``speed``, `qc_control.ride.road.iso8608`."""
-
-    kind: ClassVar[str] = "iso8608"
-    noun: ClassVar[str] = "an iso8608 road"
-    road_class: str = _road_field(
-        _default(roads.iso8608, "road_class"), "class", "", "ISO 8608 class A-H", "--road-class"
-    )
-    speed: float = _road_field(_SPEED, "positive", "m/s", "vehicle speed", "--speed")
-    seed: int = _road_field(_default(roads.iso8608, "seed"), "seed", "", "road seed", "--seed")
-    band: tuple[float, float] = _road_field(
-        _default(roads.iso8608, "band"), "band", "cycles/m", "ISO 8608 band n_min,n_max"
-    )
-
-    def samples(self, T) -> np.ndarray:
-        return roads.iso8608(T, self.road_class, speed=self.speed, seed=self.seed, band=self.band)
-
-    def describe(self) -> str:
-        lo, hi = self.band
-        return (
-            f"an ISO 8608 class {self.road_class} road at {self.speed:g} m/s "
-            f"(seed {self.seed}, band {lo:g}–{hi:g} cycles/m)"
-        )
-
-    def largest_step(self) -> float:
-        return roads.largest_step(self.speed, self.band)
-
-    def sampled(self) -> str:
-        return (
-            f"an ISO 8608 road at {self.speed:g} m/s, whose band reaches {self.band[1]:g} cycles/m"
-        )
-
-
-#: Every kind of road, by its ``kind``.
-ROADS: dict[str, type[Road]] = {
+#: Every kind of road, by its ``kind``. The ISO 8608 road is the ride layer's
+#: (`qc_control.ride.spectral.ISO8608Road`): one class for the Scenario's
+#: sampled road and for the spectral sweep's white road velocity.
+ROADS: dict[str, type[Road] | type[ISO8608Road]] = {
     cls.kind: cls for cls in (NoRoad, StepRoad, BumpRoad, SineRoad, ISO8608Road)
 }
+
+
+#: A road spec: one of `ROADS`' classes.
+RoadSpec = Road | ISO8608Road
 
 
 def road_option(f) -> str:
@@ -360,7 +298,7 @@ def road_option(f) -> str:
     return f.metadata["option"] or "--road-" + f.name.replace("_", "-")
 
 
-def road_from_mapping(values: Mapping[str, Any]) -> Road:
+def road_from_mapping(values: Mapping[str, Any]) -> RoadSpec:
     """A `Road` from ``{'kind': ..., parameter: value, ...}``.
 
     A missing ``kind`` means no road. A key that is a parameter of another
@@ -396,7 +334,13 @@ def road_from_mapping(values: Mapping[str, Any]) -> Road:
                 key,
             )
         raise ScenarioError(f"unknown [scenario.road] key {key!r}; {takes}", None, key)
-    return cls(**values)
+    try:
+        return cls(**values)
+    except ScenarioError:
+        raise
+    except ValueError as exc:  # the ride layer's road: its message starts with the name
+        culprit = next((k for k in allowed if str(exc).startswith(k + " ")), None)
+        raise ScenarioError(str(exc), _ROAD_SECTION, culprit) from None
 
 
 # ------------------------------------------------------------- scenario
@@ -406,59 +350,33 @@ def road_from_mapping(values: Mapping[str, Any]) -> Road:
 MAX_STATE = 1e150
 
 
-@dataclass(frozen=True)
-class ModelKind:
-    """A vehicle a `Scenario` can run: its parameters and how to build it.
-
-    Attributes
-    ----------
-    params : type
-        The parameter dataclass (``from_mapping``, ``to_dict``), e.g.
-        `QuarterCarParams`; its fields are the top-level keys of the TOML.
-    build : callable ``(params, *, road: bool) -> VehicleModel``
-    description : str
-        One line for ``--help``.
-    """
-
-    params: Any  # a parameter dataclass
-    build: Callable[..., VehicleModel]
-    description: str
-
-    def states(self, vehicle) -> list[str]:
-        """The state labels, in the order of ``x0``."""
-        return list(self.build(vehicle, road=False).system.state_labels)
-
-
-#: The vehicles a `Scenario` runs, by its ``model`` name. A new vehicle is one
-#: entry here (its parameters become TOML keys and command-line options).
-MODELS: dict[str, ModelKind] = {
-    "quarter": ModelKind(QuarterCarParams, quarter_car_model, "the seed's quarter car"),
-    "half": ModelKind(HalfCarParams, half_car_model, "the bounce-pitch half car"),
-    "full": ModelKind(FullCarParams, full_car_model, "the heave-pitch-roll full car"),
-    "nonlinear": ModelKind(
-        QuarterCarParams,
-        nonlinear_quarter_car_model,
-        "the quarter car with gravity and a unilateral tire (wheel lift-off), optionally a "
-        "bump stop; by default over a 20 cm, 8 m bump at 20 m/s",
-    ),
-}
-
-#: The nonlinear car's default road: the lift-off bump (the wheel is airborne
-#: 0.4356-0.5213 s), with its default run 0-0.8 s at h = 2 ms.
-NONLINEAR_ROAD = BumpRoad(height=0.2, length=8.0, speed=20.0, t0=0.1)
-NONLINEAR_T_END = 0.8
-NONLINEAR_H = 0.002
-_TIRES = ("unilateral", "linear")
+#: The model of a scenario that names none (not written in its TOML or command).
+DEFAULT_MODEL = "quarter"
+#: Kept for the name of earlier versions: a model the Scenario runs is a registry entry.
+ModelKind = ModelEntry
+#: The nonlinear car's default road and run, as its registry entry states them.
+NONLINEAR_ROAD: RoadSpec = road_from_mapping(get_model("nonlinear").defaults.road or {})
+NONLINEAR_T_END = get_model("nonlinear").defaults.t_end
+NONLINEAR_H = get_model("nonlinear").defaults.h
 
 
 def vehicle_keys() -> tuple[str, ...]:
     """Every parameter name of every model in `MODELS`, each once, in order."""
-    return tuple(dict.fromkeys(f.name for kind in MODELS.values() for f in fields(kind.params)))
+    return tuple(parameter_keys())
 
 
-_RUN_KEYS = ("t_end", "h", "x0", "methods", "max_steps", "model", "tire", "bump_stop", "events")
-#: The keys that apply to ``model = "nonlinear"`` only.
-_NONLINEAR_KEYS = ("tire", "bump_stop", "events")
+#: The Scenario's fields that hold a model's own options (`ModelOption`) by name;
+#: the options of other registered models are held in ``model_options``.
+_OPTION_KEYS = ("tire", "bump_stop", "events")
+RUN_KEYS = ("t_end", "h", "x0", "methods", "max_steps", "model", *_OPTION_KEYS)
+
+
+def run_keys() -> tuple[str, ...]:
+    """The ``[scenario]`` keys: `RUN_KEYS` and every registered model's options."""
+    options = (o.name for e in MODELS.values() for o in e.options)
+    return tuple(dict.fromkeys((*RUN_KEYS, *options)))
+
+
 #: The flat road keys of the ``[scenario]`` table of earlier versions.
 _LEGACY_ROAD_KEYS = ("road", "road_class", "speed", "seed")
 
@@ -466,15 +384,12 @@ _LEGACY_ROAD_KEYS = ("road", "road_class", "speed", "seed")
 def _model_name(model, vehicle) -> str:
     """The model's name: given, or read from the vehicle's type, else ``'quarter'``."""
     if model is None:
-        kind = next((k for k, m in MODELS.items() if isinstance(vehicle, m.params)), "quarter")
-        return kind
-    if not isinstance(model, str) or model not in MODELS:
-        raise ScenarioError(
-            f"model must be one of {', '.join(map(repr, MODELS))}, got {model!r}",
-            "scenario",
-            "model",
-        )
-    return model
+        entry = model_for_params(vehicle)
+        return DEFAULT_MODEL if entry is None else entry.name
+    try:
+        return get_model(model).name
+    except ValueError as exc:
+        raise ScenarioError(str(exc), "scenario", "model") from None
 
 
 def _vehicle(values, model: str):
@@ -541,6 +456,32 @@ def _sequence(value) -> list | None:
     return None
 
 
+def _road(road: Any, default: Mapping[str, Any] | None) -> RoadSpec:
+    """The scenario's road from what was given, over the model's default road.
+
+    None (or an empty table) is the model's default road; a table of the
+    default road's kind (or without a kind) takes the parameters it does
+    not give from the default road.
+    """
+    if isinstance(road, Mapping) and not road:
+        road = None
+    if road is None:
+        road = dict(default) if default else NoRoad()
+    if isinstance(road, str):
+        road = {"kind": road}
+    if isinstance(road, Mapping):
+        if default and road.get("kind", default["kind"]) == default["kind"]:
+            road = {**default, **road}
+        road = road_from_mapping(road)
+    if not isinstance(road, (Road, ISO8608Road)):
+        raise ScenarioError(
+            f"road must be a Road (e.g. BumpRoad(height=0.1)) or a table with 'kind', got {road!r}",
+            "scenario",
+            "road",
+        )
+    return road
+
+
 @dataclass(frozen=True)
 class Scenario:
     """One method comparison: vehicle, initial state, road, time grid and methods.
@@ -601,6 +542,10 @@ class Scenario:
     events : bool, optional
         Whether the nonlinear car's methods step to each switching time
         (default True; the convergence study runs both ways regardless).
+    model_options : mapping, optional
+        The options of a registered model that are not fields here
+        (`qc_control.ModelOption`), by name; each checked by its option and
+        defaulted. Held as ``((name, value), ...)``; `option` reads one.
 
     Examples
     --------
@@ -614,7 +559,7 @@ class Scenario:
     """
 
     vehicle: Any = None
-    road: Road = None  # type: ignore[assignment]  # resolved: NoRoad, or the nonlinear default
+    road: RoadSpec = None  # type: ignore[assignment]  # resolved: NoRoad, or the nonlinear default
     # None resolves to the default in __post_init__: the attribute is always set
     x0: tuple[float, ...] = None  # type: ignore[assignment]
     t_end: float = None  # type: ignore[assignment]
@@ -625,41 +570,22 @@ class Scenario:
     tire: str | None = None
     bump_stop: tuple[float, float] | None = None
     events: bool | None = None
+    model_options: Any = None  # resolved: a tuple of (name, value) pairs, hashable
 
     def __post_init__(self):
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
         put("model", _model_name(self.model, self.vehicle))
         put("vehicle", _vehicle(self.vehicle, self.model))
-        nonlinear = self.model == "nonlinear"
-        road: Any = self.road
-        if isinstance(road, Mapping) and not road:
-            road = None
-        if road is None:
-            road = NONLINEAR_ROAD if nonlinear else NoRoad()
-        if isinstance(road, str):
-            road = {"kind": road}
-        if isinstance(road, Mapping):
-            if nonlinear and road.get("kind", NONLINEAR_ROAD.kind) == NONLINEAR_ROAD.kind:
-                # the nonlinear car's bump is the lift-off bump, changed where given
-                road = {"kind": NONLINEAR_ROAD.kind, **NONLINEAR_ROAD.params(), **road}
-            road = road_from_mapping(road)
-        if not isinstance(road, Road):
-            raise ScenarioError(
-                f"road must be a Road (e.g. BumpRoad(height=0.1)) or a table with 'kind', "
-                f"got {road!r}",
-                "scenario",
-                "road",
-            )
+        defaults = self.entry.defaults
+        road = _road(self.road, defaults.road)
         put("road", road)
         put("methods", self._methods(self.methods))
-        if self.t_end is None:
-            put("t_end", NONLINEAR_T_END if nonlinear else DEFAULT_T_END)
+        put("t_end", defaults.t_end if self.t_end is None else self.t_end)
         put("t_end", _number("scenario", "t_end", self.t_end, "s", positive=True))
         limit = road.largest_step()
         chosen = self.h is None
         if chosen:
-            default = NONLINEAR_H if nonlinear else DEFAULT_H
-            put("h", default if default <= limit else _iso_step(limit))
+            put("h", defaults.h if defaults.h <= limit else _iso_step(limit))
         else:
             put("h", _number("scenario", "h", self.h, "s", positive=True))
         m = self.max_steps
@@ -677,53 +603,59 @@ class Scenario:
                 "h",
             )
         put("x0", self._x0(self.x0))
-        if self.model in ("half", "full") and not isinstance(road, NoRoad):
+        if self.entry.road_layout != "single" and not isinstance(road, NoRoad):
             self._check_speed()
-        self._nonlinear_options()
+        self._model_options()
 
-    def _nonlinear_options(self) -> None:
-        """Check (and default) the keys that apply to the nonlinear car only."""
-        put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
-        if self.model != "nonlinear":
-            for key in _NONLINEAR_KEYS:
-                value = getattr(self, key)
-                if value is not None:
-                    raise ScenarioError(
-                        f"{key} = {value!r} applies to the nonlinear car only: choose it "
-                        "(model = 'nonlinear' in [scenario], --model nonlinear)",
-                        "scenario",
-                        key,
-                    )
-            return
-        tire = "unilateral" if self.tire is None else self.tire
-        if tire not in _TIRES:
-            raise ScenarioError(
-                f"tire must be 'unilateral' or 'linear', got {tire!r}", "scenario", "tire"
-            )
-        put("tire", tire)
-        events = True if self.events is None else self.events
-        if not isinstance(events, (bool, np.bool_)):
-            raise ScenarioError(
-                f"events must be true or false, got {events!r}", "scenario", "events"
-            )
-        put("events", bool(events))
-        if self.bump_stop is not None:
-            values = _sequence(self.bump_stop)
-            if values is not None and all(isinstance(v, str) for v in values):
-                try:
-                    values = [float(v) for v in values]
-                except ValueError:
-                    values = None
-            ok = values is not None and len(values) == 2
-            ok = ok and all(_is_number(v) and math.isfinite(v) for v in values or ())
-            if not ok or not (values[0] >= 0 and values[1] > 0):  # type: ignore[index]
+    @property
+    def entry(self) -> ModelEntry:
+        """The registry entry of this scenario's model (`qc_control.models.registry`)."""
+        return get_model(self.model)
+
+    def _model_options(self) -> None:
+        """Check (and default) the keys that apply to some models only (`ModelOption`):
+        the fields ``tire``, ``bump_stop``, ``events`` and ``model_options``' entries."""
+        entry = self.entry
+        given = dict(self.model_options or {})
+        given.update({k: getattr(self, k) for k in _OPTION_KEYS if getattr(self, k) is not None})
+        for key, value in given.items():
+            if entry.option(key) is None:
+                users = [e.name for e in MODELS.values() if e.option(key) is not None]
+                if not users:
+                    raise ScenarioError(f"unknown [scenario] key {key!r}", "scenario", key)
                 raise ScenarioError(
-                    "bump_stop must be CLEARANCE,STIFFNESS: a clearance >= 0 m and a stiffness "
-                    f"> 0 N/m, finite, got {self.bump_stop!r}",
+                    f"{key} = {value!r} applies to the {' and '.join(users)} car only: "
+                    f"choose it (model = {users[0]!r} in [scenario], --model {users[0]})",
                     "scenario",
-                    "bump_stop",
+                    key,
                 )
-            put("bump_stop", (float(values[0]), float(values[1])))  # type: ignore[index]
+        extra = []
+        for option in entry.options:
+            value = given.get(option.name, option.default)
+            try:
+                checked = option.check(value)
+            except ValueError as exc:
+                raise ScenarioError(str(exc), "scenario", option.name) from None
+            if option.name in _OPTION_KEYS:
+                object.__setattr__(self, option.name, checked)
+            else:
+                extra.append((option.name, checked))
+        object.__setattr__(self, "model_options", tuple(extra))
+
+    def option(self, name: str) -> Any:
+        """The value of the model option ``name`` (a `ModelOption` of its entry)."""
+        if name in _OPTION_KEYS:
+            return getattr(self, name)
+        return dict(self.model_options)[name]
+
+    def option_arguments(self, target: str) -> dict[str, Any]:
+        """This scenario's model options bound for ``target`` (``'build'`` or
+        ``'compare'``), as the keyword arguments that take them."""
+        return {
+            o.name: o.argument(self.option(o.name))
+            for o in self.entry.options
+            if o.target == target
+        }
 
     def _check_speed(self) -> None:
         if getattr(self.road, "speed", None) is None:
@@ -780,16 +712,12 @@ class Scenario:
             )
 
     def _x0(self, x0) -> tuple[float, ...]:
-        kind = MODELS[self.model]
-        names = kind.states(self.vehicle)
+        model = self.entry.model(self.vehicle)
+        names = list(model.system.state_labels)
         if x0 is None:
             if not isinstance(self.road, NoRoad):
                 return (0.0,) * len(names)
-            if self.model == "quarter":
-                return tuple(float(v) for v in DEFAULT_X0)
-            # the body released from 5 cm, as the quarter car's DEFAULT_X0
-            body = kind.build(self.vehicle, road=False).body_disp
-            return tuple(0.05 if name == body else 0.0 for name in names)
+            return self.entry.free_start(self.vehicle)
         values = _sequence(x0)
         if values is not None and all(isinstance(v, str) for v in values):
             try:
@@ -801,7 +729,7 @@ class Scenario:
             or len(values) != len(names)
             or not all(_is_number(v) and math.isfinite(v) for v in values)
         ):
-            units = kind.build(self.vehicle, road=False).units
+            units = model.units
             raise ScenarioError(
                 f"x0 must be {len(names)} comma-separated numbers, all finite: "
                 f"{', '.join(names)} [{', '.join(units[n] for n in names)}]; got {x0!r}",
@@ -833,25 +761,26 @@ class Scenario:
     def road_input(self, T=None) -> tuple[np.ndarray | None, str]:
         """``(road samples on T, description)``; ``(None, '')`` without a road.
 
-        On a quarter car the samples are ``zr``; on a half car
-        ``[zr_front, zr_rear]`` and on a full car ``[zr_fl, zr_fr, zr_rl,
-        zr_rr]``, the rear wheels a wheelbase later. The description is
-        written from the road's actual parameters. ``T`` defaults to
-        `time_grid`.
+        The samples follow the model's road layout (`ModelEntry.road_layout`):
+        on a quarter car ``zr``; on a half car ``[zr_front, zr_rear]`` and on
+        a full car ``[zr_fl, zr_fr, zr_rl, zr_rr]``, the rear wheels a
+        wheelbase later. The description is written from the road's actual
+        parameters. ``T`` defaults to `time_grid`.
         """
         T = self.time_grid() if T is None else T
         zr, description = self.road.samples(T), self.road.describe()
-        if zr is None or self.model in ("quarter", "nonlinear"):
+        layout = self.entry.road_layout
+        if zr is None or layout == "single":
             return zr, description
         v, speed = self.vehicle, float(cast(Any, self.road).speed)
         wheelbase = v.a + v.b
         late = f"; the rear wheels {wheelbase / speed:.4g} s later ((a + b)/speed)"
-        if self.model == "half":
+        if layout == "axles":
             return roads.axle_inputs(T, zr, wheelbase, speed), description + late
         if isinstance(self.road, ISO8608Road):
             r = self.road
             left, right = roads.iso8608_tracks(
-                T, r.road_class, speed, v.track_front, r.seed, r.band
+                T, str(r.road_class), speed, v.track_front, r.seed, r.band
             )
             description += f", left and right tracks {v.track_front:g} m apart (isotropic road)"
         else:
@@ -859,21 +788,18 @@ class Scenario:
         return roads.corner_inputs(T, left, right, wheelbase, speed), description + late
 
     def vehicle_model(self, *, road: bool = False) -> VehicleModel:
-        """The `VehicleModel` this scenario runs.
+        """The `VehicleModel` this scenario runs, with this scenario's model options
+        (the nonlinear car's tire and bump stop).
 
-        The nonlinear car carries this scenario's tire and bump stop; with
-        ``road=True`` its road is this scenario's, as a function of time
-        (an ISO 8608 road, which has no closed form, as the input ``zr``).
+        With ``road=True`` a model that takes the road as a function of time
+        (`ModelEntry.road_function`) gets this scenario's road so, evaluated
+        at every stage; an ISO 8608 road, which has no closed form, stays
+        the input ``zr``.
         """
-        if self.model != "nonlinear":
-            return MODELS[self.model].build(self.vehicle, road=road)
         profile: Any = bool(road)
-        if road and not isinstance(self.road, (NoRoad, ISO8608Road)):
+        if road and self.entry.road_function and not isinstance(self.road, (NoRoad, ISO8608Road)):
             profile = functools.partial(_road_at, self.road)
-        stop = None if self.bump_stop is None else BumpStop(*self.bump_stop)
-        return nonlinear_quarter_car_model(
-            self.vehicle, tire=self.tire, bump_stop=stop, road=profile
-        )
+        return self.entry.model(self.vehicle, road=profile, **self.option_arguments("build"))
 
     def run(self, progress: Callable[[str], None] | None = None) -> MethodComparison:
         """Run the comparison: `qc_control.compare_methods` on this scenario.
@@ -883,16 +809,9 @@ class Scenario:
         """
         T = self.time_grid()
         U, description = self.road_input(T)
-        extra: dict[str, Any] = {}
-        if self.model == "nonlinear":
-            vehicle: Any = self.vehicle_model(road=U is not None)
-            if U is not None and "zr" not in vehicle.system.input_labels:
-                U, description = None, description + " (the road as a function of time)"
-            extra["events"] = None if self.events else False
-        elif self.model == "quarter":
-            vehicle = self.vehicle
-        else:
-            vehicle = self.vehicle_model(road=U is not None)
+        vehicle = self.vehicle_model(road=U is not None)
+        if U is not None and not vehicle.road_inputs():
+            U, description = None, description + " (the road as a function of time)"
         cmp = compare_methods(
             vehicle,
             T,
@@ -901,7 +820,7 @@ class Scenario:
             methods=self.methods,
             progress=progress,
             input_description=description,
-            **extra,
+            **self.option_arguments("compare"),
         )
         cmp.scenario = self
         return cmp
@@ -957,7 +876,14 @@ class Scenario:
             road = {**road, **over["road"]}
         given = {None: over["vehicle"], "scenario": over["run"], _ROAD_SECTION: over["road"]}
         try:
-            return cls(vehicle=cast(Any, vehicle), road=cast(Any, road), **run)
+            fixed = {k: v for k, v in run.items() if k in RUN_KEYS}
+            extra = {k: v for k, v in run.items() if k not in RUN_KEYS}
+            return cls(
+                vehicle=cast(Any, vehicle),
+                road=cast(Any, road),
+                model_options=extra or None,
+                **fixed,
+            )
         except ScenarioError as exc:
             from_overrides = exc.key is not None and exc.key in given.get(exc.section, {})
             section = exc.section
@@ -1016,7 +942,7 @@ class Scenario:
             *(f"{k} = {_toml_value(v)}" for k, v in self.vehicle.to_dict().items()),
             "",
             "[scenario]",
-            *([f"model = {_toml_value(self.model)}"] if self.model != "quarter" else []),
+            *([f"model = {_toml_value(self.model)}"] if self.model != DEFAULT_MODEL else []),
             f"t_end = {_toml_value(self.t_end)}",
             f"h = {_toml_value(self.h)}",
             f"x0 = {_toml_value(self.x0)}",
@@ -1024,13 +950,12 @@ class Scenario:
         ]
         if self.max_steps != MAX_STEPS:
             lines.append(f"max_steps = {self.max_steps}")
-        if self.model == "nonlinear":
-            lines.append(f"tire = {_toml_value(self.tire)}")
-            if self.bump_stop is not None:
-                lines.append(f"bump_stop = {_toml_value(self.bump_stop)}")
-            lines.append(f"events = {_toml_value(self.events)}")
-        if self.model == "nonlinear" and isinstance(self.road, NoRoad):
-            # no road is not the nonlinear car's default (the lift-off bump): say so
+        for option in self.entry.options:
+            value = self.option(option.name)
+            if value is not None:
+                lines.append(f"{option.name} = {_toml_value(value)}")
+        if self.entry.defaults.road and isinstance(self.road, NoRoad):
+            # no road is not this model's default: say so
             lines += ["", f"[{_ROAD_SECTION}]", f"kind = {_toml_value(NoRoad.kind)}"]
         elif not isinstance(self.road, NoRoad):
             lines += ["", f"[{_ROAD_SECTION}]", f"kind = {_toml_value(self.road.kind)}"]
@@ -1051,43 +976,73 @@ class Scenario:
         Every value is written with ``repr``, so the command gives the same
         numbers; defaults are written out, so it does not depend on them.
         """
-        args = ["qc-control", "report"]
         if config is not None:
-            args += ["--config", str(config)]
+            options: list[tuple[str, str | None]] = [("--config", str(config))]
         else:
-            if self.model != "quarter":
-                args += _option("--model", self.model)
-            for name, value in self.vehicle.to_dict().items():
-                args += _option("--" + name.replace("_", "-"), repr(value))
-            args += _option("--t-end", repr(self.t_end))
-            args += _option("--h", repr(self.h))
-            args += _option("--x0", ",".join(map(repr, self.x0)))
-            args += _option("--methods", ",".join(self.methods))
-            if self.max_steps != MAX_STEPS:
-                args += _option("--max-steps", str(self.max_steps))
-            if self.model == "nonlinear":
-                args += _option("--tire", str(self.tire))
-                if self.bump_stop is not None:
-                    args += _option("--bump-stop", ",".join(map(repr, self.bump_stop)))
-                if not self.events:
-                    args.append("--no-events")
-                if isinstance(self.road, NoRoad):
-                    args += _option("--road", NoRoad.kind)
-            if not isinstance(self.road, NoRoad):
-                args += _option("--road", self.road.kind)
-                for f in fields(self.road):
-                    value = getattr(self.road, f.name)
-                    text = (
-                        ",".join(map(repr, value))
-                        if isinstance(value, tuple)
-                        else value
-                        if isinstance(value, str)
-                        else repr(value)
-                    )
-                    args += _option(road_option(f), text)
+            options = self._options()
         if out is not None:
-            args += _option("--out", str(out))
-        return shlex.join(args)
+            options.append(("--out", str(out)))
+        return command_line(["report"], options)
+
+    def _options(self) -> list[tuple[str, str | None]]:
+        """``(option, value)`` pairs of ``qc-control report`` that give every value
+        of this scenario (value None: a flag)."""
+        options: list[tuple[str, str | None]] = []
+        if self.model != DEFAULT_MODEL:
+            options.append(("--model", self.model))
+        options += [(option_name(k), repr(v)) for k, v in self.vehicle.to_dict().items()]
+        options += [("--t-end", repr(self.t_end)), ("--h", repr(self.h))]
+        options += [("--x0", ",".join(map(repr, self.x0))), ("--methods", ",".join(self.methods))]
+        if self.max_steps != MAX_STEPS:
+            options.append(("--max-steps", str(self.max_steps)))
+        for option in self.entry.options:
+            value = self.option(option.name)
+            if isinstance(value, bool):
+                if value != option.default:
+                    options.append((option_flag(option.name, option.default), None))
+            elif value is not None:
+                options.append((option_name(option.name), _cli_text(value)))
+        if self.entry.defaults.road and isinstance(self.road, NoRoad):
+            options.append(("--road", NoRoad.kind))
+        if not isinstance(self.road, NoRoad):
+            options.append(("--road", self.road.kind))
+            options += [
+                (road_option(f), _cli_text(getattr(self.road, f.name))) for f in fields(self.road)
+            ]
+        return options
+
+
+def option_name(key: str) -> str:
+    """A key's option: ``--ks-front`` for ``ks_front`` (one spelling, as ``--t-end``)."""
+    return "--" + key.replace("_", "-")
+
+
+def option_flag(key: str, default: bool) -> str:
+    """The flag that turns a boolean option away from its default: ``--no-events``."""
+    return option_name(f"no_{key}" if default else key)
+
+
+def _cli_text(value) -> str:
+    """A value as the command line gives it: tuples comma-separated, floats by repr."""
+    if isinstance(value, tuple):
+        return ",".join(map(repr, value))
+    return value if isinstance(value, str) else repr(value)
+
+
+def command_line(words: list[str], options: list[tuple[str, str | None]]) -> str:
+    """``qc-control WORDS --option value ...`` as one shell-quoted line.
+
+    Parameters
+    ----------
+    words : list of str
+        The subcommand, e.g. ``['report']``.
+    options : list of (option, value)
+        Each option with its value as text, or None for a flag.
+    """
+    args = ["qc-control", *words]
+    for name, value in options:
+        args += [name] if value is None else _option(name, value)
+    return shlex.join(args)
 
 
 def _road_at(road: Road, t: float) -> float:
@@ -1139,10 +1094,10 @@ def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
             )
     road, section = table.pop("road", None), _ROAD_SECTION
     legacy = {k: table.pop(k) for k in _LEGACY_ROAD_KEYS[1:] if k in table}
-    unknown = sorted(set(table) - set(_RUN_KEYS))
+    unknown = sorted(set(table) - set(run_keys()))
     if unknown:
         raise ScenarioError(
-            f"unknown [scenario] key {unknown[0]!r}; expected {', '.join(_RUN_KEYS)} and a "
+            f"unknown [scenario] key {unknown[0]!r}; expected {', '.join(run_keys())} and a "
             f"road (a [scenario.road] table with kind and its parameters)",
             None,
             unknown[0],

@@ -25,6 +25,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 from matplotlib.ticker import NullFormatter
 
+from ..models.registry import model_for_params, model_for_system
 from ..numerics.stability import stability_function
 from .findings import coincidence_groups
 from .plotting import output_signal, output_unit
@@ -58,8 +59,8 @@ _OVERLAY_STYLES = ("-", (0, (5, 4)), (0, (1, 2.5)), (0, (8, 3, 1, 3)))
 _MARKERS = ("o", "s", "^", "v", "D")
 #: Exact responses: two greys and two styles, under the methods' colours.
 _EXACT: dict[str, dict[str, Any]] = {
-    "xs": {"color": "0.55", "lw": 4.0, "ls": "-", "alpha": 0.7},
-    "xu": {"color": "0.8", "lw": 4.0, "ls": (0, (2, 1)), "alpha": 0.9},
+    "body": {"color": "0.55", "lw": 4.0, "ls": "-", "alpha": 0.7},
+    "wheel": {"color": "0.8", "lw": 4.0, "ls": (0, (2, 1)), "alpha": 0.9},
 }
 
 
@@ -101,14 +102,19 @@ def _legend(fig, note: str = "", **kw):
     return fig.legend(**kw)
 
 
-def _body_wheel(cmp) -> tuple[str, str, str | None]:
-    """(body displacement, first wheel's displacement, first road input) labels:
+def _body_wheel(cmp) -> tuple[str, str | None, str | None]:
+    """(body displacement, wheel displacement, first road input) labels:
     ``xs``, ``xu``, ``zr`` on a quarter car, ``z``, ``xu_front``, ``zr_front``
-    on a half car."""
+    on a half car. The wheel is the model's registry entry's ``wheel_disp``
+    (None when the model has no entry or no such output: the body alone)."""
     model = getattr(cmp, "model", None)
     outputs = list(cmp.system.output_labels)
     body = model.body_disp if model is not None else "xs"
-    wheel = "xu" if "xu" in outputs else next(o for o in outputs if o.startswith("xu_"))
+    entry = None if model is None else model_for_params(model.params)
+    if entry is None:
+        entry = model_for_system(cmp.system)
+    wheel = None if entry is None else entry.wheel_disp
+    wheel = wheel if wheel in outputs else None
     roads = model.road_inputs() if model is not None else ["zr"]
     road = next((r for r in roads if r in cmp.system.input_labels), None)
     return body, wheel, road
@@ -124,9 +130,10 @@ def reference_figure(cmp) -> Figure:
         zr = np.asarray(cmp.U)[list(cmp.system.input_labels).index(road)]
         ax.plot(cmp.T, zr * _MM, color="tab:brown", lw=0.9, label=f"road {road}")
     ax.plot(ref.time, output_signal(ref, body) * _MM, "r-", lw=1.3, label=f"body {body} (exact)")
-    ax.plot(
-        ref.time, output_signal(ref, wheel) * _MM, "b--", lw=1.1, label=f"wheel {wheel} (exact)"
-    )
+    if wheel is not None:
+        ax.plot(
+            ref.time, output_signal(ref, wheel) * _MM, "b--", lw=1.1, label=f"wheel {wheel} (exact)"
+        )
     ax.set(
         xlabel="time [s]",
         ylabel="displacement [mm]",
@@ -140,19 +147,22 @@ def reference_figure(cmp) -> Figure:
 def method_figure(cmp, method: str) -> Figure:
     """One method's displacements against time, as in the seed's Figures 3-6.
 
-    Sprung mass ``xs`` in red (solid), wheel ``xu`` in blue (dashed); the
-    exact ``xs`` (dark grey, solid) and ``xu`` (light grey, dashed) are
-    drawn wide underneath.
+    The body displacement (``xs`` on a quarter car) in red (solid), the
+    wheel's (the model entry's ``wheel_disp``, ``xu``) in blue (dashed); the
+    exact ones (dark grey, solid; light grey, dashed) are drawn wide
+    underneath.
     """
     resp, ref = cmp.responses[method], cmp.reference
     body, wheel, _ = _body_wheel(cmp)
     fig = Figure(figsize=(8, 3.4), layout="constrained")
     ax = fig.subplots()
-    for name, style in ((body, "xs"), (wheel, "xu")):
+    drawn = [(body, "body", "r-", "suspension (sprung mass)")]
+    if wheel is not None:
+        drawn.append((wheel, "wheel", "b--", "wheel"))
+    for name, style, _, _ in drawn:
         ax.plot(ref.time, output_signal(ref, name) * _MM, label=f"exact {name}", **_EXACT[style])
-    xs, xu = output_signal(resp, body), output_signal(resp, wheel)
-    ax.plot(resp.time, xs * _MM, "r-", lw=1.2, label=f"suspension (sprung mass) {body}")
-    ax.plot(resp.time, xu * _MM, "b--", lw=1.2, label=f"wheel {wheel}")
+    for name, _, line, what in drawn:
+        ax.plot(resp.time, output_signal(resp, name) * _MM, line, lw=1.2, label=f"{what} {name}")
     title = f"{method}, h = {cmp.h:g} s"
     same = [g for g in coincidence_groups(cmp) if method in g]
     if same:
@@ -430,7 +440,7 @@ def transmissibility_figure(cmp) -> Figure:
     fig = Figure(figsize=(10, 6.5), layout="constrained")
     axes = fig.subplots(2, 2, sharex=True).ravel()
     for ax, (name, h) in zip(axes, tr.response.items()):
-        unit = output_unit(name)
+        unit = output_unit(name, getattr(getattr(cmp, "model", None), "units", None))
         gain = f"({unit})/m" if "/" in unit else f"{unit}/m"
         ax.loglog(tr.freqs_hz, np.abs(h), color="tab:blue", lw=1.6)
         ax.set(title=f"{name} / zr", ylabel=f"|H| [{gain}]")

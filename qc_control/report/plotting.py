@@ -16,18 +16,14 @@ from collections.abc import Iterable, Mapping
 
 import numpy as np
 
+from ..models.quarter import UNITS
+
 __all__ = ["plot_outputs", "output_signal", "output_unit", "OUTPUT_UNITS"]
 
-#: Units of the quarter car's outputs (`qc_control.models.quarter.OUTPUTS`) and inputs.
-OUTPUT_UNITS = {
-    "xs": "m",
-    "xu": "m",
-    "susp_travel": "m",
-    "tire_defl": "m",
-    "body_acc": "m/s²",
-    "zr": "m",
-    "fa": "N",
-}
+#: The units `output_unit` knows without a model's: the quarter car's
+#: (`qc_control.models.quarter.UNITS`, the one table; a `VehicleModel` carries
+#: its own as ``model.units``).
+OUTPUT_UNITS = UNITS
 
 #: Line styles that keep coinciding curves visible: solid, then dashes over it.
 _OVERLAYS = ("-", (0, (5, 4)), (0, (1, 2.5)), (0, (8, 3, 1, 3)))

@@ -22,17 +22,13 @@ import scipy
 import scipy.signal
 from scipy.integrate import solve_ivp
 
-from ..models.halfcar import FullCarParams, HalfCarParams
 from ..models.modal import ModalAnalysis, modal_analysis
-from ..models.nonlinear import NONLINEAR_OUTPUTS, nonlinear_quarter_car_model
 from ..models.quarter import (
-    OUTPUTS,
     SEED_X0,
-    STATES,
     QuarterCarParams,
     as_params,
-    quarter_car_model,
 )
+from ..models.registry import MODELS, model_for_params, model_for_system
 from ..models.vehicle import VehicleModel
 from ..numerics.integrate import DivergenceWarning, check_time_grid, uniform_step
 from ..numerics.limits import check_memory
@@ -564,35 +560,51 @@ def method_timings(
 
 
 def _as_model(sys, U, params) -> tuple[control.NonlinearIOSystem, VehicleModel | None, Any]:
-    """(system, model, params) from a system, parameters, a model, or None."""
+    """(system, model, params) from a system, parameters, a model, or None.
+
+    Parameters are built by their registry entry (`qc_control.models.registry`);
+    a bare system gets the roles of the registered model whose signals it has.
+    """
     if isinstance(sys, VehicleModel):
         return sys.system, sys, sys.params
     if _is_nonlinear(sys):
         model = _nonlinear_model(sys, params)
         return sys, model, None if model is None else model.params
-    if isinstance(sys, (HalfCarParams, FullCarParams)):
-        model = sys.model(road=U is not None)
-        return model.system, model, model.params
-    if sys is None or isinstance(sys, (QuarterCarParams, dict)):
-        model = quarter_car_model(as_params(sys), road=U is not None)
+    if sys is None or isinstance(sys, dict):
+        sys = as_params(sys)
+    entry = model_for_params(sys)
+    if entry is not None:
+        model = entry.model(sys, road=U is not None)
         return model.system, model, model.params
     if not isinstance(sys, control.StateSpace):
         raise TypeError(
             f"sys must be a control.StateSpace, a control.NonlinearIOSystem, a VehicleModel "
-            f"or QuarterCarParams, got {type(sys).__name__}"
+            f"or the parameters of a registered model ({', '.join(MODELS)}), "
+            f"got {type(sys).__name__}"
         )
-    if params is not None:
-        model = quarter_car_model(
-            params, road="zr" in sys.input_labels, actuator="fa" in sys.input_labels
-        )
-        return sys, model, params
-    try:  # a quarter car's labels: the roles are known even without the masses
-        model = quarter_car_model(road="zr" in sys.input_labels, actuator="fa" in sys.input_labels)
-        if list(model.system.output_labels) == list(sys.output_labels):
-            return sys, model, None
-    except ValueError:
-        pass
-    return sys, None, None
+    if params is not None:  # the vehicle behind the system is given
+        p = as_params(params) if isinstance(params, dict) else params
+        like = model_for_params(p)
+    else:  # the labels give the roles even without the parameters
+        p, like = None, model_for_system(sys)
+    if like is None:
+        return sys, None, None
+    try:
+        model = like.model(p, road=_has_road(sys), **_actuated(sys))
+    except (TypeError, ValueError):
+        return sys, None, None
+    if params is None and list(model.system.output_labels) != list(sys.output_labels):
+        return sys, None, None
+    return sys, model, params
+
+
+def _actuated(sys) -> dict[str, bool]:
+    """``{'actuator': True}`` for a system with the actuator force input ``fa``."""
+    return {"actuator": True} if "fa" in sys.input_labels else {}
+
+
+def _has_road(sys) -> bool:
+    return "zr" in sys.input_labels
 
 
 def compare_methods(
@@ -748,7 +760,7 @@ def compare_methods(
             "events and levels apply to nonlinear systems only: a linear comparison has "
             "no switching and always refines h five times"
         )
-    modes = modal_analysis(sys)
+    modes = modal_analysis(model)  # its corners name the modes of any registered model
     eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
     metres = [label for label in sys.output_labels if model.unit(label) == "m"]
     reference = exact_reference(sys, T, X0, U, outputs=metres, repeats=repeats if timing else 0)
@@ -1086,22 +1098,19 @@ def _bare_rebuild(name: str, params) -> VehicleModel:
 
 
 def _nonlinear_model(sys, params) -> VehicleModel | None:
-    """Roles for a bare NonlinearIOSystem with the nonlinear car's or the quarter car's labels."""
-    outputs = list(sys.output_labels)
-    road = "zr" in sys.input_labels
-    if outputs == list(NONLINEAR_OUTPUTS):
-        build: Callable[..., VehicleModel] = nonlinear_quarter_car_model
-    elif outputs in (list(OUTPUTS), [*OUTPUTS, "fa"]):  # the quarter car, or its closed loop
-        build = quarter_car_model
-    else:
-        return None
-    if list(sys.state_labels[:4]) != list(STATES):
+    """Roles for a bare NonlinearIOSystem with the signals of a registered model
+    (the nonlinear car's, or the quarter car's closed loop)."""
+    entry = model_for_system(sys)
+    if entry is None:
         return None
     if params is None:
         own = getattr(sys, "params", None) or {}
-        params = {k: own[k] for k in ("ms", "mu", "ks", "ku", "cs") if k in own} or None
-    p = as_params(params)
-    like = build(p, road=road)  # the car whose labels these are: its roles and units
+        names = [k for k in entry.keys() if k in own and k != "zeta"]  # cs states the damping
+        params = {k: own[k] for k in names} or None
+    if isinstance(params, dict):
+        params = entry.params.from_mapping(params)
+    p = entry.params() if params is None else params
+    like = entry.model(p, road=_has_road(sys))  # the car whose labels these are
     units = {**like.units, "fa": "N"}
     units.update({s: units.get(s, "-") for s in sys.state_labels})
     units.update({u: units.get(u, "-") for u in sys.input_labels})
