@@ -50,6 +50,7 @@ from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
 
 __all__ = [
     "MethodComparison",
+    "ComparisonProblem",
     "Provenance",
     "compare_methods",
     "Reference",
@@ -107,8 +108,46 @@ class Provenance(Protocol):
 
 
 @dataclass(eq=False)
-class MethodComparison:
+class ComparisonProblem:
+    """What every method of a comparison solves, as `compare_methods` checked it.
+
+    Attributes
+    ----------
+    system : control.StateSpace or control.NonlinearIOSystem
+        The vehicle's system.
+    params : object
+        The parameters the vehicle was built from (None for a bare system).
+    model : VehicleModel
+        The vehicle's description (signal roles, units).
+    T : ndarray
+        The uniform output grid [s].
+    X0 : ndarray
+        The initial state.
+    U : ndarray or None
+        The input samples on ``T``; None for the free response.
+    h : float
+        The step [s]; ``substeps`` of it per interval of ``T``.
+    substeps : int
+    methods : tuple of ButcherTableau
+    """
+
+    system: control.NonlinearIOSystem
+    params: Any
+    model: VehicleModel
+    T: np.ndarray
+    X0: np.ndarray
+    U: np.ndarray | None
+    h: float
+    substeps: int
+    methods: tuple[ButcherTableau, ...]
+
+
+@dataclass(eq=False)
+class MethodComparison(ComparisonProblem):
     """The numbers of a method comparison. See `compare_methods`.
+
+    Its problem (system, grid, start, input, step, methods) is that of
+    `ComparisonProblem`.
 
     Attributes
     ----------
@@ -146,8 +185,6 @@ class MethodComparison:
         Each method's ride metrics against the reference's [%].
     transmissibility : Transmissibility or None
         Under a road input: the road-to-ride frequency responses.
-    model : VehicleModel or None
-        The vehicle's description (signal roles, units), when known.
     scenario : Provenance or None
         The run this comparison came from, when it came from one (the
         command line's Scenario sets itself here); the report prints its
@@ -157,15 +194,6 @@ class MethodComparison:
         where Midpoint and Heun part, the linearisation behind ``modes``.
     """
 
-    system: control.NonlinearIOSystem
-    params: QuarterCarParams | None
-    model: VehicleModel | None
-    T: np.ndarray
-    X0: np.ndarray
-    U: np.ndarray | None
-    h: float
-    substeps: int
-    methods: tuple[ButcherTableau, ...]
     table: pd.DataFrame
     modes: ModalAnalysis
     numerical_modes: dict
@@ -691,20 +719,6 @@ def _as_model(sys, U, params) -> tuple[control.NonlinearIOSystem, VehicleModel |
     return sys, None, None
 
 
-class _Problem(NamedTuple):
-    """What every method solves: the vehicle, the grid, the start, the input, the step."""
-
-    system: control.NonlinearIOSystem
-    model: VehicleModel
-    params: Any
-    T: np.ndarray
-    X0: np.ndarray
-    U: np.ndarray | None
-    h: float
-    substeps: int
-    methods: tuple[ButcherTableau, ...]
-
-
 def _tableaus(methods: Sequence) -> tuple[ButcherTableau, ...]:
     """The methods by name or tableau: at least one, each once."""
     tabs = tuple(get_method(m) for m in methods)
@@ -716,7 +730,9 @@ def _tableaus(methods: Sequence) -> tuple[ButcherTableau, ...]:
     return tabs
 
 
-def _problem(sys, model, params, T, X0, U, methods: Sequence, h, repeats) -> _Problem:
+def _checked_problem(
+    sys, model, params, T, X0, U, methods: Sequence, h, repeats
+) -> ComparisonProblem:
     """The comparison's arguments checked, each error naming the value and what was expected."""
     if model is None:
         raise ValueError(
@@ -740,7 +756,7 @@ def _problem(sys, model, params, T, X0, U, methods: Sequence, h, repeats) -> _Pr
         f"a method comparison over {T.size - 1} steps (refined down to h/{2**_LEVELS})",
         "use a shorter run or a larger step",
     )
-    return _Problem(sys, model, params, T, X0, U, h, substeps, tabs)
+    return ComparisonProblem(sys, params, model, T, X0, U, h, substeps, tabs)
 
 
 @dataclass(frozen=True, eq=False)
@@ -763,14 +779,14 @@ class _Measured:
     nonlinear: NonlinearStudy | None = None
 
 
-def _on_road(problem: _Problem) -> bool:
+def _on_road(problem: ComparisonProblem) -> bool:
     """Whether the input is the vehicle's road, one height per wheel: ride metrics apply."""
     roads = problem.model.road_inputs()
     return problem.U is not None and bool(roads) and list(problem.system.input_labels) == roads
 
 
 def _linear_times(
-    problem: _Problem, reference: Reference, repeats: int, timing: bool
+    problem: ComparisonProblem, reference: Reference, repeats: int, timing: bool
 ) -> pd.DataFrame:
     """The wall-time columns of a linear comparison (NaN without ``timing``)."""
     names = [t.name for t in problem.methods]
@@ -785,7 +801,7 @@ def _linear_times(
 
 
 def _measure_linear(
-    problem: _Problem, repeats: int, timing: bool, progress: Callable[[str], None] | None
+    problem: ComparisonProblem, repeats: int, timing: bool, progress: Callable[[str], None] | None
 ) -> _Measured:
     """The linear path: python-control's exact response, each method at h and refined."""
     sys, model, T, X0, U = problem.system, problem.model, problem.T, problem.X0, problem.U
@@ -820,7 +836,7 @@ def _measure_linear(
     )
 
 
-def _cost_columns(problem: _Problem, responses: dict) -> pd.DataFrame:
+def _cost_columns(problem: ComparisonProblem, responses: dict) -> pd.DataFrame:
     """Each method's order, stages, step and what its run at h cost."""
     tabs, names = problem.methods, [t.name for t in problem.methods]
     return pd.DataFrame(
@@ -835,7 +851,9 @@ def _cost_columns(problem: _Problem, responses: dict) -> pd.DataFrame:
     )
 
 
-def _comparison(problem: _Problem, measured: _Measured, input_description: str) -> MethodComparison:
+def _comparison(
+    problem: ComparisonProblem, measured: _Measured, input_description: str
+) -> MethodComparison:
     """The comparison from what either path measured: errors, modes, cost, ride."""
     reference, responses, tabs = measured.reference, measured.responses, problem.methods
     numerical, stability = mode_errors(tabs, problem.h, measured.linear, measured.modes)
@@ -858,15 +876,7 @@ def _comparison(problem: _Problem, measured: _Measured, input_description: str) 
         ride_comparison(reference, responses, problem.model) if _on_road(problem) else (None, None)
     )
     return MethodComparison(
-        system=problem.system,
-        params=problem.params,
-        model=problem.model,
-        T=problem.T,
-        X0=problem.X0,
-        U=problem.U,
-        h=problem.h,
-        substeps=problem.substeps,
-        methods=tabs,
+        **vars(problem),
         table=table,
         modes=measured.modes,
         numerical_modes=numerical,
@@ -992,7 +1002,7 @@ def compare_methods(
     event times, the orders and where Midpoint and Heun part.
     """
     sys, model, params = _as_model(sys, U, params)
-    problem = _problem(sys, model, params, T, X0, U, methods, h, repeats)
+    problem = _checked_problem(sys, model, params, T, X0, U, methods, h, repeats)
     if _is_nonlinear(sys):
         measured = _measure_nonlinear(problem, events, levels, timing, progress)
     else:
@@ -1437,7 +1447,7 @@ def _displacement_accuracy(sys, model: VehicleModel, ref: NonlinearReference) ->
     return ref.accuracy * float(np.max(np.abs(ref.x)))
 
 
-def _solve_reference(problem: _Problem, levels: int, switching) -> _SolvedReference:
+def _solve_reference(problem: ComparisonProblem, levels: int, switching) -> _SolvedReference:
     """DOP853 once on the finest grid (restarted at each event), timed, with its accuracy."""
     sys, T, U = problem.system, problem.T, problem.U
     fine_T, fine_U = _refined(T, levels), _refined_input(T, U, levels)
@@ -1499,7 +1509,7 @@ class _EventConvergence(NamedTuple):
 
 
 def _event_convergence(
-    problem: _Problem,
+    problem: ComparisonProblem,
     solved: _SolvedReference,
     levels: int,
     ways: tuple[bool, ...],
@@ -1572,7 +1582,7 @@ def _method_events(at_h: dict, names: list[str], switching) -> dict:
 
 
 def _measure_nonlinear(
-    problem: _Problem, events, levels, timing: bool, progress: Callable[[str], None] | None
+    problem: ComparisonProblem, events, levels, timing: bool, progress: Callable[[str], None] | None
 ) -> _Measured:
     """The nonlinear path: a DOP853 reference, each method with and without events."""
     sys, T = problem.system, problem.T
