@@ -25,7 +25,7 @@ import tempfile
 from collections.abc import Callable
 from importlib.metadata import version
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -131,39 +131,43 @@ def _method_order(cmp) -> list[str]:
     return seed + [m for m in names if m not in SEED_FIGURES]
 
 
-def figure_specs(cmp) -> list[FigureSpec]:
-    """Every figure, in report order, numbered.
+class _FigureDraft(NamedTuple):
+    """A figure before it is numbered; the seed's methods keep the seed's numbers."""
 
-    Figure 1 is the exact response, Figure 2 all methods over it. When the
-    comparison runs any of the seed's four methods, they keep the seed's
-    numbers (Euler 3, Midpoint 4, RK4 5, Heun 6) and the other figures
-    count on from 7; otherwise figures are numbered in order.
-    """
-    nonlinear = getattr(cmp, "nonlinear", None) is not None
-    drafts: list[tuple[str, str, Callable[[], Any], int | None]] = [
-        (
-            "reference.png",
-            (
-                "The reference the methods are measured against: solve_ivp (DOP853, rtol "
-                "1e-12, restarted at every event)"
-                if nonlinear
-                else "The exact response the methods are measured against: python-control's "
-                "matrix exponential"
-            )
-            + (f", under {cmp.input_description}" if getattr(cmp, "input_description", "") else ""),
-            lambda: reference_figure(cmp),
-            None,
-        ),
-        (
+    name: str
+    caption: str
+    make: Callable[[], Figure]
+    seed_number: int | None = None
+
+
+def _reference_caption(cmp) -> str:
+    if getattr(cmp, "nonlinear", None) is not None:
+        what = (
+            "The reference the methods are measured against: solve_ivp (DOP853, rtol "
+            "1e-12, restarted at every event)"
+        )
+    else:
+        what = (
+            "The exact response the methods are measured against: python-control's "
+            "matrix exponential"
+        )
+    under = getattr(cmp, "input_description", "")
+    return what + (f", under {under}" if under else "")
+
+
+def _response_figures(cmp) -> list[_FigureDraft]:
+    """The reference, all methods over it, and each method alone."""
+    drafts = [
+        _FigureDraft("reference.png", _reference_caption(cmp), lambda: reference_figure(cmp)),
+        _FigureDraft(
             "overlay.png",
             "All methods' body displacement over the exact response",
             lambda: overlay_figure(cmp),
-            None,
         ),
     ]
     for name in _method_order(cmp):
         drafts.append(
-            (
+            _FigureDraft(
                 f"method_{_slug(name)}.png",
                 f"{name}: displacement of the suspension (sprung mass, red solid) and of "
                 f"the wheel (blue dashed) against the exact ones (dark grey, light "
@@ -172,57 +176,83 @@ def figure_specs(cmp) -> list[FigureSpec]:
                 SEED_FIGURES.get(name),
             )
         )
-    drafts += [
-        (
+    return drafts
+
+
+def _analysis_figures(cmp) -> list[_FigureDraft]:
+    """Error in time, convergence, work against precision, stability regions."""
+    return [
+        _FigureDraft(
             "error.png",
             "Body-displacement error against time (log axis)",
             lambda: error_figure(cmp),
-            None,
         ),
-        (
+        _FigureDraft(
             "convergence.png",
             f"Max |{_body(cmp)} error| against h, with slope guides of each order",
             lambda: convergence_figure(cmp),
-            None,
         ),
-        (
+        _FigureDraft(
             "work_precision.png",
             f"Max |{_body(cmp)} error| against RHS evaluations (machine-independent) and against "
             "wall time (measured on this machine)",
             lambda: work_precision_figure(cmp),
-            None,
         ),
-        (
+        _FigureDraft(
             "stability.png",
             "Stability regions |R(z)| ≤ 1 with hλ of each mode, and a zoom on hλ",
             lambda: stability_figure(cmp),
-            None,
         ),
     ]
-    drafts += [(name, caption, make, None) for name, caption, make in nonlinear_figures(cmp)]
-    if cmp.ride is not None and getattr(cmp, "transmissibility", None) is not None:
-        drafts.append(
-            (
-                "transmissibility.png",
-                "Transmissibility from the road height zr (magnitude and phase); the "
-                "circle is the invariant point √(ku/mu), where |body_acc/zr| = ku/ms for "
-                "every damper",
-                lambda: transmissibility_figure(cmp),
-                None,
-            )
+
+
+def _ride_figures(cmp) -> list[_FigureDraft]:
+    """The transmissibility, when the comparison ran on a road and has one."""
+    if cmp.ride is None or getattr(cmp, "transmissibility", None) is None:
+        return []
+    return [
+        _FigureDraft(
+            "transmissibility.png",
+            "Transmissibility from the road height zr (magnitude and phase); the "
+            "circle is the invariant point √(ku/mu), where |body_acc/zr| = ku/ms for "
+            "every damper",
+            lambda: transmissibility_figure(cmp),
         )
-    seed_present = any(d[3] is not None for d in drafts)
+    ]
+
+
+def _numbered_figures(drafts: list[_FigureDraft]) -> list[FigureSpec]:
+    """Number the figures in order; with a seed method present, 3-6 are the seed's."""
+    seed_present = any(d.seed_number is not None for d in drafts)
     specs, count = [], 0
-    for name, caption, make, fixed in drafts:
-        if fixed is None:
+    for draft in drafts:
+        if draft.seed_number is None:
             count += 1
             if seed_present and 3 <= count <= 6:
                 count = 7
             number = count
         else:
-            number = fixed
-        specs.append(FigureSpec(name, f"Figure {number}", caption, make))
+            number = draft.seed_number
+        specs.append(FigureSpec(draft.name, f"Figure {number}", draft.caption, draft.make))
     return specs
+
+
+def figure_specs(cmp) -> list[FigureSpec]:
+    """Every figure, in report order, numbered.
+
+    Figure 1 is the exact response, Figure 2 all methods over it. When the
+    comparison runs any of the seed's four methods, they keep the seed's
+    numbers (Euler 3, Midpoint 4, RK4 5, Heun 6) and the other figures
+    count on from 7; otherwise figures are numbered in order.
+    """
+    return _numbered_figures(
+        [
+            *_response_figures(cmp),
+            *_analysis_figures(cmp),
+            *(_FigureDraft(*figure) for figure in nonlinear_figures(cmp)),
+            *_ride_figures(cmp),
+        ]
+    )
 
 
 def _scenario_text(cmp) -> str:
@@ -283,16 +313,10 @@ def _numbered(blocks: list) -> list:
     return out
 
 
-def build_blocks(cmp, command: str | None = None) -> list:
-    """The report as blocks, in the order: problem card, figures, findings, footer."""
-    table = cmp.table
-    figs = {spec.name: Image(spec.name, spec.caption, spec.label) for spec in figure_specs(cmp)}
-    blocks = [Paragraph(_scenario_text(cmp)), Heading("Problem card")]
-    if cmp.params is not None:
-        frame = pd.DataFrame(cmp.params.table(), columns=["symbol", "quantity", "value", "unit"])
-        blocks.append(Table(frame.set_index("symbol"), "Vehicle parameters"))
+def _system_blocks(cmp) -> list:
+    """The system's A and B (a nonlinear one's linearisation) and its modes."""
     study = getattr(cmp, "nonlinear", None)
-    linear = cmp.system if study is None else study.linearization
+    blocks: list = []
     if study is not None:
         blocks.append(
             Paragraph(
@@ -300,150 +324,201 @@ def build_blocks(cmp, command: str | None = None) -> list:
                 "linearisation at the static equilibrium (x = 0, u = 0)."
             )
         )
+    linear = cmp.system if study is None else study.linearization
     blocks.append(Code(_matrix("A", linear.A) + "\n\n" + _matrix("B", linear.B)))
-    modes = cmp.modes.to_frame()
     blocks.append(
         Table(
-            modes,
+            cmp.modes.to_frame(),
             f"Modes from the eigenvalues of {'A' if study is None else 'the linearised A'} "
             "(eigenvalue, natural and damped frequency, modal and nominal damping, mode shape)",
         )
     )
     if cmp.modes.note:
         blocks.append(Paragraph(cmp.modes.note))
-    if study is None:
-        blocks.append(
-            Paragraph(
-                f"Reference: {cmp.reference_name}, the exact solution for an input linear "
-                f"between samples (matrix exponential). Its own accuracy: it differs from "
-                f"{cmp.reference_description} by at most {fmt(cmp.reference_error)} m. "
-                f"It took {fmt(cmp.reference_time * 1e3)} ms."
-            )
-        )
-    else:
-        blocks.append(Paragraph(reference_text(cmp)))
-    blocks.append(figs["reference.png"])
+    return blocks
 
-    blocks += [Heading("All methods against the reference"), figs["overlay.png"]]
+
+def _exact_reference_text(cmp) -> str:
+    """The reference paragraph of a linear comparison."""
+    return (
+        f"Reference: {cmp.reference_name}, the exact solution for an input linear "
+        f"between samples (matrix exponential). Its own accuracy: it differs from "
+        f"{cmp.reference_description} by at most {fmt(cmp.reference_error)} m. "
+        f"It took {fmt(cmp.reference_time * 1e3)} ms."
+    )
+
+
+def _problem_card(cmp, figs: dict[str, Image]) -> list:
+    """The run, the vehicle, its system and modes, and the reference."""
+    blocks: list = [Paragraph(_scenario_text(cmp)), Heading("Problem card")]
+    if cmp.params is not None:
+        frame = pd.DataFrame(cmp.params.table(), columns=["symbol", "quantity", "value", "unit"])
+        blocks.append(Table(frame.set_index("symbol"), "Vehicle parameters"))
+    blocks += _system_blocks(cmp)
+    linear = getattr(cmp, "nonlinear", None) is None
+    blocks.append(Paragraph(_exact_reference_text(cmp) if linear else reference_text(cmp)))
+    blocks.append(figs["reference.png"])
+    return blocks
+
+
+def _response_blocks(cmp, figs: dict[str, Image]) -> list:
+    """All methods over the reference, then each method's own figure."""
+    blocks: list = [Heading("All methods against the reference"), figs["overlay.png"]]
     blocks.append(Heading("Per-method responses"))
     names = [tab.name for tab in cmp.methods]
     seed = [m for m in SEED_FIGURES if m in names]
     if seed:
+        every = len(seed) == len(SEED_FIGURES)
         blocks.append(
             Paragraph(
                 "Figures 3–6 keep the seed paper's numbers: Euler, Midpoint, RK4, Heun"
                 + (
                     "."
-                    if len(seed) == len(SEED_FIGURES)
+                    if every
                     else "; the numbers of the seed's methods not run here are left out."
                 )
             )
         )
-    blocks += [figs[f"method_{_slug(name)}.png"] for name in _method_order(cmp)]
+    return blocks + [figs[f"method_{_slug(name)}.png"] for name in _method_order(cmp)]
 
+
+def _accuracy_blocks(cmp, figs: dict[str, Image]) -> list:
+    table = cmp.table
     accuracy = [c for c in table.columns if "err" in c and "freq" not in c and "zeta" not in c]
-    blocks += [
+    return [
         Heading("Accuracy"),
         figs["error.png"],
         Table(table[accuracy], "Errors against the reference over the whole run"),
     ]
 
-    blocks += [Heading("Convergence"), figs["convergence.png"]]
+
+def _convergence_blocks(cmp, figs: dict[str, Image]) -> list:
+    """The error at each refinement of h, and the order observed from it."""
     conv = cmp.convergence.pivot(index="h", columns="method", values="error")
     conv = conv.sort_index(ascending=False)[[t.name for t in cmp.methods]]
     conv.index.name = "h [s]"
     finest = 2 ** int(cmp.convergence["level"].max())
-    blocks.append(Table(conv, f"Max |{_body(cmp)} error| [m] at h, h/2, …, h/{finest}"))
-    blocks.append(
+    return [
+        Heading("Convergence"),
+        figs["convergence.png"],
+        Table(conv, f"Max |{_body(cmp)} error| [m] at h, h/2, …, h/{finest}"),
         Table(
-            table[["order", "observed order"]],
+            cmp.table[["order", "observed order"]],
             "Observed order: least-squares slope of log error against log h over h, h/2 and h/4",
+        ),
+    ]
+
+
+_COST_COLUMNS = [
+    "stages",
+    "steps",
+    "RHS evals",
+    "wall time [ms]",
+    "LTI engine [ms]",
+    "time / control",
+]
+
+
+def _cost_table(cmp) -> Table:
+    """What each method's run at h cost: evaluations and wall time."""
+    if getattr(cmp, "nonlinear", None) is not None:
+        return Table(
+            cmp.table[_COST_COLUMNS[:4]],
+            f"Cost at h = {fmt(cmp.h)} s: wall time of one run through "
+            "qc.input_output_response (depends on the machine; a nonlinear system has "
+            "no LTI engine); steps include those ending at events",
         )
+    return Table(
+        cmp.table[_COST_COLUMNS],
+        f"Cost at h = {fmt(cmp.h)} s (best of several runs; wall times depend on the "
+        "machine): wall time of the step-by-step loop, as the seed runs it, and of "
+        "qc_control's LTI engine, which computes the same trajectory; control's exact "
+        f"response took {fmt(cmp.reference_time * 1e3)} ms",
     )
 
-    blocks += [Heading("Work and precision"), figs["work_precision.png"]]
-    cost_cols = [
-        "stages",
-        "steps",
-        "RHS evals",
-        "wall time [ms]",
-        "LTI engine [ms]",
-        "time / control",
-    ]
-    if study is None:
-        blocks.append(
-            Table(
-                table[cost_cols],
-                f"Cost at h = {fmt(cmp.h)} s (best of several runs; wall times depend on the "
-                "machine): wall time of the step-by-step loop, as the seed runs it, and of "
-                "qc_control's LTI engine, which computes the same trajectory; control's exact "
-                f"response took {fmt(cmp.reference_time * 1e3)} ms",
-            )
-        )
-    else:
-        blocks.append(
-            Table(
-                table[cost_cols[:4]],
-                f"Cost at h = {fmt(cmp.h)} s: wall time of one run through "
-                "qc.input_output_response (depends on the machine; a nonlinear system has "
-                "no LTI engine); steps include those ending at events",
-            )
-        )
+
+def _reach_table(cmp) -> Table:
+    """RHS evaluations to reach each tolerance, and how each was found."""
     reach = cmp.cost.T.copy()
     reach.columns = [f"to {fmt(t)} m" for t in cmp.cost.index]
     kinds = cmp.cost_kind.T
     for col, tol in zip(reach.columns, cmp.cost.index):
         reach[col] = [f"{fmt(v)} ({k[0]})" for v, k in zip(reach[col], kinds[tol])]
     reach.index.name = "method"
-    blocks.append(
-        Table(
-            reach,
-            f"RHS evaluations to reach each max |{_body(cmp)} error| "
-            "(i: interpolated between refinements, e: extrapolated with "
-            "e = C·h^p, never beyond h_max)",
-        )
+    return Table(
+        reach,
+        f"RHS evaluations to reach each max |{_body(cmp)} error| "
+        "(i: interpolated between refinements, e: extrapolated with "
+        "e = C·h^p, never beyond h_max)",
     )
 
-    blocks += [Heading("Stability and numerical modes"), figs["stability.png"]]
-    stab_cols = ["h_max [s]", "limited by", "stable"] + [
+
+def _stability_blocks(cmp, figs: dict[str, Image]) -> list:
+    table = cmp.table
+    columns = ["h_max [s]", "limited by", "stable"] + [
         c for c in table.columns if "freq err" in c or "zeta err" in c
     ]
-    blocks.append(
+    return [
+        Heading("Stability and numerical modes"),
+        figs["stability.png"],
         Table(
-            table[stab_cols],
+            table[columns],
             f"Step limit and each mode as the method sees it at h = {fmt(cmp.h)} s "
             "(frequency error of the damped frequency; zeta err = ζ_h − ζ)",
-        )
-    )
+        ),
+    ]
 
-    if cmp.ride is not None:
-        blocks.append(Heading("Road and ride"))
-        if "transmissibility.png" in figs:
-            blocks.append(figs["transmissibility.png"])
-        blocks += [
-            Table(
-                cmp.ride,
-                "Ride metrics of each method and of the exact reference "
-                "(ISO 2631-1 Wk weighting; tire load over the static "
-                "wheel load (ms + mu)·g)",
-            ),
-            Table(cmp.ride_error, "Each method's ride metrics against the reference [%]"),
+
+def _ride_blocks(cmp, figs: dict[str, Image]) -> list:
+    """Under a road input: the transmissibility and the ride metrics."""
+    if cmp.ride is None:
+        return []
+    blocks: list = [Heading("Road and ride")]
+    if "transmissibility.png" in figs:
+        blocks.append(figs["transmissibility.png"])
+    return blocks + [
+        Table(
+            cmp.ride,
+            "Ride metrics of each method and of the exact reference "
+            "(ISO 2631-1 Wk weighting; tire load over the static "
+            "wheel load (ms + mu)·g)",
+        ),
+        Table(cmp.ride_error, "Each method's ride metrics against the reference [%]"),
+    ]
+
+
+def _reproduce_blocks(cmp, command: str | None) -> list:
+    """The versions behind the numbers, and how to redo the run."""
+    versions = ", ".join(f"{k} {v}" for k, v in _versions().items())
+    written = _dt.datetime.now().isoformat(timespec="seconds")
+    return [
+        Heading("Reproduce"),
+        Paragraph(f"Versions: {versions}. Written {written}."),
+        *_reproduce(cmp, command),
+    ]
+
+
+def build_blocks(cmp, command: str | None = None) -> list:
+    """The report as blocks, in the order: problem card, figures, findings, footer."""
+    figs = {spec.name: Image(spec.name, spec.caption, spec.label) for spec in figure_specs(cmp)}
+    return _numbered(
+        [
+            *_problem_card(cmp, figs),
+            *_response_blocks(cmp, figs),
+            *_accuracy_blocks(cmp, figs),
+            *_convergence_blocks(cmp, figs),
+            Heading("Work and precision"),
+            figs["work_precision.png"],
+            _cost_table(cmp),
+            _reach_table(cmp),
+            *_stability_blocks(cmp, figs),
+            *_ride_blocks(cmp, figs),
+            *nonlinear_blocks(cmp, figs),
+            Heading("Findings"),
+            *(Paragraph(text) for text in findings(cmp)),
+            *_reproduce_blocks(cmp, command),
         ]
-    blocks += nonlinear_blocks(cmp, figs)
-    blocks.append(Heading("Findings"))
-    blocks += [Paragraph(text) for text in findings(cmp)]
-
-    blocks.append(Heading("Reproduce"))
-    versions = _versions()
-    blocks.append(
-        Paragraph(
-            "Versions: "
-            + ", ".join(f"{k} {v}" for k, v in versions.items())
-            + f". Written {_dt.datetime.now().isoformat(timespec='seconds')}."
-        )
     )
-    blocks += _reproduce(cmp, command)
-    return _numbered(blocks)
 
 
 def _csv_tables(cmp) -> dict[str, pd.DataFrame]:

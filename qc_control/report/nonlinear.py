@@ -186,69 +186,68 @@ def _errors_table(cmp) -> pd.DataFrame:
     return frame
 
 
-def nonlinear_blocks(cmp, figs: dict[str, Image]) -> list:
-    """The section: events, order with and without them, where Midpoint and Heun part."""
-    study = getattr(cmp, "nonlinear", None)
-    if study is None:
+def _switching_text(study) -> str:
+    """How the methods met the switching functions' kinks."""
+    if not study.switching_labels:
+        return (
+            "The system has no switching functions (sys.switching), so its kinks (a "
+            "clipped damper's, say) are stepped across: the methods ran without events."
+        )
+    how = (
+        "The methods above stepped to each switching time (events=True): each crossing "
+        "is located inside its step and stepped to exactly."
+        if study.events
+        else "The methods above stepped across the switching times (no events)."
+    )
+    return (
+        f"The system's right-hand side has kinks where its switching functions "
+        f"({', '.join(study.switching_labels)}) change sign. {how} The convergence "
+        "study runs every method both ways."
+    )
+
+
+def _flight_text(up: float, down: float) -> str:
+    """One flight of the wheel: when it leaves the road and when it lands."""
+    landing = (
+        f"lands at t = {fmt(down)} s: airborne for {fmt(down - up)} s."
+        if math.isfinite(down)
+        else "is still airborne at the end of the run."
+    )
+    return f"The wheel leaves the road at t = {fmt(up)} s and {landing}"
+
+
+def _event_blocks(study) -> list:
+    """The reference's events, what each means, and the wheel's flights."""
+    if not study.t_events.size:
+        if study.switching_labels:
+            return [Paragraph("No switching function changed sign in the reference.")]
         return []
-    blocks: list = [Heading("Nonlinear system: events and order")]
-    if study.switching_labels:
-        how = (
-            "The methods above stepped to each switching time (events=True): each crossing "
-            "is located inside its step and stepped to exactly."
-            if study.events
-            else "The methods above stepped across the switching times (no events)."
-        )
-        blocks.append(
-            Paragraph(
-                f"The system's right-hand side has kinks where its switching functions "
-                f"({', '.join(study.switching_labels)}) change sign. {how} The convergence "
-                "study runs every method both ways."
-            )
-        )
-    else:
-        blocks.append(
-            Paragraph(
-                "The system has no switching functions (sys.switching), so its kinks (a "
-                "clipped damper's, say) are stepped across: the methods ran without events."
-            )
-        )
-    if study.t_events.size:
-        events = pd.DataFrame(
-            {
-                "t [s]": study.t_events,
-                "switching function": study.event_labels,
-                "what happens": [
-                    _event_text(label, sign)
-                    for label, sign in zip(study.event_labels, study.event_signs)
-                ],
-            }
-        )
-        events.index = pd.RangeIndex(1, len(events) + 1, name="event")
-        blocks.append(Table(events, "The reference's events (where it restarted)"))
-        for up, down in study.airborne:
-            blocks.append(
-                Paragraph(
-                    f"The wheel leaves the road at t = {fmt(up)} s and "
-                    + (
-                        f"lands at t = {fmt(down)} s: airborne for {fmt(down - up)} s."
-                        if math.isfinite(down)
-                        else "is still airborne at the end of the run."
-                    )
-                )
-            )
-    elif study.switching_labels:
-        blocks.append(Paragraph("No switching function changed sign in the reference."))
-    blocks.append(figs["events_convergence.png"])
+    events = pd.DataFrame(
+        {
+            "t [s]": study.t_events,
+            "switching function": study.event_labels,
+            "what happens": [
+                _event_text(label, sign)
+                for label, sign in zip(study.event_labels, study.event_signs)
+            ],
+        }
+    )
+    events.index = pd.RangeIndex(1, len(events) + 1, name="event")
+    blocks: list = [Table(events, "The reference's events (where it restarted)")]
+    return blocks + [Paragraph(_flight_text(up, down)) for up, down in study.airborne]
+
+
+def _order_blocks(cmp, study) -> list:
+    """The order observed with and without events, and the errors it is fitted to."""
     orders = _orders_table(cmp)
-    blocks.append(
+    blocks: list = [
         Table(
             orders,
             "Observed order with and without events: least-squares slope of log max |"
             f"{_body(cmp)} error| against log h over h, h/2 and h/4 (errors within 10x "
             f"the reference's own, {fmt(study.error_floor)} m, left out)",
         )
-    )
+    ]
     if study.switching_labels and "rk4" in orders.index:
         with_ev, without = orders.loc["rk4", "with events"], orders.loc["rk4", "without events"]
         blocks.append(
@@ -264,25 +263,45 @@ def nonlinear_blocks(cmp, figs: dict[str, Image]) -> list:
             f"Max |{_body(cmp)} error| [m] at each h, with and without events",
         )
     )
-    part = study.parting
-    if part:
-        since = (
-            f"They part at t = {fmt(part['from [s]'])} s (the first sample where they differ "
-            f"by more than 1e-12 m)"
-            if math.isfinite(part["from [s]"])
-            else "They never differ by more than 1e-12 m"
-        )
-        blocks.append(
-            Paragraph(
-                "Midpoint and Heun give the same trajectory on a linear system with an input "
-                "linear within each step; on a nonlinear right-hand side, or an input that "
-                f"curves within a step, they part. {since}; their largest displacement "
-                f"difference is {fmt(part['max [m]'])} m, at t = {fmt(part['at [s]'])} s."
-            )
-        )
-        blocks.append(figs["parting.png"])
-    blocks.append(Paragraph(study.linearization_note))
     return blocks
+
+
+def _parting_blocks(study, figs: dict[str, Image]) -> list:
+    """Where Midpoint and Heun part, when both ran."""
+    part = study.parting
+    if not part:
+        return []
+    since = (
+        f"They part at t = {fmt(part['from [s]'])} s (the first sample where they differ "
+        f"by more than 1e-12 m)"
+        if math.isfinite(part["from [s]"])
+        else "They never differ by more than 1e-12 m"
+    )
+    return [
+        Paragraph(
+            "Midpoint and Heun give the same trajectory on a linear system with an input "
+            "linear within each step; on a nonlinear right-hand side, or an input that "
+            f"curves within a step, they part. {since}; their largest displacement "
+            f"difference is {fmt(part['max [m]'])} m, at t = {fmt(part['at [s]'])} s."
+        ),
+        figs["parting.png"],
+    ]
+
+
+def nonlinear_blocks(cmp, figs: dict[str, Image]) -> list:
+    """The section: events, order with and without them, where Midpoint and Heun part."""
+    study = getattr(cmp, "nonlinear", None)
+    if study is None:
+        return []
+    return [
+        Heading("Nonlinear system: events and order"),
+        Paragraph(_switching_text(study)),
+        *_event_blocks(study),
+        figs["events_convergence.png"],
+        *_order_blocks(cmp, study),
+        *_parting_blocks(study, figs),
+        Paragraph(study.linearization_note),
+    ]
 
 
 def nonlinear_tables(cmp) -> dict[str, pd.DataFrame]:

@@ -13,7 +13,7 @@ import time
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 import control
 import numpy as np
@@ -46,12 +46,15 @@ from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
 
 __all__ = [
     "MethodComparison",
+    "ComparisonProblem",
+    "Provenance",
     "compare_methods",
     "Reference",
     "exact_reference",
     "method_responses",
     "error_table",
     "convergence_study",
+    "ConvergencePoint",
     "observed_orders",
     "cost_to_reach",
     "mode_errors",
@@ -82,9 +85,65 @@ _LEVELS = 5
 _ROUNDING_FLOOR = 1e-13
 
 
+@runtime_checkable
+class Provenance(Protocol):
+    """The run a comparison came from, as a report records it.
+
+    Whatever set the run up (the command line's Scenario is one) can say
+    the command that redoes it and its whole setting as TOML; the report
+    prints the one and saves the other as ``scenario.toml``.
+    """
+
+    def command(self) -> str:
+        """The command that redoes the run."""
+        ...
+
+    def to_toml(self) -> str:
+        """The run's whole setting: vehicle, initial state, input, time span, step, methods."""
+        ...
+
+
 @dataclass(eq=False)
-class MethodComparison:
+class ComparisonProblem:
+    """What every method of a comparison solves, as `compare_methods` checked it.
+
+    Attributes
+    ----------
+    system : control.StateSpace or control.NonlinearIOSystem
+        The vehicle's system.
+    params : object
+        The parameters the vehicle was built from (None for a bare system).
+    model : VehicleModel
+        The vehicle's description (signal roles, units).
+    T : ndarray
+        The uniform output grid [s].
+    X0 : ndarray
+        The initial state.
+    U : ndarray or None
+        The input samples on ``T``; None for the free response.
+    h : float
+        The step [s]; ``substeps`` of it per interval of ``T``.
+    substeps : int
+    methods : tuple of ButcherTableau
+    """
+
+    system: control.NonlinearIOSystem
+    params: Any
+    model: VehicleModel
+    T: np.ndarray
+    X0: np.ndarray
+    U: np.ndarray | None
+    h: float
+    substeps: int
+    methods: tuple[ButcherTableau, ...]
+
+
+@dataclass(eq=False)
+class MethodComparison(ComparisonProblem):
     """The numbers of a method comparison. See `compare_methods`.
+
+    Its problem (system, grid, start, input, step, methods) is that of
+    `ComparisonProblem`.
 
     Attributes
     ----------
@@ -122,25 +181,15 @@ class MethodComparison:
         Each method's ride metrics against the reference's [%].
     transmissibility : Transmissibility or None
         Under a road input: the road-to-ride frequency responses.
-    model : VehicleModel or None
-        The vehicle's description (signal roles, units), when known.
-    scenario : Scenario or None
-        The run this comparison came from, when it came from one
-        (`qc_control.cli.scenario.Scenario.run`); the report saves it.
+    scenario : Provenance or None
+        The run this comparison came from, when it came from one (the
+        command line's Scenario sets itself here); the report prints its
+        command and saves its TOML.
     nonlinear : NonlinearStudy or None
         On a nonlinear system: events, the order with and without them,
         where Midpoint and Heun part, the linearisation behind ``modes``.
     """
 
-    system: control.NonlinearIOSystem
-    params: QuarterCarParams | None
-    model: VehicleModel | None
-    T: np.ndarray
-    X0: np.ndarray
-    U: np.ndarray | None
-    h: float
-    substeps: int
-    methods: tuple[ButcherTableau, ...]
     table: pd.DataFrame
     modes: ModalAnalysis
     numerical_modes: dict
@@ -159,7 +208,7 @@ class MethodComparison:
     ride: pd.DataFrame | None = None
     ride_error: pd.DataFrame | None = None
     transmissibility: Transmissibility | None = None
-    scenario: Any = None
+    scenario: Provenance | None = None
     nonlinear: NonlinearStudy | None = None
 
     def summary(self) -> pd.DataFrame:
@@ -417,6 +466,97 @@ def error_table(responses: dict, reference: Reference, model: VehicleModel) -> p
     return frame
 
 
+class ConvergencePoint(NamedTuple):
+    """One method's run at one refinement of the grid: a row of the convergence study."""
+
+    method: str
+    level: int
+    h: float
+    steps: int
+    nfev: int
+    time: float
+    error: float
+    stable: bool
+
+
+class _Refinement(NamedTuple):
+    """A method's run on one refined grid, and what it is measured against there."""
+
+    response: Any  # FixedStepResponse
+    reference: np.ndarray  # the body displacement of the reference on the same grid [m]
+    seconds: float  # wall time of one run [s]; NaN untimed
+
+
+#: How a path runs a method on a refined grid: ``run(method, level, T, U)``.
+_RefinementRun = Callable[[ButcherTableau, int, np.ndarray, np.ndarray | None], _Refinement]
+
+
+def _max_error(y: np.ndarray, reference: np.ndarray, samples: int) -> float:
+    """Largest |y - reference|; infinite for a run cut short by a divergence."""
+    if y.size != samples:
+        return math.inf
+    # a run that overflowed is infinitely wrong, whatever its samples' arithmetic gives
+    with np.errstate(invalid="ignore", over="ignore"):
+        error = float(np.max(np.abs(y - reference)))
+    return error if math.isfinite(error) else math.inf
+
+
+def _convergence_points(
+    tab: ButcherTableau,
+    T: np.ndarray,
+    U: np.ndarray | None,
+    h: float,
+    levels: int,
+    h_max: float,
+    body: int,
+    run: _RefinementRun,
+) -> tuple[list[ConvergencePoint], Any]:
+    """One method's max body-displacement error at h, h/2, ..., h/2**levels, and its run at h.
+
+    The linear and the nonlinear comparison differ only in ``run``: how the
+    method is stepped and what reference it meets on each refined grid.
+    """
+    points, at_h = [], None
+    for level in range(levels + 1):
+        Tl, Ul = _refined(T, level), _refined_input(T, U, level)
+        refinement = run(tab, level, Tl, Ul)
+        response = refinement.response
+        if level == 0:
+            at_h = response
+        y = np.asarray(response.outputs)[body]
+        points.append(
+            ConvergencePoint(
+                method=tab.name,
+                level=level,
+                h=h / 2**level,
+                steps=response.steps,
+                nfev=response.nfev,
+                time=refinement.seconds,
+                error=_max_error(y, refinement.reference, Tl.size),
+                stable=h / 2**level <= h_max,
+            )
+        )
+    return points, at_h
+
+
+def _linear_refinement(
+    sys, X0, substeps: int, body: int, timing: bool, tab, level, T, U
+) -> _Refinement:
+    """A method on a refined grid of a linear system, against the exact response there.
+
+    Its time is a second run step by step (``engine='generic'``, whose time
+    follows the RHS evaluations), as `method_timings` measures.
+    """
+    exact = np.asarray(_exact(sys, T, X0, U).outputs)[body]
+    response = _simulate(sys, T, X0, U, tab, substeps)
+    seconds = (
+        best_time(lambda: _simulate(sys, T, X0, U, tab, substeps, "generic"), 1)
+        if timing
+        else math.nan
+    )
+    return _Refinement(response, exact, seconds)
+
+
 def convergence_study(
     sys,
     T,
@@ -433,54 +573,38 @@ def convergence_study(
 ) -> pd.DataFrame:
     """Max body-displacement error at h, h/2, ..., h/2**levels, per method (long form).
 
-    Columns: method, level, h, steps, nfev, time (step-by-step wall time of
-    one run [s], NaN without ``timing``), error [m], stable (h within the
-    method's stability limit). The input is refined by linear
-    interpolation, which is the same input function.
+    Columns (`ConvergencePoint`): method, level, h, steps, nfev, time
+    (step-by-step wall time of one run [s], NaN without ``timing``), error
+    [m], stable (h within the method's stability limit). The input is
+    refined by linear interpolation, which is the same input function.
     """
     eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
     body = list(sys.output_labels).index(model.body_disp)
-    rows = []
+    run = functools.partial(_linear_refinement, sys, X0, substeps, body, timing)
+    points: list[ConvergencePoint] = []
     for tab in methods:
         if progress:
             progress(
                 f"{tab.name}: h = {h:g} s, then {levels} halvings of h for the convergence study"
             )
-        h_max = max_stable_step(tab, eig)
-        for lvl in range(levels + 1):
-            Tl, Ul = _refined(T, lvl), _refined_input(T, U, lvl)
-            exact = np.asarray(_exact(sys, Tl, X0, Ul).outputs)[body]
-            r = _simulate(sys, Tl, X0, Ul, tab, substeps)
-            t_run = (
-                best_time(lambda: _simulate(sys, Tl, X0, Ul, tab, substeps, "generic"), 1)
-                if timing
-                else math.nan
-            )
-            y = np.asarray(r.outputs)[body]
-            error = float(np.max(np.abs(y - exact[: y.size]))) if y.size == Tl.size else math.inf
-            rows.append(
-                {
-                    "method": tab.name,
-                    "level": lvl,
-                    "h": h / 2**lvl,
-                    "steps": r.steps,
-                    "nfev": r.nfev,
-                    "time": t_run,
-                    "error": error,
-                    "stable": h / 2**lvl <= h_max,
-                }
-            )
-    return pd.DataFrame(rows)
+        mine, _ = _convergence_points(tab, T, U, h, levels, max_stable_step(tab, eig), body, run)
+        points += mine
+    return pd.DataFrame(points)
 
 
-def observed_orders(convergence: pd.DataFrame, levels: int = 2) -> pd.Series:
+def observed_orders(
+    convergence: pd.DataFrame, levels: int = 2, floor: float = _ROUNDING_FLOOR
+) -> pd.Series:
     """Least-squares slope of log error against log h over the first ``levels + 1``
-    steps, per method; NaN when a step is unstable or errors are rounding."""
+    steps, per method; NaN when a step is unstable or errors are below ``floor``
+    (rounding, or within reach of a reference's own error)."""
     out = {}
     for name, rows in convergence.groupby("method", sort=False):
         mine = rows[rows["level"] <= levels]
-        out[name] = _observed_order(mine["h"], mine["error"]) if mine["stable"].all() else math.nan
-    return pd.Series(out, name="observed order")
+        out[name] = (
+            _observed_order(mine["h"], mine["error"], floor) if mine["stable"].all() else math.nan
+        )
+    return pd.Series(out, name="observed order", dtype=float)
 
 
 def cost_to_reach(
@@ -607,6 +731,186 @@ def _has_road(sys) -> bool:
     return "zr" in sys.input_labels
 
 
+def _tableaus(methods: Sequence) -> tuple[ButcherTableau, ...]:
+    """The methods by name or tableau: at least one, each once."""
+    tabs = tuple(get_method(m) for m in methods)
+    if not tabs:
+        raise ValueError("methods must name at least one method")
+    names = [t.name for t in tabs]
+    if len(set(names)) != len(names):
+        raise ValueError(f"methods must be distinct, got {names}")
+    return tabs
+
+
+def _checked_problem(
+    sys, model, params, T, X0, U, methods: Sequence, h, repeats
+) -> ComparisonProblem:
+    """The comparison's arguments checked, each error naming the value and what was expected."""
+    if model is None:
+        raise ValueError(
+            f"system {sys.name!r} is not a known vehicle: pass a VehicleModel "
+            "(e.g. qc.quarter_car_model(params, road=True)) so that the "
+            "comparison knows which output is which"
+        )
+    T = check_time_grid(np.linspace(0, DEFAULT_T_END, 1001) if T is None else T, "T")
+    h, substeps = _grid(T, h)
+    tabs = _tableaus(methods)
+    if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
+        raise ValueError(f"repeats must be a positive integer, got {repeats!r}")
+    X0 = check_initial_state(X0, sys.nstates)
+    if U is not None:
+        U = check_input_samples(U, sys.ninputs, T.size)
+    # the finest refinement holds 2**levels times the samples, states and outputs, in the
+    # method's response and the exact one, with the scans' temporaries
+    finest = (T.size - 1) * 2**_LEVELS + 1
+    check_memory(
+        6 * finest * (sys.nstates + sys.noutputs + sys.ninputs) * 8,
+        f"a method comparison over {T.size - 1} steps (refined down to h/{2**_LEVELS})",
+        "use a shorter run or a larger step",
+    )
+    return ComparisonProblem(sys, params, model, T, X0, U, h, substeps, tabs)
+
+
+@dataclass(frozen=True, eq=False)
+class _Measured:
+    """What the linear or the nonlinear path measured, for `_comparison` to assemble.
+
+    ``linear`` is the system itself, or its linearisation at rest: its
+    eigenvalues give the modes, the step limits and the numerical modes.
+    ``orders`` holds the ``observed order`` column(s) of the table.
+    """
+
+    reference: Reference
+    responses: dict
+    linear: control.StateSpace
+    modes: ModalAnalysis
+    convergence: pd.DataFrame
+    orders: pd.DataFrame
+    times: pd.DataFrame
+    transmissibility: Transmissibility | None = None
+    nonlinear: NonlinearStudy | None = None
+
+
+def _on_road(problem: ComparisonProblem) -> bool:
+    """Whether the input is the vehicle's road, one height per wheel: ride metrics apply."""
+    roads = problem.model.road_inputs()
+    return problem.U is not None and bool(roads) and list(problem.system.input_labels) == roads
+
+
+def _linear_times(
+    problem: ComparisonProblem, reference: Reference, repeats: int, timing: bool
+) -> pd.DataFrame:
+    """The wall-time columns of a linear comparison (NaN without ``timing``)."""
+    names = [t.name for t in problem.methods]
+    if not timing:
+        return pd.DataFrame(
+            math.nan, index=names, columns=["wall time [ms]", "LTI engine [ms]", "time / control"]
+        )
+    sys, T, X0, U = problem.system, problem.T, problem.X0, problem.U
+    times = method_timings(sys, T, X0, U, problem.methods, problem.substeps, repeats)
+    times["time / control"] = times["wall time [ms]"] / (1e3 * reference.time)
+    return times
+
+
+def _measure_linear(
+    problem: ComparisonProblem, repeats: int, timing: bool, progress: Callable[[str], None] | None
+) -> _Measured:
+    """The linear path: python-control's exact response, each method at h and refined."""
+    sys, model, T, X0, U = problem.system, problem.model, problem.T, problem.X0, problem.U
+    modes = modal_analysis(model)  # its corners name the modes of any registered model
+    metres = [label for label in sys.output_labels if model.unit(label) == "m"]
+    reference = exact_reference(sys, T, X0, U, outputs=metres, repeats=repeats if timing else 0)
+    responses = method_responses(sys, T, X0, U, problem.methods, problem.substeps)
+    convergence = convergence_study(
+        sys,
+        T,
+        X0,
+        U,
+        problem.methods,
+        problem.h,
+        problem.substeps,
+        model,
+        timing=timing,
+        progress=progress,
+    )
+    # one road input: the quarter car's transmissibility (a car on several axles
+    # needs the speed for its wheelbase delay: qc.transmissibility(model, speed=V))
+    one_road = _on_road(problem) and len(model.road_inputs()) == 1
+    return _Measured(
+        reference,
+        responses,
+        sys,
+        modes,
+        convergence,
+        observed_orders(convergence).to_frame(),
+        _linear_times(problem, reference, repeats, timing),
+        transmissibility(sys) if one_road and problem.params is not None else None,
+    )
+
+
+def _cost_columns(problem: ComparisonProblem, responses: dict) -> pd.DataFrame:
+    """Each method's order, stages, step and what its run at h cost."""
+    tabs, names = problem.methods, [t.name for t in problem.methods]
+    return pd.DataFrame(
+        {
+            "order": [t.order for t in tabs],
+            "stages": [t.stages for t in tabs],
+            "h [s]": problem.h,
+            "steps": [responses[n].steps for n in names],
+            "RHS evals": [responses[n].nfev for n in names],
+        },
+        index=names,
+    )
+
+
+def _comparison(
+    problem: ComparisonProblem, measured: _Measured, input_description: str
+) -> MethodComparison:
+    """The comparison from what either path measured: errors, modes, cost, ride."""
+    reference, responses, tabs = measured.reference, measured.responses, problem.methods
+    numerical, stability = mode_errors(tabs, problem.h, measured.linear, measured.modes)
+    span = float(problem.T[-1] - problem.T[0])
+    cost, cost_kind = cost_to_reach(
+        measured.convergence, tabs, span, stability["h_max [s]"].to_dict()
+    )
+    table = pd.concat(
+        [
+            _cost_columns(problem, responses),
+            measured.times,
+            error_table(responses, reference, problem.model),
+            measured.orders,
+            stability,
+        ],
+        axis=1,
+    )
+    table.index.name = "method"
+    ride, ride_error = (
+        ride_comparison(reference, responses, problem.model) if _on_road(problem) else (None, None)
+    )
+    return MethodComparison(
+        **vars(problem),
+        table=table,
+        modes=measured.modes,
+        numerical_modes=numerical,
+        convergence=measured.convergence,
+        cost=cost,
+        cost_kind=cost_kind,
+        coincident=_coincident(responses),
+        reference=reference.response,
+        reference_error=reference.error,
+        reference_time=reference.time,
+        reference_description=reference.description,
+        reference_name=reference.name,
+        responses=responses,
+        eigenvalues=np.linalg.eigvals(np.asarray(measured.linear.A, dtype=float)),
+        input_description=input_description,
+        ride=ride,
+        ride_error=ride_error,
+        transmissibility=measured.transmissibility,
+        nonlinear=measured.nonlinear,
+    )
+
+
 def compare_methods(
     sys,
     T=None,
@@ -710,129 +1014,17 @@ def compare_methods(
     event times, the orders and where Midpoint and Heun part.
     """
     sys, model, params = _as_model(sys, U, params)
-    if model is None:
-        raise ValueError(
-            f"system {sys.name!r} is not a known vehicle: pass a VehicleModel "
-            "(e.g. qc.quarter_car_model(params, road=True)) so that the "
-            "comparison knows which output is which"
-        )
-    T = check_time_grid(np.linspace(0, DEFAULT_T_END, 1001) if T is None else T, "T")
-    h, substeps = _grid(T, h)
-    tabs = tuple(get_method(m) for m in methods)
-    if not tabs:
-        raise ValueError("methods must name at least one method")
-    names = [t.name for t in tabs]
-    if len(set(names)) != len(names):
-        raise ValueError(f"methods must be distinct, got {names}")
-    if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
-        raise ValueError(f"repeats must be a positive integer, got {repeats!r}")
-    X0 = check_initial_state(X0, sys.nstates)
-    if U is not None:
-        U = check_input_samples(U, sys.ninputs, T.size)
-
-    # the finest refinement holds 2**levels times the samples, states and outputs, in the
-    # method's response and the exact one, with the scans' temporaries
-    finest = (T.size - 1) * 2**_LEVELS + 1
-    check_memory(
-        6 * finest * (sys.nstates + sys.noutputs + sys.ninputs) * 8,
-        f"a method comparison over {T.size - 1} steps (refined down to h/{2**_LEVELS})",
-        "use a shorter run or a larger step",
-    )
+    problem = _checked_problem(sys, model, params, T, X0, U, methods, h, repeats)
     if _is_nonlinear(sys):
-        return _compare_nonlinear(
-            sys,
-            model,
-            params,
-            T,
-            X0,
-            U,
-            tabs,
-            h,
-            substeps,
-            events=events,
-            levels=levels,
-            timing=timing,
-            progress=progress,
-            input_description=input_description,
-        )
-    if events is not None or levels is not None:
-        raise ValueError(
-            "events and levels apply to nonlinear systems only: a linear comparison has "
-            "no switching and always refines h five times"
-        )
-    modes = modal_analysis(model)  # its corners name the modes of any registered model
-    eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
-    metres = [label for label in sys.output_labels if model.unit(label) == "m"]
-    reference = exact_reference(sys, T, X0, U, outputs=metres, repeats=repeats if timing else 0)
-    responses = method_responses(sys, T, X0, U, tabs, substeps)
-    errors = error_table(responses, reference, model)
-    convergence = convergence_study(
-        sys, T, X0, U, tabs, h, substeps, model, timing=timing, progress=progress
-    )
-    orders = observed_orders(convergence)
-    nm, stability = mode_errors(tabs, h, sys, modes)
-    cost, cost_kind = cost_to_reach(
-        convergence, tabs, float(T[-1] - T[0]), stability["h_max [s]"].to_dict()
-    )
-    if timing:
-        times = method_timings(sys, T, X0, U, tabs, substeps, repeats)
-        times["time / control"] = times["wall time [ms]"] / (1e3 * reference.time)
+        measured = _measure_nonlinear(problem, events, levels, timing, progress)
     else:
-        times = pd.DataFrame(
-            math.nan, index=names, columns=["wall time [ms]", "LTI engine [ms]", "time / control"]
-        )
-
-    cost_cols = pd.DataFrame(
-        {
-            "order": [t.order for t in tabs],
-            "stages": [t.stages for t in tabs],
-            "h [s]": h,
-            "steps": [responses[n].steps for n in names],
-            "RHS evals": [responses[n].nfev for n in names],
-        },
-        index=names,
-    )
-    table = pd.concat(
-        [cost_cols, times, errors, orders.rename("observed order"), stability], axis=1
-    )
-    table.index.name = "method"
-
-    ride, ride_error, trans = None, None, None
-    roads = model.road_inputs()
-    if U is not None and roads and list(sys.input_labels) == roads:
-        ride, ride_error = ride_comparison(reference, responses, model)
-        # one road input: the quarter car's transmissibility (a car on several axles
-        # needs the speed for its wheelbase delay: qc.transmissibility(model, speed=V))
-        trans = transmissibility(sys) if params is not None and len(roads) == 1 else None
-    return MethodComparison(
-        system=sys,
-        params=params,
-        model=model,
-        T=T,
-        X0=X0,
-        U=U,
-        h=h,
-        substeps=substeps,
-        methods=tabs,
-        table=table,
-        modes=modes,
-        numerical_modes=nm,
-        convergence=convergence,
-        cost=cost,
-        cost_kind=cost_kind,
-        coincident=_coincident(responses),
-        reference=reference.response,
-        reference_error=reference.error,
-        reference_time=reference.time,
-        reference_description=reference.description,
-        reference_name=reference.name,
-        responses=responses,
-        eigenvalues=eig,
-        input_description=input_description,
-        ride=ride,
-        ride_error=ride_error,
-        transmissibility=trans,
-    )
+        if events is not None or levels is not None:
+            raise ValueError(
+                "events and levels apply to nonlinear systems only: a linear comparison has "
+                "no switching and always refines h five times"
+            )
+        measured = _measure_linear(problem, repeats, timing, progress)
+    return _comparison(problem, measured, input_description)
 
 
 # ---------------------------------------------------------------- nonlinear systems
@@ -1210,27 +1402,10 @@ def _parting(cmp_responses: dict, sys, model: VehicleModel, T) -> tuple[dict, np
     }, gap
 
 
-def _compare_nonlinear(
-    sys,
-    model: VehicleModel,
-    params,
-    T,
-    X0,
-    U,
-    tabs: tuple[ButcherTableau, ...],
-    h: float,
-    substeps: int,
-    *,
-    events,
-    levels,
-    timing: bool,
-    progress,
-    input_description: str,
-) -> MethodComparison:
-    """`compare_methods` on a `control.NonlinearIOSystem` (see its Notes)."""
-    switching = _switching_labels(sys)
+def _checked_events(sys, events, switching: tuple[str, ...]) -> bool:
+    """Whether the methods step to each switching time: by default, when there are any."""
     if events is None:
-        events = bool(switching)
+        return bool(switching)
     if not isinstance(events, bool):
         raise TypeError(f"events must be None, True or False, got {events!r}")
     if events and not switching:
@@ -1238,36 +1413,32 @@ def _compare_nonlinear(
             f"events=True needs switching functions; system {sys.name!r} has none "
             "(sys.switching, as qc.nonlinear_quarter_car gives)"
         )
+    return events
+
+
+def _checked_levels(levels) -> int:
     levels = NONLINEAR_LEVELS if levels is None else levels
     if isinstance(levels, bool) or not isinstance(levels, int) or not 1 <= levels <= 6:
         raise ValueError(f"levels must be an integer from 1 to 6, got {levels!r}")
-    lin, modes, note = _linearization(sys, params)
-    eig = np.linalg.eigvals(np.asarray(lin.A, dtype=float))
+    return levels
 
-    if progress:
-        progress("reference: solve_ivp DOP853 at rtol 1e-12 (and 1e-14 for its own accuracy)")
-    fine_T, fine_U = _refined(T, levels), _refined_input(T, U, levels)
-    start = time.perf_counter()
-    ref = nonlinear_reference(
-        sys, fine_T, 0.0 if fine_U is None else fine_U, X0, events=True if switching else None
-    )
-    ref_time = time.perf_counter() - start
-    # its own error on the displacements [m], which the errors below are measured on
-    metre_states = [i for i, s in enumerate(sys.state_labels) if model.unit(s) == "m"]
-    ref_error = (
-        float(np.max(ref.state_accuracy[metre_states]))
-        if metre_states
-        else ref.accuracy * float(np.max(np.abs(ref.x)))
-    )
-    floor = max(_ROUNDING_FLOOR, _REFERENCE_MARGIN * ref_error)
-    every = 2**levels
-    x_ref = ref.x[:, ::every]
-    u_ref = None if U is None else U
-    response = control.TimeResponseData(
+
+class _SolvedReference(NamedTuple):
+    """The DOP853 reference, and what the comparison reads of it."""
+
+    solution: NonlinearReference  # on T refined 2**levels times
+    reference: Reference  # on T: the errors at h and the report's figures
+    body: np.ndarray  # the body displacement on the finest grid [m]
+    floor: float  # errors below this [m] are not fitted for an order
+
+
+def _reference_response(sys, T, x, U) -> control.TimeResponseData:
+    """The reference's states ``x`` on ``T`` as a response, with the outputs along them."""
+    return control.TimeResponseData(
         T,
-        _outputs_along(sys, T, x_ref, u_ref),
-        x_ref,
-        u_ref if u_ref is not None else np.zeros((sys.ninputs, T.size)),
+        _outputs_along(sys, T, x, U),
+        x,
+        U if U is not None else np.zeros((sys.ninputs, T.size)),
         output_labels=list(sys.output_labels),
         state_labels=list(sys.state_labels),
         input_labels=list(sys.input_labels),
@@ -1275,165 +1446,198 @@ def _compare_nonlinear(
         title=f"DOP853 reference for {sys.name}",
         issiso=sys.ninputs == 1 and sys.noutputs == 1,
     )
+
+
+def _displacement_accuracy(sys, model: VehicleModel, ref: NonlinearReference) -> float:
+    """The reference's own error on the displacements [m], which the methods' are measured on."""
+    metre_states = [i for i, s in enumerate(sys.state_labels) if model.unit(s) == "m"]
+    if metre_states:
+        return float(np.max(ref.state_accuracy[metre_states]))
+    return ref.accuracy * float(np.max(np.abs(ref.x)))
+
+
+def _solve_reference(problem: ComparisonProblem, levels: int, switching) -> _SolvedReference:
+    """DOP853 once on the finest grid (restarted at each event), timed, with its accuracy."""
+    sys, T, U = problem.system, problem.T, problem.U
+    fine_T, fine_U = _refined(T, levels), _refined_input(T, U, levels)
+    start = time.perf_counter()
+    solution = nonlinear_reference(
+        sys,
+        fine_T,
+        0.0 if fine_U is None else fine_U,
+        problem.X0,
+        events=True if switching else None,
+    )
+    seconds = time.perf_counter() - start
+    error = _displacement_accuracy(sys, problem.model, solution)
     name = (
         "scipy.integrate.solve_ivp (DOP853, rtol 1e-12, atol 1e-12·max|x_i| per state, "
         f"restarted at every switching event; scipy {scipy.__version__})"
     )
     reference = Reference(
-        response,
-        ref_error,
+        _reference_response(sys, T, solution.x[:, :: 2**levels], U),
+        error,
         "the same solve at rtol and atol 100x tighter",
         name,
-        ref_time,
+        seconds,
     )
-    body = list(sys.output_labels).index(model.body_disp)
-    body_ref = _outputs_along(sys, fine_T, ref.x, fine_U)[body]
+    body = list(sys.output_labels).index(problem.model.body_disp)
+    fine_body = _outputs_along(sys, fine_T, solution.x, fine_U)[body]
+    floor = max(_ROUNDING_FLOOR, _REFERENCE_MARGIN * error)
+    return _SolvedReference(solution, reference, fine_body, floor)
 
-    modes_run = (True, False) if switching else (False,)
-    responses: dict = {}
-    method_events: dict = {}
-    rows = []
-    for tab in tabs:
+
+def _nonlinear_refinement(
+    sys,
+    X0,
+    substeps: int,
+    events: bool,
+    fine_body,
+    levels: int,
+    timing: bool,
+    tab,
+    level,
+    T,
+    U,
+) -> _Refinement:
+    """A method on a refined grid of a nonlinear system, against the reference's samples there.
+
+    Its time is the run itself (there is no LTI engine to compare with).
+    """
+    start = time.perf_counter()
+    response = _run_nonlinear(sys, T, X0, U, tab, substeps, events)
+    seconds = time.perf_counter() - start if timing else math.nan
+    return _Refinement(response, fine_body[:: 2 ** (levels - level)], seconds)
+
+
+class _EventConvergence(NamedTuple):
+    """The convergence study run with and without events."""
+
+    frame: pd.DataFrame  # long form: method, events, level, h, steps, nfev, time, error, stable
+    at_h: dict  # (method, events) -> its response at h
+
+
+def _event_convergence(
+    problem: ComparisonProblem,
+    solved: _SolvedReference,
+    levels: int,
+    ways: tuple[bool, ...],
+    eig: np.ndarray,
+    timing: bool,
+    progress: Callable[[str], None] | None,
+) -> _EventConvergence:
+    """Every method over h, h/2, ..., h/2**levels, each way of stepping in ``ways``."""
+    sys, h = problem.system, problem.h
+    body = list(sys.output_labels).index(problem.model.body_disp)
+    rows: list[tuple[bool, ConvergencePoint]] = []
+    at_h = {}
+    for tab in problem.methods:
         h_max = max_stable_step(tab, eig)
-        for ev in modes_run:
+        for events in ways:
             if progress:
-                progress(
-                    f"{tab.name}{' with events' if ev else ''}: h = {h:g} s and {levels} halvings"
-                )
-            for lvl in range(levels + 1):
-                Tl, Ul = _refined(T, lvl), _refined_input(T, U, lvl)
-                start = time.perf_counter()
-                r = _run_nonlinear(sys, Tl, X0, Ul, tab, substeps, ev)
-                elapsed = time.perf_counter() - start
-                if lvl == 0 and ev == events:
-                    responses[tab.name] = r
-                if lvl == 0 and ev:
-                    method_events[tab.name] = (r.t_events, r.event_labels)
-                y = np.asarray(r.outputs)[body]
-                exact = body_ref[:: 2 ** (levels - lvl)]
-                with np.errstate(invalid="ignore", over="ignore"):
-                    error = float(np.max(np.abs(y - exact))) if y.size == Tl.size else math.inf
-                rows.append(
-                    {
-                        "method": tab.name,
-                        "events": ev,
-                        "level": lvl,
-                        "h": h / 2**lvl,
-                        "steps": r.steps,
-                        "nfev": r.nfev,
-                        "time": elapsed if timing else math.nan,
-                        "error": error if math.isfinite(error) else math.inf,
-                        "stable": h / 2**lvl <= h_max,
-                    }
-                )
-        if not switching:
-            method_events[tab.name] = (np.empty(0), ())
-    long = pd.DataFrame(rows)
-    orders = {}
-    for tab in tabs:
-        row = {}
-        for ev, col in ((True, "with events"), (False, "without events")):
-            mine = long[(long["method"] == tab.name) & (long["events"] == ev)]
-            row[col] = (
-                _observed_order(mine["h"], mine["error"], floor)
-                if len(mine) and mine["stable"].all()
-                else math.nan
+                with_events = " with events" if events else ""
+                progress(f"{tab.name}{with_events}: h = {h:g} s and {levels} halvings")
+            run = functools.partial(
+                _nonlinear_refinement,
+                sys,
+                problem.X0,
+                problem.substeps,
+                events,
+                solved.body,
+                levels,
+                timing,
             )
-        orders[tab.name] = row
-    order_frame = pd.DataFrame.from_dict(orders, orient="index")
-    order_frame.index.name = "method"
-    convergence = long[long["events"] == events].drop(columns="events").reset_index(drop=True)
+            points, at_h[tab.name, events] = _convergence_points(
+                tab, problem.T, problem.U, h, levels, h_max, body, run
+            )
+            rows += [(events, point) for point in points]
+    frame = pd.DataFrame([point for _, point in rows])
+    frame.insert(1, "events", [events for events, _ in rows])
+    return _EventConvergence(frame, at_h)
 
-    names = [t.name for t in tabs]
-    errors = error_table(responses, reference, model)
-    nm, stability = mode_errors(tabs, h, lin, modes)
-    cost, cost_kind = cost_to_reach(
-        convergence, tabs, float(T[-1] - T[0]), stability["h_max [s]"].to_dict()
-    )
-    level0 = convergence[convergence["level"] == 0].set_index("method")
-    times = pd.DataFrame(
+
+def _event_orders(convergence: pd.DataFrame, names: list[str], floor: float, levels: int):
+    """Per method, the observed order with and without events over every refinement."""
+    orders = pd.DataFrame(
         {
-            "wall time [ms]": 1e3 * level0["time"].reindex(names),
+            column: observed_orders(
+                convergence[convergence["events"] == events], levels, floor
+            ).reindex(names)
+            for events, column in ((True, "with events"), (False, "without events"))
+        }
+    )
+    orders.index.name = "method"
+    return orders
+
+
+def _nonlinear_times(convergence: pd.DataFrame, names: list[str]) -> pd.DataFrame:
+    """The wall-time columns: each method's run at h; no LTI engine, no exact call."""
+    at_h = convergence[convergence["level"] == 0].set_index("method")
+    return pd.DataFrame(
+        {
+            "wall time [ms]": 1e3 * at_h["time"].reindex(names),
             "LTI engine [ms]": math.nan,
             "time / control": math.nan,
         },
         index=names,
     )
-    cost_cols = pd.DataFrame(
-        {
-            "order": [t.order for t in tabs],
-            "stages": [t.stages for t in tabs],
-            "h [s]": h,
-            "steps": [responses[n].steps for n in names],
-            "RHS evals": [responses[n].nfev for n in names],
-        },
-        index=names,
-    )
-    main = "with events" if events else "without events"
-    table = pd.concat(
-        [
-            cost_cols,
-            times,
-            errors,
-            order_frame[main].rename("observed order"),
-            order_frame["with events"].rename("observed order (events)"),
-            order_frame["without events"].rename("observed order (no events)"),
-            stability,
-        ],
-        axis=1,
-    )
-    table.index.name = "method"
 
-    ride, ride_error = None, None
-    roads = model.road_inputs()
-    if U is not None and roads and list(sys.input_labels) == roads:
-        ride, ride_error = ride_comparison(reference, responses, model)
-    parting, gap = _parting(responses, sys, model, T)
-    signs, flights = _event_signs(sys, T, X0, U, ref, switching)
+
+def _method_events(at_h: dict, names: list[str], switching) -> dict:
+    """Per method, ``(t_events, event_labels)`` of its run at h with events."""
+    if not switching:
+        return {name: (np.empty(0), ()) for name in names}
+    return {name: (at_h[name, True].t_events, at_h[name, True].event_labels) for name in names}
+
+
+def _measure_nonlinear(
+    problem: ComparisonProblem, events, levels, timing: bool, progress: Callable[[str], None] | None
+) -> _Measured:
+    """The nonlinear path: a DOP853 reference, each method with and without events."""
+    sys, T = problem.system, problem.T
+    switching = _switching_labels(sys)
+    events = _checked_events(sys, events, switching)
+    levels = _checked_levels(levels)
+    lin, modes, note = _linearization(sys, problem.params)
+    if progress:
+        progress("reference: solve_ivp DOP853 at rtol 1e-12 (and 1e-14 for its own accuracy)")
+    solved = _solve_reference(problem, levels, switching)
+    ways = (True, False) if switching else (False,)
+    eig = np.linalg.eigvals(np.asarray(lin.A, dtype=float))
+    runs = _event_convergence(problem, solved, levels, ways, eig, timing, progress)
+    names = [t.name for t in problem.methods]
+    responses = {name: runs.at_h[name, events] for name in names}
+    long = runs.frame
+    convergence = long[long["events"] == events].drop(columns="events").reset_index(drop=True)
+    orders = _event_orders(long, names, solved.floor, levels)
+    parting, gap = _parting(responses, sys, problem.model, T)
+    signs, flights = _event_signs(sys, T, problem.X0, problem.U, solved.solution, switching)
     study = NonlinearStudy(
         events=events,
         switching_labels=switching,
-        t_events=ref.t_events,
-        event_labels=ref.event_labels,
+        t_events=solved.solution.t_events,
+        event_labels=solved.solution.event_labels,
         event_signs=signs,
         airborne=flights,
-        method_events=method_events,
+        method_events=_method_events(runs.at_h, names, switching),
         convergence=long,
-        orders=order_frame,
+        orders=orders,
         parting=parting,
         parting_gap=gap,
-        reference=ref,
-        error_floor=floor,
+        reference=solved.solution,
+        error_floor=solved.floor,
         linearization=lin,
         linearization_note=note,
     )
-    return MethodComparison(
-        system=sys,
-        params=params,
-        model=model,
-        T=T,
-        X0=X0,
-        U=U,
-        h=h,
-        substeps=substeps,
-        methods=tabs,
-        table=table,
-        modes=modes,
-        numerical_modes=nm,
-        convergence=convergence,
-        cost=cost,
-        cost_kind=cost_kind,
-        coincident=_coincident(responses),
-        reference=reference.response,
-        reference_error=reference.error,
-        reference_time=reference.time,
-        reference_description=reference.description,
-        reference_name=reference.name,
-        responses=responses,
-        eigenvalues=eig,
-        input_description=input_description,
-        ride=ride,
-        ride_error=ride_error,
-        transmissibility=None,
-        nonlinear=study,
+    main = "with events" if events else "without events"
+    table_orders = pd.DataFrame(
+        {
+            "observed order": orders[main],
+            "observed order (events)": orders["with events"],
+            "observed order (no events)": orders["without events"],
+        }
+    )
+    times = _nonlinear_times(convergence, names)
+    return _Measured(
+        solved.reference, responses, lin, modes, convergence, table_orders, times, None, study
     )
