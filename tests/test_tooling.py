@@ -15,6 +15,7 @@ import importlib.metadata
 import io
 import pydoc
 import re
+import shutil
 import subprocess
 import sys
 import tokenize
@@ -312,6 +313,74 @@ def test_the_import_rules_see_what_they_look_for(tmp_path, monkeypatch):
         "qc_control/b.py:13: import matplotlib",
         "qc_control/b.py:14: from .a import __dunder__",
     ]
+
+
+# --- functions that each do one thing; no repeated blocks -----------------------
+
+#: The longest a function of the package may be, in lines of code: its body
+#: without the docstring, blank lines or comment lines. Complexity is ruff's
+#: C901 (mccabe, max-complexity in pyproject.toml), run by test_ruff_check_is_clean.
+MAX_FUNCTION_LINES = 80
+
+
+def _code_lines(lines: list[str], node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+    body = node.body
+    first = body[0]
+    if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant):
+        if len(body) == 1:
+            return 0
+        first = body[1]
+    code = lines[first.lineno - 1 : node.end_lineno]
+    return sum(1 for line in code if line.strip() and not line.strip().startswith("#"))
+
+
+def long_functions(limit: int = MAX_FUNCTION_LINES) -> list[str]:
+    """Functions of the package with more than ``limit`` lines of code."""
+    offenders = []
+    for path, _, _ in _modules():
+        source = path.read_text(encoding="utf-8")
+        lines = source.splitlines()
+        for node in ast.walk(ast.parse(source)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                count = _code_lines(lines, node)
+                if count > limit:
+                    where = f"{path.relative_to(ROOT).as_posix()}:{node.lineno}"
+                    offenders.append(f"{where} {node.name}: {count} lines")
+    return offenders
+
+
+def test_no_function_is_longer_than_80_lines_of_code():
+    _assert_none(long_functions(), f"functions over {MAX_FUNCTION_LINES} lines of code")
+
+
+def test_the_length_rule_counts_code_only(tmp_path, monkeypatch):
+    """A docstring, blank lines and comments do not count; statements do."""
+    pkg = tmp_path / "qc_control"
+    pkg.mkdir()
+    body = "\n".join(f"    x{i} = {i}" for i in range(3))
+    (pkg / "a.py").write_text(
+        f'def short():\n    """A docstring\n\n    of lines."""\n\n    # why\n{body}\n'
+    )
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    monkeypatch.setattr(sys.modules[__name__], "PACKAGE", pkg)
+    assert long_functions(limit=3) == []
+    assert long_functions(limit=2) == ["qc_control/a.py:1 short: 3 lines"]
+
+
+def test_complexity_is_checked_by_ruff():
+    lint = PYPROJECT["tool"]["ruff"]["lint"]
+    assert "C901" in lint["select"]
+    assert lint["mccabe"]["max-complexity"] == 15
+    assert not any("C901" in codes for codes in lint.get("per-file-ignores", {}).values())
+
+
+@pytest.mark.skipif(shutil.which("duplicates") is None, reason="the duplicates command is absent")
+def test_the_package_repeats_no_block():
+    """No run of six or more lines, the same or of the same shape, stands
+    twice in the package (the developers' ``duplicates`` command)."""
+    run = _run(["duplicates", "--repo", "qc_control", "--seconds", "60"], timeout=120)
+    first = run.stdout.splitlines()[0] if run.stdout else run.stderr
+    assert first.startswith("no duplicates"), run.stdout
 
 
 # --- the package root --------------------------------------------------------
