@@ -36,6 +36,7 @@ from ..models.quarter import (
 from ..models.vehicle import VehicleModel
 from ..numerics.integrate import DivergenceWarning, check_time_grid, uniform_step
 from ..numerics.limits import check_memory
+from ..numerics.lti import is_nonlinear_system
 from ..numerics.methods import ButcherTableau, get_method
 from ..numerics.stability import max_stable_step, numerical_modes
 from ..responses.timeresp import (
@@ -567,7 +568,7 @@ def _as_model(sys, U, params) -> tuple[control.NonlinearIOSystem, VehicleModel |
     """(system, model, params) from a system, parameters, a model, or None."""
     if isinstance(sys, VehicleModel):
         return sys.system, sys, sys.params
-    if _is_nonlinear(sys):
+    if is_nonlinear_system(sys):
         model = _nonlinear_model(sys, params)
         return sys, model, None if model is None else model.params
     if isinstance(sys, (HalfCarParams, FullCarParams)):
@@ -726,7 +727,7 @@ def compare_methods(
         f"a method comparison over {T.size - 1} steps (refined down to h/{2**_LEVELS})",
         "use a shorter run or a larger step",
     )
-    if _is_nonlinear(sys):
+    if is_nonlinear_system(sys):
         return _compare_nonlinear(
             sys,
             model,
@@ -1066,10 +1067,6 @@ class NonlinearStudy:
     error_floor: float
     linearization: control.StateSpace
     linearization_note: str
-
-
-def _is_nonlinear(sys) -> bool:
-    return isinstance(sys, control.NonlinearIOSystem) and not isinstance(sys, control.StateSpace)
 
 
 def _switching_labels(sys) -> tuple[str, ...]:
