@@ -674,19 +674,14 @@ def _transfer_function_warnings(sys, X0, return_x) -> None:
         warnings.warn(_NONZERO_X0_FOR_TF, stacklevel=_stacklevel())
 
 
-def _discrete_forced(sys, T, U, X0, layout: _Layout, interpolate):
-    """A discrete-time or ``dt=None`` system: python-control's difference equation."""
-    data = _control_forced_response(
-        sys,
-        T,
-        U,
-        X0,
-        transpose=layout.transpose,
-        params=layout.params,
-        interpolate=interpolate,
-        return_states=layout.return_x,
-        squeeze=layout.squeeze,
-    )
+def _difference_equation(control_response, sys, T, U, X0, layout: _Layout, **keywords):
+    """A discrete-time or ``dt=None`` system: python-control's own difference
+    equation, by its ``control_response`` (`control.forced_response` or
+    `control.input_output_response`, whose own ``keywords`` are passed on)."""
+    data = control_response(
+        sys, T, U, X0, params=layout.params, transpose=layout.transpose,
+        squeeze=layout.squeeze, **keywords,
+    )  # fmt: skip
     return _wrap(data, note=_discrete_note(sys))
 
 
@@ -703,7 +698,10 @@ def _forced(sys, T, U, X0, layout: _Layout, interpolate, opts, auto=False, inner
     if layout.return_x is None:
         layout = layout._replace(return_x=control.config.defaults["forced_response.return_x"])
     if not control.isctime(sys, strict=True):
-        return _discrete_forced(sys, T, U, X0, layout, interpolate)
+        return _difference_equation(
+            _control_forced_response, sys, T, U, X0, layout,
+            interpolate=interpolate, return_states=layout.return_x,
+        )  # fmt: skip
     _transfer_function_warnings(sys, X0, layout.return_x)
     ss = _as_statespace(sys)
     run = _linear_run(ss, T, U, X0, layout.transpose, opts, auto)
@@ -781,22 +779,38 @@ def _with_aliases(kwargs: dict, **named) -> dict:
     return values
 
 
+def _grid_arguments(sysdata, kwargs, grid, options, is_step: bool, positional: str, **named):
+    """What initial, step and impulse responses share before simulating.
+
+    python-control's keyword processing (`_with_aliases`) of ``grid =
+    (timepts, timepts_num, return_states)`` and of ``named`` (each a value
+    and its sentinel); no method in the positional ``positional``; the
+    keyword-only ``options = (method, substeps, engine)``; and the time
+    grid, python-control's own when ``T`` is None or a final time.
+
+    Returns
+    -------
+    (values, opts, T, auto)
+    """
+    timepts, timepts_num, return_states = grid
+    v = _with_aliases(
+        kwargs,
+        timepts=(timepts, None),
+        **named,
+        return_states=(return_states, False),
+        timepts_num=(timepts_num, None),
+    )
+    _not_a_method(v[positional], positional)
+    opts = _Options(*options)
+    T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=is_step)
+    return v, opts, T, auto
+
+
 def forced_response(
-    sysdata,
-    timepts=None,
-    inputs=0.0,
-    initial_state=0.0,
-    transpose=False,
-    params=None,
-    interpolate=False,
-    return_states=None,
-    squeeze=None,
-    *,
-    method="rk4",
-    substeps: int = 1,
-    engine="auto",
-    **kwargs,
-):
+    sysdata, timepts=None, inputs=0.0, initial_state=0.0, transpose=False, params=None,
+    interpolate=False, return_states=None, squeeze=None,
+    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+):  # fmt: skip
     """Forced response computed by a fixed-step method.
 
     The same call as python-control 0.10.2's `control.forced_response`
@@ -888,21 +902,10 @@ def forced_response(
 
 
 def initial_response(
-    sysdata,
-    timepts=None,
-    initial_state=0,
-    output_indices=None,
-    timepts_num=None,
-    params=None,
-    transpose=False,
-    return_states=False,
-    squeeze=None,
-    *,
-    method="rk4",
-    substeps: int = 1,
-    engine="auto",
-    **kwargs,
-):
+    sysdata, timepts=None, initial_state=0, output_indices=None, timepts_num=None,
+    params=None, transpose=False, return_states=False, squeeze=None,
+    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+):  # fmt: skip
     """Initial-condition response computed by a fixed-step method.
 
     The same call as python-control 0.10.2's `control.initial_response`;
@@ -965,17 +968,11 @@ def initial_response(
     >>> bool(np.max(abs(rk4.outputs[0] - exact.outputs[0])) < 1e-8)
     True
     """
-    v = _with_aliases(
-        kwargs,
-        timepts=(timepts, None),
-        initial_state=(initial_state, 0.0),
-        output_indices=(output_indices, None),
-        return_states=(return_states, False),
-        timepts_num=(timepts_num, None),
-    )
-    _not_a_method(v["output_indices"], "output_indices")
-    opts = _Options(method, substeps, engine)
-    T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=False)
+    v, opts, T, auto = _grid_arguments(
+        sysdata, kwargs, (timepts, timepts_num, return_states), (method, substeps, engine),
+        False, "output_indices",
+        initial_state=(initial_state, 0.0), output_indices=(output_indices, None),
+    )  # fmt: skip
     X0, output = v["initial_state"], v["output_indices"]
     layout = _Layout(params, transpose, v["return_states"], squeeze)
     return _each(sysdata, lambda s: _initial(s, T, auto, X0, output, layout, opts))
@@ -1061,22 +1058,10 @@ def _as_lti_statespace(sys):
 
 
 def step_response(
-    sysdata,
-    timepts=None,
-    initial_state=0.0,
-    input_indices=None,
-    output_indices=None,
-    timepts_num=None,
-    transpose=False,
-    return_states=False,
-    squeeze=None,
-    params=None,
-    *,
-    method="rk4",
-    substeps: int = 1,
-    engine="auto",
-    **kwargs,
-):
+    sysdata, timepts=None, initial_state=0.0, input_indices=None, output_indices=None,
+    timepts_num=None, transpose=False, return_states=False, squeeze=None, params=None,
+    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+):  # fmt: skip
     """Step response computed by a fixed-step method.
 
     The same call as python-control 0.10.2's `control.step_response`: a
@@ -1109,25 +1094,18 @@ def step_response(
     >>> round(float(r.outputs[-1]), 6), r.method.name, r.substeps
     (1.0, 'rk4', 2)
     """
-    v = _with_aliases(
-        kwargs,
-        timepts=(timepts, None),
-        initial_state=(initial_state, 0.0),
-        input_indices=(input_indices, None),
-        output_indices=(output_indices, None),
-        return_states=(return_states, False),
-        timepts_num=(timepts_num, None),
-    )
-    _not_a_method(v["input_indices"], "input_indices")
-    opts = _Options(method, substeps, engine)
-    T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=True)
+    v, opts, T, auto = _grid_arguments(
+        sysdata, kwargs, (timepts, timepts_num, return_states), (method, substeps, engine),
+        True, "input_indices", initial_state=(initial_state, 0.0),
+        input_indices=(input_indices, None), output_indices=(output_indices, None),
+    )  # fmt: skip
     T = np.atleast_1d(T).reshape(-1)
     args = (v["initial_state"], v["input_indices"], v["output_indices"])
-    rest = (transpose, v["return_states"], squeeze, params, opts)
-    return _each(sysdata, lambda s: _step(s, T, auto, *args, *rest))
+    layout = _Layout(params, transpose, v["return_states"], squeeze)
+    return _each(sysdata, lambda s: _step(s, T, auto, *args, layout, opts))
 
 
-def _step(sys, T, auto, X0, inputs, output, transpose, return_x, squeeze, params, opts):
+def _step(sys, T, auto, X0, inputs, output, layout: _Layout, opts):
     if isinstance(sys, control.TransferFunction) and np.any(np.asarray(X0) != 0):
         warnings.warn(_NONZERO_X0_FOR_TF, stacklevel=_stacklevel())
     _check_system(sys)
@@ -1140,20 +1118,18 @@ def _step(sys, T, auto, X0, inputs, output, transpose, return_x, squeeze, params
         U[i, :] = 1.0
         return U
 
-    traces = _traces("step", sys, T, auto, lambda i: X0, U_of, inputs, output, opts, params)
-    shape = (transpose, return_x, squeeze)
-    return _multi_trace("Step", sys, T, traces, inputs, output, shape, params)
+    traces = _traces("step", sys, T, auto, lambda i: X0, U_of, inputs, output, opts, layout.params)
+    return _multi_trace("Step", sys, T, traces, inputs, output, layout)
 
 
-def _multi_trace(kind, sys, T, traces, inputs, output, shape, params):
-    """One response of the traces `_traces` computed (``shape``: transpose,
-    return_x, squeeze, as python-control takes them)."""
+def _multi_trace(kind, sys, T, traces, inputs, output, layout: _Layout):
+    """One response of the traces `_traces` computed, laid out as asked."""
     yout, xout, uout, parts, labels = traces
     computed, success, message = _combine(parts) if parts else (None, True, None)
     resp = _response(
         sys,
         (T if not parts else parts[-1].t, yout, xout, uout),
-        _Layout(params, *shape),
+        layout,
         _title(kind, sys.name),
         success,
         message,
@@ -1168,20 +1144,10 @@ def _multi_trace(kind, sys, T, traces, inputs, output, shape, params):
 
 
 def impulse_response(
-    sysdata,
-    timepts=None,
-    input_indices=None,
-    output_indices=None,
-    timepts_num=None,
-    transpose=False,
-    return_states=False,
-    squeeze=None,
-    *,
-    method="rk4",
-    substeps: int = 1,
-    engine="auto",
-    **kwargs,
-):
+    sysdata, timepts=None, input_indices=None, output_indices=None, timepts_num=None,
+    transpose=False, return_states=False, squeeze=None,
+    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+):  # fmt: skip
     """Impulse response computed by a fixed-step method.
 
     The same call as python-control 0.10.2's `control.impulse_response`.
@@ -1213,23 +1179,18 @@ def impulse_response(
     >>> [round(float(y), 6) for y in r.outputs]   # e^{-t}
     [1.0, 0.606531, 0.367879]
     """
-    v = _with_aliases(
-        kwargs,
-        timepts=(timepts, None),
-        input_indices=(input_indices, None),
-        output_indices=(output_indices, None),
-        return_states=(return_states, False),
-        timepts_num=(timepts_num, None),
-    )
-    _not_a_method(v["input_indices"], "input_indices")
-    opts = _Options(method, substeps, engine)
-    T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=False)
+    v, opts, T, auto = _grid_arguments(
+        sysdata, kwargs, (timepts, timepts_num, return_states), (method, substeps, engine),
+        False, "input_indices",
+        input_indices=(input_indices, None), output_indices=(output_indices, None),
+    )  # fmt: skip
     T = np.atleast_1d(T).reshape(-1)
-    args = (v["input_indices"], v["output_indices"], transpose, v["return_states"], squeeze)
-    return _each(sysdata, lambda s: _impulse(s, T, auto, *args, opts))
+    inputs, output = v["input_indices"], v["output_indices"]
+    layout = _Layout(None, transpose, v["return_states"], squeeze)
+    return _each(sysdata, lambda s: _impulse(s, T, auto, inputs, output, layout, opts))
 
 
-def _impulse(sys, T, auto, inputs, output, transpose, return_x, squeeze, opts):
+def _impulse(sys, T, auto, inputs, output, layout: _Layout, opts):
     if not isinstance(sys, control.LTI):
         raise ValueError("system must be LTI system for impulse response")
     _check_system(sys)
@@ -1254,8 +1215,7 @@ def _impulse(sys, T, auto, inputs, output, transpose, return_x, squeeze, opts):
         return U
 
     traces = _traces("impulse", sys, T, auto, X0_of, U_of, inputs, output, opts, None)
-    shape = (transpose, return_x, squeeze)
-    return _multi_trace("Impulse", sys, T, traces, inputs, output, shape, None)
+    return _multi_trace("Impulse", sys, T, traces, inputs, output, layout)
 
 
 # ---------------------------------------------------------------- nonlinear systems
@@ -1427,22 +1387,6 @@ class _IOTrajectory(NamedTuple):
     compiled: CompiledInterconnect | None
 
 
-def _io_discrete(sys, T, U, X0, layout: _Layout, t_eval):
-    """A discrete-time system: a difference equation, python-control's own loop."""
-    data = _control_io_response(
-        sys,
-        T,
-        U,
-        X0,
-        params=layout.params,
-        transpose=layout.transpose,
-        return_x=layout.return_x,
-        squeeze=layout.squeeze,
-        evaluation_times=t_eval,
-    )
-    return _wrap(data, note=_discrete_note(sys))
-
-
 def _io_problem(sys, T, U, X0, params) -> _IOProblem:
     """``T``, ``U`` and ``X0`` checked by python-control's rules, and the outputs' count."""
     if T is None or np.ndim(T) == 0:
@@ -1590,7 +1534,10 @@ def _io_response(sys, T, U, X0, layout: _Layout, io: _IOOptions):
     if not isinstance(sys, control.NonlinearIOSystem):
         raise TypeError(f"System of type {type(sys)} not valid")
     if control.isdtime(sys, strict=True):
-        return _io_discrete(sys, T, U, X0, layout, io.t_eval)
+        return _difference_equation(
+            _control_io_response, sys, T, U, X0, layout,
+            return_x=layout.return_x, evaluation_times=io.t_eval,
+        )  # fmt: skip
     prob = _io_problem(sys, T, U, X0, layout.params)
     u_of_t = linear_input(prob.T, prob.u_samples)  # python-control's interpolation of the samples
     computed = _io_step(sys, prob, layout.params, io)
@@ -1614,24 +1561,11 @@ def _io_response(sys, T, U, X0, layout: _Layout, io: _IOOptions):
 
 
 def input_output_response(
-    sys,
-    timepts=None,
-    inputs=0.0,
-    initial_state=0.0,
-    params=None,
-    ignore_errors=False,
-    transpose=False,
-    return_states=False,
-    squeeze=None,
-    solve_ivp_kwargs=None,
+    sys, timepts=None, inputs=0.0, initial_state=0.0, params=None, ignore_errors=False,
+    transpose=False, return_states=False, squeeze=None, solve_ivp_kwargs=None,
     evaluation_times="T",
-    *,
-    method="rk4",
-    substeps: int = 1,
-    events=None,
-    fast: bool = True,
-    **kwargs,
-):
+    *, method="rk4", substeps: int = 1, events=None, fast: bool = True, **kwargs,
+):  # fmt: skip
     """Response of a nonlinear (or any) input/output system, at a fixed step.
 
     The same call as python-control 0.10.2's
