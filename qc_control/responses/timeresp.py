@@ -737,11 +737,11 @@ def _linear_run(ss, T, U, X0, transpose, opts, auto) -> _LinearRun:
         f"a fixed-step response of {ss.name!r} on {T.size} samples",
         "use fewer samples (a coarser T; substeps refine the step without storing it)",
     )
-    x0 = check_initial_state(X0, ss.nstates)
+    x0 = check_initial_state(X0, ss.nstates, ss.state_labels)
     u = np.asarray(0.0 if U is None else U)
     if transpose and u.ndim == 2:
         u = u.T
-    u = check_input_samples(u, ss.ninputs, T.size)
+    u = check_input_samples(u, ss.ninputs, T.size, ss.input_labels)
     return _simulate(ss, T, u, x0, opts, auto)
 
 
