@@ -571,14 +571,14 @@ class _Layout(NamedTuple):
 def _response(sys, data, layout: _Layout, title: str, success, message, **labels):
     """A `FixedStepResponse` of ``sys``'s signals ``data = (t, y, x, u)``.
 
-    ``labels`` override the system's ``issiso``, ``output_labels`` and
-    ``input_labels`` (one output or input kept) and add python-control's
-    trace keywords.
+    ``labels``: the system's ``issiso``, ``output_labels`` and
+    ``input_labels`` unless given (all three, when one output or input is
+    kept), and python-control's trace keywords.
     """
-    named = dict(
-        issiso=sys.issiso(), output_labels=sys.output_labels, input_labels=sys.input_labels
-    )
-    named.update(labels)
+    if "issiso" not in labels:  # the whole system's signals
+        labels.update(
+            issiso=sys.issiso(), output_labels=sys.output_labels, input_labels=sys.input_labels
+        )
     return FixedStepResponse(
         *data,
         params=layout.params,
@@ -590,7 +590,7 @@ def _response(sys, data, layout: _Layout, title: str, success, message, **labels
         squeeze=layout.squeeze,
         success=success,
         message=message or None,
-        **named,
+        **labels,
     )
 
 
