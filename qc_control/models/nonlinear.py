@@ -288,6 +288,100 @@ def _check_damper(damper) -> None:
         raise ValueError(f"damper(0.0) must be finite, got {f0!r}")
 
 
+def _spring_law(spring, k3: float | None) -> Callable:
+    """``F_s(d, q)`` [N]: linear ``ks·d``, progressive ``ks·d + k3·d³``, or the user's."""
+    if spring is None:
+        return lambda d, q: q["ks"] * d
+    if k3 is not None:
+        return lambda d, q: q["ks"] * d + k3 * d**3
+    return lambda d, q: float(spring(d))
+
+
+def _damper_law(damper) -> Callable:
+    """``F_d(v, q)`` [N]: linear ``cs·v``, or the `PiecewiseDamper` or callable given."""
+    if damper is None:
+        return lambda v, q: q["cs"] * v
+    return lambda v, q: float(damper(v))
+
+
+def _road_height(road, actuator: bool):
+    """``(zr_at(t, u), inputs, ia)``: the road height [m] from the input ``zr`` or a
+    profile ``zr(t)`` (0 without either), the input labels, and the index of the
+    actuator force ``fa`` (None without one)."""
+    profile = road if callable(road) else None
+    if profile is None and not isinstance(road, bool):
+        raise TypeError(f"road must be True, False or a callable zr(t) [m], got {road!r}")
+    road_input = road is True
+    iz = 0 if road_input else None
+    ia = (1 if road_input else 0) if actuator else None
+
+    def zr_at(t, u):
+        if iz is not None:
+            return u[iz]
+        return 0.0 if profile is None else float(profile(t))
+
+    inputs = [s for s, on in (("zr", road_input), ("fa", actuator)) if on]
+    return zr_at, inputs, ia
+
+
+def _force_elements(p, *, tire: str, bump_stop, damper, spring, gravity: bool, zr_at):
+    """``elements(t, x, u, q) -> (F_s + F_d + F_b, F_t - ku δ0, F_t, δ)``, the force
+    elements at the state ``x`` (module docstring), checked and built once."""
+    if tire not in _TIRES:
+        raise ValueError(f"tire must be 'unilateral' or 'linear', got {tire!r}")
+    if bump_stop is not None and not isinstance(bump_stop, BumpStop):
+        raise TypeError(f"bump_stop must be a BumpStop or None, got {type(bump_stop).__name__}")
+    if not isinstance(gravity, bool):
+        raise TypeError(f"gravity must be True or False, got {gravity!r}")
+    unilateral = tire == "unilateral"
+    g = STANDARD_GRAVITY if gravity else 0.0
+    spring_force = _spring_law(spring, None if spring is None else _check_spring(spring, p.ks))
+    if damper is not None:
+        _check_damper(damper)
+    damper_force = _damper_law(damper)
+    stop = bump_stop
+
+    def elements(t, x, u, q):
+        vs, vu, xs, xu = x[0], x[1], x[2], x[3]
+        d, v = xs - xu, vs - vu
+        fb = stop.force(d) if stop is not None else 0.0
+        delta = xu - zr_at(t, u)
+        static = (q["ms"] + q["mu"]) * g
+        ft = static - q["ku"] * delta
+        if unilateral and ft < 0.0:
+            ft = 0.0
+        return spring_force(d, q) + damper_force(v, q) + fb, ft - static, ft, delta
+
+    return elements
+
+
+def _kinks(*, tire: str, bump_stop, damper, gravity: bool, zr_at):
+    """``(switching(t, x, u, q), labels)``: the functions whose zeros are the kinks
+    of the right-hand side (contact, stops, damper knees), and their names."""
+    g = STANDARD_GRAVITY if gravity else 0.0
+    labels: list[str] = []
+    kinks: list[Callable] = []
+    if tire == "unilateral":
+        labels.append("contact")
+        kinks.append(lambda t, x, u, q: (q["ms"] + q["mu"]) * g / q["ku"] - (x[3] - zr_at(t, u)))
+    stop = bump_stop
+    if stop is not None and math.isfinite(stop.clearance_bound):
+        labels.append("bump stop")
+        kinks.append(lambda t, x, u, q: x[2] - x[3] + stop.clearance_bound)
+    if stop is not None and math.isfinite(stop.clearance_rebound):
+        labels.append("rebound stop")
+        kinks.append(lambda t, x, u, q: stop.clearance_rebound - (x[2] - x[3]))
+    if isinstance(damper, PiecewiseDamper):
+        for knee in damper.knees():
+            labels.append(f"damper knee {knee:+g} m/s")
+            kinks.append(lambda t, x, u, q, k=knee: x[0] - x[1] - k)
+
+    def switching(t, x, u, q):
+        return np.array([k(t, x, u, q) for k in kinks])
+
+    return switching, tuple(labels)
+
+
 def nonlinear_quarter_car(
     params=None,
     *,
@@ -351,49 +445,10 @@ def nonlinear_quarter_car(
     3934.4
     """
     p = as_params(params)
-    if tire not in _TIRES:
-        raise ValueError(f"tire must be 'unilateral' or 'linear', got {tire!r}")
-    if bump_stop is not None and not isinstance(bump_stop, BumpStop):
-        raise TypeError(f"bump_stop must be a BumpStop or None, got {type(bump_stop).__name__}")
-    if not isinstance(gravity, bool):
-        raise TypeError(f"gravity must be True or False, got {gravity!r}")
-    unilateral = tire == "unilateral"
-    g = STANDARD_GRAVITY if gravity else 0.0
-    k3 = None if spring is None else _check_spring(spring, p.ks)
-    if damper is not None:
-        _check_damper(damper)
-    stop = bump_stop
-    profile = road if callable(road) else None
-    if profile is None and not isinstance(road, bool):
-        raise TypeError(f"road must be True, False or a callable zr(t) [m], got {road!r}")
-    road_input = road is True
-    iz = 0 if road_input else None
-    ia = (1 if road_input else 0) if actuator else None
-
-    def zr_at(t, u):
-        if iz is not None:
-            return u[iz]
-        return 0.0 if profile is None else float(profile(t))
-
-    def elements(t, x, u, q):
-        """The force elements at the state ``x``: ``(F_s + F_d + F_b, F_t - ku δ0, F_t, δ)``."""
-        vs, vu, xs, xu = x[0], x[1], x[2], x[3]
-        d, v = xs - xu, vs - vu
-        if spring is None:
-            fs = q["ks"] * d
-        elif k3 is not None:
-            fs = q["ks"] * d + k3 * d**3
-        else:
-            fs = float(spring(d))
-        fd = q["cs"] * v if damper is None else float(damper(v))
-        fb = stop.force(d) if stop is not None else 0.0
-        delta = xu - zr_at(t, u)
-        ku = q["ku"]
-        static = (q["ms"] + q["mu"]) * g
-        ft = static - ku * delta
-        if unilateral and ft < 0.0:
-            ft = 0.0
-        return fs + fd + fb, ft - static, ft, delta
+    zr_at, inputs, ia = _road_height(road, actuator)
+    forces = dict(tire=tire, bump_stop=bump_stop, damper=damper, gravity=gravity, zr_at=zr_at)
+    elements = _force_elements(p, spring=spring, **forces)
+    switching, switching_labels = _kinks(**forces)
 
     def update(t, x, u, q):
         f, tire_dyn, _, _ = elements(t, x, u, q)
@@ -405,27 +460,6 @@ def nonlinear_quarter_car(
         fa = u[ia] if ia is not None else 0.0
         return np.array([x[2], x[3], x[2] - x[3], delta, (fa - f) / q["ms"], ft])
 
-    labels: list[str] = []
-    kinks: list[Callable] = []
-    if unilateral:
-        labels.append("contact")
-        kinks.append(lambda t, x, u, q: (q["ms"] + q["mu"]) * g / q["ku"] - (x[3] - zr_at(t, u)))
-    if stop is not None:
-        if math.isfinite(stop.clearance_bound):
-            labels.append("bump stop")
-            kinks.append(lambda t, x, u, q: x[2] - x[3] + stop.clearance_bound)
-        if math.isfinite(stop.clearance_rebound):
-            labels.append("rebound stop")
-            kinks.append(lambda t, x, u, q: stop.clearance_rebound - (x[2] - x[3]))
-    if isinstance(damper, PiecewiseDamper):
-        for knee in damper.knees():
-            labels.append(f"damper knee {knee:+g} m/s")
-            kinks.append(lambda t, x, u, q, k=knee: x[0] - x[1] - k)
-
-    def switching(t, x, u, q):
-        return np.array([k(t, x, u, q) for k in kinks])
-
-    inputs = [s for s, on in (("zr", road_input), ("fa", actuator)) if on]
     sys = control.nlsys(
         update,
         output,
@@ -436,7 +470,7 @@ def nonlinear_quarter_car(
         params={"ms": p.ms, "mu": p.mu, "ks": p.ks, "ku": p.ku, "cs": float(p.cs)},  # type: ignore[arg-type]
     )
     sys.switching = switching
-    sys.switching_labels = tuple(labels)
+    sys.switching_labels = switching_labels
     return sys
 
 

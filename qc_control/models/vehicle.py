@@ -26,6 +26,8 @@ from typing import Any
 import control
 import numpy as np
 
+from ..numerics.lti import is_nonlinear_system
+
 __all__ = [
     "Corner",
     "SignalRoles",
@@ -177,6 +179,17 @@ class VehicleModel:
     @property
     def name(self) -> str:
         return self.system.name
+
+    @property
+    def is_nonlinear(self) -> bool:
+        """Whether the model is stepped by its right-hand side, not scanned as ``R(hA)``.
+
+        True when its ``system`` is a nonlinear I/O system
+        (`qc_control.numerics.lti.is_nonlinear_system`) or it gives
+        ``batch_dynamics``, which only a nonlinear model has: `qc_control.sweep`
+        then takes its nonlinear path (`qc_control.studies.nlsweep`).
+        """
+        return self.batch_dynamics is not None or is_nonlinear_system(self.system)
 
     @property
     def body_acc(self) -> str:

@@ -28,6 +28,7 @@ from collections import OrderedDict
 from collections.abc import Callable, Hashable
 from typing import Any
 
+import control
 import numpy as np
 
 from .integrate import DivergenceWarning, Solution, check_substeps, check_time_grid, uniform_step
@@ -44,12 +45,33 @@ __all__ = [
     "memo",
     "array_key",
     "TailBound",
+    "is_nonlinear_system",
 ]
 
 #: How many step maps (and free-response power tables, eigenvalues) `memo` keeps.
 MEMO_SIZE = 32
 _memo_store: OrderedDict = OrderedDict()
 _memo_lock = threading.Lock()
+
+
+def is_nonlinear_system(sys) -> bool:
+    """Whether ``sys`` is a python-control nonlinear I/O system, beyond this engine.
+
+    A `control.NonlinearIOSystem` (an `control.InterconnectedSystem`, a
+    `control.nlsys`, a closed loop with a clipped controller) is stepped by
+    its right-hand side; a `control.StateSpace` (which python-control 0.10
+    derives from `control.NonlinearIOSystem`) or a
+    `control.TransferFunction` is linear, and its step map is ``R(hA)``.
+
+    Examples
+    --------
+    >>> import control
+    >>> is_nonlinear_system(control.ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]]))
+    False
+    >>> is_nonlinear_system(control.nlsys(lambda t, x, u, p: -x, None, states=1))
+    True
+    """
+    return isinstance(sys, control.NonlinearIOSystem) and not isinstance(sys, control.StateSpace)
 
 
 def array_key(a: np.ndarray) -> tuple:

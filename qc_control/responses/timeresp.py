@@ -31,6 +31,8 @@ from __future__ import annotations
 import inspect
 import math
 import warnings
+from dataclasses import dataclass
+from typing import NamedTuple
 
 import control
 import numpy as np
@@ -57,9 +59,9 @@ from ..numerics.integrate import (
     stage_times,
     uniform_step,
 )
-from ..numerics.interconnect import compile_interconnect
+from ..numerics.interconnect import CompiledInterconnect, FusedSteps, compile_interconnect
 from ..numerics.limits import check_memory
-from ..numerics.lti import array_key, lti_states, memo
+from ..numerics.lti import array_key, is_nonlinear_system, lti_states, memo
 from ..numerics.methods import METHODS, ButcherTableau, get_method
 from ..numerics.sampled import linear_input
 from ..numerics.stability import max_stable_step, stability_coefficients, step_is_stable
@@ -144,11 +146,13 @@ class FixedStepResponse(control.TimeResponseData):
 # ---------------------------------------------------------------- input checks
 
 
-def check_initial_state(X0, n: int) -> np.ndarray:
+def check_initial_state(X0, n: int, labels=None) -> np.ndarray:
     """``X0`` as a finite real array of shape ``(n,)``.
 
     A number fills every state; ``(n, 1)`` and ``(1, n)`` are flattened,
-    as python-control accepts them.
+    as python-control accepts them. The one check of an initial state that
+    the responses and `qc_control.sweep` share; ``labels`` (the state
+    labels) name the states in its message.
 
     Raises
     ------
@@ -169,17 +173,23 @@ def check_initial_state(X0, n: int) -> np.ndarray:
     elif x0.shape in ((n, 1), (1, n)):
         x0 = x0.reshape(n)
     if x0.shape != (n,):
-        raise ValueError(f"X0 must have shape ({n},) for a system with {n} states, got {raw.shape}")
+        states = "" if labels is None else f" {list(labels)}"
+        raise ValueError(
+            f"X0 must be {n} finite numbers, one per state{states}, or one number for "
+            f"every state: X0 must have shape ({n},) for a system with {n} states, got {raw.shape}"
+        )
     if not np.all(np.isfinite(x0)):
         raise ValueError(f"X0 must be finite, got {x0.tolist()}")
     return x0
 
 
-def check_input_samples(U, ninputs: int, nsteps: int) -> np.ndarray:
+def check_input_samples(U, ninputs: int, nsteps: int, labels=None) -> np.ndarray:
     """``U`` as a finite real ``(ninputs, nsteps)`` array, with python-control's shapes.
 
     A number (or None, meaning 0) holds every input at that value; one
-    input may be given as ``(nsteps,)``.
+    input may be given as ``(nsteps,)``. The one check of input samples that
+    the responses and `qc_control.sweep` share; ``labels`` (the input labels)
+    name the inputs in its message.
 
     Raises
     ------
@@ -204,8 +214,10 @@ def check_input_samples(U, ninputs: int, nsteps: int) -> np.ndarray:
         u = u.reshape(1, -1)
     if u.shape != (ninputs, nsteps):
         want = f"({nsteps},) or (1, {nsteps})" if ninputs == 1 else f"({ninputs}, {nsteps})"
+        inputs = "" if labels is None else f" {list(labels)}"
         raise ValueError(
-            f"U must have shape {want} to match T (len {nsteps}) and the "
+            f"U must be finite, of shape {want} for the inputs{inputs} on T, or one number "
+            f"for every input: U must have shape {want} to match T (len {nsteps}) and the "
             f"system's {ninputs} input(s), got {raw.shape}"
         )
     if not np.all(np.isfinite(u)):
@@ -356,13 +368,55 @@ class _Options:
         self.engine = engine
 
 
-def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
-    """Run the fixed-step method on a continuous-time StateSpace."""
-    tab = opts.tab
-    A, B = np.asarray(ss.A, dtype=float), np.asarray(ss.B, dtype=float)
-    C, D = np.asarray(ss.C, dtype=float), np.asarray(ss.D, dtype=float)
-    dt = checked_uniform_step(T)  # T passed check_time_grid in the caller
-    H = dt if dt is not None else float(np.diff(T).max())
+@dataclass
+class _Computed:
+    """How a response was computed: what `FixedStepResponse` adds to control's data."""
+
+    method: ButcherTableau | None
+    h: float | None
+    substeps: int
+    step_rule: str | None
+    eigenvalues: np.ndarray | None
+    steps: int = 0
+    nfev: int = 0
+    note: str | None = None
+
+    def stamp(self, resp: FixedStepResponse) -> FixedStepResponse:
+        """``resp`` with these attributes set."""
+        resp.method, resp.h, resp.substeps = self.method, self.h, self.substeps
+        resp.steps, resp.nfev = self.steps, self.nfev
+        resp.step_rule, resp.note, resp._eigenvalues = self.step_rule, self.note, self.eigenvalues
+        return resp
+
+    @classmethod
+    def of(cls, resp: FixedStepResponse) -> _Computed:
+        """What ``resp`` says about how it was computed."""
+        return cls(
+            resp.method, resp.h, resp.substeps, resp.step_rule, resp._eigenvalues,
+            resp.steps, resp.nfev, resp.note,
+        )  # fmt: skip
+
+
+class _LinearRun(NamedTuple):
+    """One fixed-step run of a continuous-time StateSpace (`_simulate`)."""
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    u: np.ndarray
+    computed: _Computed
+    success: bool
+    message: str
+    #: the engine proved the states finite (the LTI engine's cut): `_finalise` looks at y only
+    states_finite: bool = False
+
+
+def _linear_step(tab: ButcherTableau, A: np.ndarray, H: float, opts: _Options, auto: bool):
+    """The run's `_Computed` before stepping: eigenvalues, substeps and ``h``.
+
+    With an automatic grid, the fewest substeps whose step meets `auto_step`'s
+    rule (never fewer than asked).
+    """
     # eigenvalues as computed: the stability functions settle those that rounding
     # moved off the imaginary axis (qc_control.numerics.stability, MARGINAL_RTOL)
     eig = (
@@ -374,58 +428,71 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> dict:
     if auto:
         h_rule, step_rule = auto_step(tab, eig)
         if math.isfinite(h_rule):
-            # the smallest count whose step meets the rule (never fewer than asked)
             substeps = max(substeps, substeps_for(H, h_rule))
-    h = H / substeps
-    meta = {"method": tab, "h": h, "substeps": substeps, "step_rule": step_rule, "eig": eig}
-    if not eig.size:  # a static gain: nothing to integrate
-        x = np.zeros((0, T.size))
-        y = D @ u_samples if u_samples.size else np.zeros((C.shape[0], T.size))
-        meta.update(t=T, x=x, y=y, u=u_samples, steps=0, nfev=0, success=True, message="")
-        meta["note"] = "the system has no states: y = D u, nothing was integrated"
-        return meta
+    return _Computed(tab, H / substeps, substeps, step_rule, eig)
 
-    success, message = True, ""
-    # The trajectory grows iff the step map R(hA) amplifies a mode; the full
-    # root-finding for h_max runs only to word the warning (or when asked).
-    stable = memo(("stable", tab, h, array_key(A)), lambda: step_is_stable(tab, h, eig))
-    if not stable:
-        h_max = max_stable_step(tab, eig)
-        success = False
-        message = (
-            f"h = {h:.6g} s exceeds the stability limit {h_max:.6g} s of "
-            f"{tab.name} for system {ss.name!r}: the response grows"
-        )
-        warnings.warn(message, DivergenceWarning, stacklevel=_stacklevel())
+
+def _beyond_stability(tab: ButcherTableau, h: float, eig, A: np.ndarray, name: str) -> str:
+    """The warning's words when ``h`` exceeds the method's stability limit, else ''.
+
+    The trajectory grows iff the step map R(hA) amplifies a mode; the full
+    root-finding for h_max runs only to word the warning (or when asked).
+    """
+    if memo(("stable", tab, h, array_key(A)), lambda: step_is_stable(tab, h, eig)):
+        return ""
+    message = (
+        f"h = {h:.6g} s exceeds the stability limit {max_stable_step(tab, eig):.6g} s of "
+        f"{tab.name} for system {name!r}: the response grows"
+    )
+    warnings.warn(message, DivergenceWarning, stacklevel=_stacklevel())
+    return message
+
+
+def _lti_run(tab, A, B, T, u_engine, x0, substeps, quiet: bool):
+    """The LTI engine's states, and whether it cut a blow-up short
+    (``quiet``: the step-size warning already told the user)."""
+    if not quiet:
+        return lti_states(tab, A, B, T, u_engine, x0, substeps)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DivergenceWarning)
+        return lti_states(tab, A, B, T, u_engine, x0, substeps)
+
+
+def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> _LinearRun:
+    """Run the fixed-step method on a continuous-time StateSpace."""
+    A, B = np.asarray(ss.A, dtype=float), np.asarray(ss.B, dtype=float)
+    C, D = np.asarray(ss.C, dtype=float), np.asarray(ss.D, dtype=float)
+    dt = checked_uniform_step(T)  # T passed check_time_grid in the caller
+    H = dt if dt is not None else float(np.diff(T).max())
+    computed = _linear_step(opts.tab, A, H, opts, auto)
+    tab, substeps = opts.tab, computed.substeps
+    if not computed.eigenvalues.size:  # a static gain: nothing to integrate
+        y = D @ u_samples if u_samples.size else np.zeros((C.shape[0], T.size))
+        computed.note = "the system has no states: y = D u, nothing was integrated"
+        return _LinearRun(T, np.zeros((0, T.size)), y, u_samples, computed, True, "")
+    message = _beyond_stability(tab, H / substeps, computed.eigenvalues, A, ss.name)
+    success = not message
     uniform = dt is not None
     # one look at the input: a zero input is the free response (no input scan, no D u)
     has_input = bool(u_samples.size) and bool(np.any(u_samples))
-    states_finite = False  # proven by the engine: _finalise need not look again
     if opts.engine == "lti" and not uniform:
         raise ValueError("engine='lti' needs a uniformly spaced T")
-    if opts.engine == "lti" or (opts.engine == "auto" and uniform and success):
-        u_engine = u_samples if has_input else None
-        if success:
-            x, cut = lti_states(tab, A, B, T, u_engine, x0, substeps)
-        else:
-            with warnings.catch_warnings():  # the step-size warning already told the user
-                warnings.simplefilter("ignore", DivergenceWarning)
-                x, cut = lti_states(tab, A, B, T, u_engine, x0, substeps)
-        states_finite = True  # lti_states cuts before the first non-finite sample
-        steps = (T.size - 1) * substeps  # the engine computes every interval at once
-        t, nfev, ok = T[: x.shape[-1]], tab.stages * steps, not cut
+    lti = opts.engine == "lti" or (opts.engine == "auto" and uniform and success)
+    if lti:
+        x, cut = _lti_run(tab, A, B, T, u_samples if has_input else None, x0, substeps, not success)
+        computed.steps = (T.size - 1) * substeps  # the engine computes every interval at once
+        t, computed.nfev, ok = T[: x.shape[-1]], tab.stages * computed.steps, not cut
     else:
         sol = _generic(A, B, T, u_samples, x0, tab, substeps, warn=success)
-        t, x, steps, nfev, cut, ok = sol.t, sol.x, sol.steps, sol.nfev, sol.message, sol.success
+        t, x, cut, ok = sol.t, sol.x, sol.message, sol.success
+        computed.steps, computed.nfev = sol.steps, sol.nfev
     if not ok:
         success, message = False, "; ".join(filter(None, [message, cut]))
-    N = t.size
-    u = u_samples[:, :N]
+    u = u_samples[:, : t.size]
     with np.errstate(over="ignore", invalid="ignore"):
         y = C @ x + D @ u if has_input else C @ x
-    meta.update(t=t, x=x, y=y, u=u, steps=steps, nfev=nfev, states_finite=states_finite)
-    meta.update(success=success, message=message, note=None)
-    return meta
+    # lti_states cuts before the first non-finite sample: _finalise need not look again
+    return _LinearRun(t, x, y, u, computed, success, message, states_finite=lti)
 
 
 def _all_finite(v: np.ndarray) -> bool:
@@ -475,7 +542,42 @@ def _wrap(data: control.TimeResponseData, **meta) -> FixedStepResponse:
 # ---------------------------------------------------------------- systems
 
 
-def _nonlinear_response(sys, T, U, X0, *, params, transpose, return_x, squeeze, opts, auto):
+class _Layout(NamedTuple):
+    """How the caller wants the result laid out, as python-control takes it."""
+
+    params: dict | None
+    transpose: bool
+    return_x: bool | None
+    squeeze: bool | None
+
+
+def _response(sys, data, layout: _Layout, title: str, success, message, **labels):
+    """A `FixedStepResponse` of ``sys``'s signals ``data = (t, y, x, u)``.
+
+    ``labels``: the system's ``issiso``, ``output_labels`` and
+    ``input_labels`` unless given (all three, when one output or input is
+    kept), and python-control's trace keywords.
+    """
+    if "issiso" not in labels:  # the whole system's signals
+        labels.update(
+            issiso=sys.issiso(), output_labels=sys.output_labels, input_labels=sys.input_labels
+        )
+    return FixedStepResponse(
+        *data,
+        params=layout.params,
+        state_labels=sys.state_labels,
+        sysname=sys.name,
+        title=title,
+        transpose=layout.transpose,
+        return_x=layout.return_x,
+        squeeze=layout.squeeze,
+        success=success,
+        message=message or None,
+        **labels,
+    )
+
+
+def _nonlinear_response(sys, T, U, X0, layout: _Layout, opts, auto):
     """The one place nonlinear systems go from the linear responses.
 
     python-control's `forced_response` (and so its initial and step
@@ -483,31 +585,13 @@ def _nonlinear_response(sys, T, U, X0, *, params, transpose, return_x, squeeze, 
     `control.input_output_response` with exactly these arguments; so does
     this module, to its fixed-step `input_output_response`.
     """
-    return _io_response(
-        sys,
-        T,
-        U,
-        X0,
-        params=params,
-        transpose=transpose,
-        return_x=return_x,
-        squeeze=squeeze,
-        t_eval="T",
-        max_step=None,
-        opts=opts,
-        auto=auto,
-    )
-
-
-def _is_nonlinear(sys) -> bool:
-    # StateSpace derives from NonlinearIOSystem in python-control 0.10
-    return isinstance(sys, control.NonlinearIOSystem) and not isinstance(sys, control.StateSpace)
+    return _io_response(sys, T, U, X0, layout, _IOOptions("T", None, opts, auto))
 
 
 def _check_system(sys) -> None:
     """Refuse what python-control refuses, in its own words (its tests expect them)."""
-    if not isinstance(sys, (control.StateSpace, control.TransferFunction)) and not _is_nonlinear(
-        sys
+    if not isinstance(sys, (control.StateSpace, control.TransferFunction)) and not (
+        is_nonlinear_system(sys)
     ):
         raise TypeError(
             "Parameter `sys`: must be a `StateSpace` or `TransferFunction`, "
@@ -552,85 +636,73 @@ def _time_grid(sysdata, T, T_num, is_step: bool):
     return T, False
 
 
-def _forced(
-    sys, T, U, X0, transpose, params, interpolate, return_x, squeeze, opts, auto=False, inner=False
-):
+_NONZERO_X0_FOR_TF = (
+    "Non-zero initial condition given for transfer function system. "
+    "Internal conversion to state space used; may not be consistent "
+    "with given X0."
+)
+
+
+def _transfer_function_warnings(sys, X0, return_x) -> None:
+    """python-control's warnings for a TransferFunction, word for word."""
+    if not isinstance(sys, control.TransferFunction):
+        return
+    if return_x:
+        warnings.warn(
+            "return_x specified for a transfer function system. Internal "
+            "conversion to state space used; results may meaningless.",
+            stacklevel=_stacklevel(),
+        )
+    if np.any(np.asarray(X0) != 0):
+        warnings.warn(_NONZERO_X0_FOR_TF, stacklevel=_stacklevel())
+
+
+def _difference_equation(control_response, sys, T, U, X0, layout: _Layout, **keywords):
+    """A discrete-time or ``dt=None`` system: python-control's own difference
+    equation, by its ``control_response`` (`control.forced_response` or
+    `control.input_output_response`, whose own ``keywords`` are passed on)."""
+    data = control_response(
+        sys, T, U, X0, params=layout.params, transpose=layout.transpose,
+        squeeze=layout.squeeze, **keywords,
+    )  # fmt: skip
+    return _wrap(data, note=_discrete_note(sys))
+
+
+def _forced(sys, T, U, X0, layout: _Layout, interpolate, opts, auto=False, inner=False):
     """`forced_response` for one system (``inner``: a step of another response,
     which checks the result itself)."""
     _check_system(sys)
-    if _is_nonlinear(sys):
+    if is_nonlinear_system(sys):
         if interpolate:  # as python-control
             warnings.warn(
                 "interpolation not supported for nonlinear I/O systems", stacklevel=_stacklevel()
             )
-        return _nonlinear_response(
-            sys,
-            T,
-            U,
-            X0,
-            params=params,
-            transpose=transpose,
-            return_x=return_x,
-            squeeze=squeeze,
-            opts=opts,
-            auto=auto,
-        )
-    if return_x is None:
-        return_x = control.config.defaults["forced_response.return_x"]
+        return _nonlinear_response(sys, T, U, X0, layout, opts, auto)
+    if layout.return_x is None:
+        layout = layout._replace(return_x=control.config.defaults["forced_response.return_x"])
     if not control.isctime(sys, strict=True):
-        data = _control_forced_response(
-            sys,
-            T,
-            U,
-            X0,
-            transpose=transpose,
-            params=params,
-            interpolate=interpolate,
-            return_states=return_x,
-            squeeze=squeeze,
-        )
-        return _wrap(data, note=_discrete_note(sys))
-    if isinstance(sys, control.TransferFunction):  # python-control's warnings
-        if return_x:
-            warnings.warn(
-                "return_x specified for a transfer function system. Internal "
-                "conversion to state space used; results may meaningless.",
-                stacklevel=_stacklevel(),
-            )
-        if np.any(np.asarray(X0) != 0):
-            warnings.warn(
-                "Non-zero initial condition given for transfer function system. "
-                "Internal conversion to state space used; may not be consistent "
-                "with given X0.",
-                stacklevel=_stacklevel(),
-            )
+        return _difference_equation(
+            _control_forced_response, sys, T, U, X0, layout,
+            interpolate=interpolate, return_states=layout.return_x,
+        )  # fmt: skip
+    _transfer_function_warnings(sys, X0, layout.return_x)
     ss = _as_statespace(sys)
-    run = _linear_run(ss, T, U, X0, transpose, opts, auto)
-    resp = FixedStepResponse(
-        run["t"],
-        run["y"],
-        run["x"],
-        run["u"],
-        params=params,
-        issiso=ss.issiso(),
-        output_labels=ss.output_labels,
-        input_labels=ss.input_labels,
-        state_labels=ss.state_labels,
-        sysname=ss.name,
+    run = _linear_run(ss, T, U, X0, layout.transpose, opts, auto)
+    resp = _response(
+        ss,
+        (run.t, run.y, run.x, run.u),
+        layout,
+        _title("Forced", ss.name),
+        run.success,
+        run.message,
         plot_inputs=True,
-        title=_title("Forced", ss.name),
         trace_types=["forced"],
-        transpose=transpose,
-        return_x=return_x,
-        squeeze=squeeze,
-        success=run["success"],
-        message=run["message"] or None,
     )
-    resp = _set_meta(resp, run)
-    return resp if inner else _finalise(resp, run.get("states_finite", False))
+    resp = run.computed.stamp(resp)
+    return resp if inner else _finalise(resp, run.states_finite)
 
 
-def _linear_run(ss, T, U, X0, transpose, opts, auto) -> dict:
+def _linear_run(ss, T, U, X0, transpose, opts, auto) -> _LinearRun:
     """Check ``T``, ``U`` and ``X0`` for a continuous-time StateSpace and simulate it
     (`_simulate`): the run's record, which the responses wrap."""
     if T is None:
@@ -648,11 +720,11 @@ def _linear_run(ss, T, U, X0, transpose, opts, auto) -> dict:
         f"a fixed-step response of {ss.name!r} on {T.size} samples",
         "use fewer samples (a coarser T; substeps refine the step without storing it)",
     )
-    x0 = check_initial_state(X0, ss.nstates)
+    x0 = check_initial_state(X0, ss.nstates, ss.state_labels)
     u = np.asarray(0.0 if U is None else U)
     if transpose and u.ndim == 2:
         u = u.T
-    u = check_input_samples(u, ss.ninputs, T.size)
+    u = check_input_samples(u, ss.ninputs, T.size, ss.input_labels)
     return _simulate(ss, T, u, x0, opts, auto)
 
 
@@ -661,38 +733,18 @@ def _title(kind: str, name: str) -> str:
     return f"{kind} response for {name}"
 
 
-def _set_meta(resp: FixedStepResponse, run: dict) -> FixedStepResponse:
-    resp.method, resp.h, resp.substeps = run["method"], run["h"], run["substeps"]
-    resp.steps, resp.nfev = run["steps"], run["nfev"]
-    resp.step_rule, resp.note, resp._eigenvalues = run["step_rule"], run["note"], run["eig"]
-    return resp
-
-
-def _meta_of(resp: FixedStepResponse) -> dict:
-    return {
-        "method": resp.method,
-        "h": resp.h,
-        "substeps": resp.substeps,
-        "steps": resp.steps,
-        "nfev": resp.nfev,
-        "step_rule": resp.step_rule,
-        "note": resp.note,
-        "eig": resp._eigenvalues,
-    }
-
-
-def _combine(parts: list[FixedStepResponse]) -> dict:
-    """One record of how several traces (inputs of a step response) were computed."""
-    meta = _meta_of(parts[-1])
-    meta["steps"] = sum(p.steps for p in parts)
-    meta["nfev"] = sum(p.nfev for p in parts)
+def _combine(parts: list[FixedStepResponse]) -> tuple[_Computed, bool, str | None]:
+    """How several traces (inputs of a step response) were computed, together:
+    the last trace's method and step, their steps and evaluations summed, and
+    whether all succeeded, with their distinct messages."""
+    computed = _Computed.of(parts[-1])
+    computed.steps = sum(p.steps for p in parts)
+    computed.nfev = sum(p.nfev for p in parts)
     messages = []
     for p in parts:
         if p.message and p.message not in messages:
             messages.append(p.message)
-    meta["success"] = all(p.success for p in parts)
-    meta["message"] = "; ".join(messages) or None
-    return meta
+    return computed, all(p.success for p in parts), "; ".join(messages) or None
 
 
 # ---------------------------------------------------------------- public functions
@@ -710,22 +762,38 @@ def _with_aliases(kwargs: dict, **named) -> dict:
     return values
 
 
+def _grid_arguments(sysdata, kwargs, grid, options, is_step: bool, positional: str, **named):
+    """What initial, step and impulse responses share before simulating.
+
+    python-control's keyword processing (`_with_aliases`) of ``grid =
+    (timepts, timepts_num, return_states)`` and of ``named`` (each a value
+    and its sentinel); no method in the positional ``positional``; the
+    keyword-only ``options = (method, substeps, engine)``; and the time
+    grid, python-control's own when ``T`` is None or a final time.
+
+    Returns
+    -------
+    (values, opts, T, auto)
+    """
+    timepts, timepts_num, return_states = grid
+    v = _with_aliases(
+        kwargs,
+        timepts=(timepts, None),
+        **named,
+        return_states=(return_states, False),
+        timepts_num=(timepts_num, None),
+    )
+    _not_a_method(v[positional], positional)
+    opts = _Options(*options)
+    T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=is_step)
+    return v, opts, T, auto
+
+
 def forced_response(
-    sysdata,
-    timepts=None,
-    inputs=0.0,
-    initial_state=0.0,
-    transpose=False,
-    params=None,
-    interpolate=False,
-    return_states=None,
-    squeeze=None,
-    *,
-    method="rk4",
-    substeps: int = 1,
-    engine="auto",
-    **kwargs,
-):
+    sysdata, timepts=None, inputs=0.0, initial_state=0.0, transpose=False, params=None,
+    interpolate=False, return_states=None, squeeze=None,
+    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+):  # fmt: skip
     """Forced response computed by a fixed-step method.
 
     The same call as python-control 0.10.2's `control.forced_response`
@@ -811,29 +879,16 @@ def forced_response(
     )
     _not_a_method(transpose, "transpose")
     opts = _Options(method, substeps, engine)
-    T, U, X0, return_x = v["timepts"], v["inputs"], v["initial_state"], v["return_states"]
-    return _each(
-        sysdata,
-        lambda s: _forced(s, T, U, X0, transpose, params, interpolate, return_x, squeeze, opts),
-    )
+    T, U, X0 = v["timepts"], v["inputs"], v["initial_state"]
+    layout = _Layout(params, transpose, v["return_states"], squeeze)
+    return _each(sysdata, lambda s: _forced(s, T, U, X0, layout, interpolate, opts))
 
 
 def initial_response(
-    sysdata,
-    timepts=None,
-    initial_state=0,
-    output_indices=None,
-    timepts_num=None,
-    params=None,
-    transpose=False,
-    return_states=False,
-    squeeze=None,
-    *,
-    method="rk4",
-    substeps: int = 1,
-    engine="auto",
-    **kwargs,
-):
+    sysdata, timepts=None, initial_state=0, output_indices=None, timepts_num=None,
+    params=None, transpose=False, return_states=False, squeeze=None,
+    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+):  # fmt: skip
     """Initial-condition response computed by a fixed-step method.
 
     The same call as python-control 0.10.2's `control.initial_response`;
@@ -896,60 +951,37 @@ def initial_response(
     >>> bool(np.max(abs(rk4.outputs[0] - exact.outputs[0])) < 1e-8)
     True
     """
-    v = _with_aliases(
-        kwargs,
-        timepts=(timepts, None),
-        initial_state=(initial_state, 0.0),
-        output_indices=(output_indices, None),
-        return_states=(return_states, False),
-        timepts_num=(timepts_num, None),
-    )
-    _not_a_method(v["output_indices"], "output_indices")
-    opts = _Options(method, substeps, engine)
-    T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=False)
-    args = (v["initial_state"], v["output_indices"], params, transpose, v["return_states"])
-    return _each(sysdata, lambda s: _initial(s, T, auto, *args, squeeze, opts))
+    v, opts, T, auto = _grid_arguments(
+        sysdata, kwargs, (timepts, timepts_num, return_states), (method, substeps, engine),
+        False, "output_indices",
+        initial_state=(initial_state, 0.0), output_indices=(output_indices, None),
+    )  # fmt: skip
+    X0, output = v["initial_state"], v["output_indices"]
+    layout = _Layout(params, transpose, v["return_states"], squeeze)
+    return _each(sysdata, lambda s: _initial(s, T, auto, X0, output, layout, opts))
 
 
-def _initial(sys, T, auto, X0, output, params, transpose, return_x, squeeze, opts):
+def _initial(sys, T, auto, X0, output, layout: _Layout, opts):
     if isinstance(sys, control.StateSpace) and control.isctime(sys, strict=True):
         # the fast path: the run's arrays go into one response, not two
         run = _linear_run(sys, T, 0, X0, False, opts, auto)
-        t, y, x = run["t"], run["y"], run["x"]
-        success, message = run["success"], run["message"] or None
     else:
-        response = _forced(sys, T, 0, X0, False, params, False, None, None, opts, auto, inner=True)
-        t, y, x, success, message = (
-            response.t,
-            response.y,
-            response.x,
-            response.success,
-            response.message,
-        )
-        run = _meta_of(response)
-    issiso = sys.issiso() or output is not None
-    yout = y if output is None else y[output]
-    output_labels = sys.output_labels if output is None else sys.output_labels[output]
-    resp = FixedStepResponse(
-        t,
-        yout,
-        x,
-        None,
-        params=params,
-        issiso=issiso,
-        output_labels=output_labels,
+        inner = _Layout(layout.params, False, None, None)
+        r = _forced(sys, T, 0, X0, inner, False, opts, auto, inner=True)
+        run = _LinearRun(r.t, r.x, r.y, r.u, _Computed.of(r), r.success, r.message)
+    resp = _response(
+        sys,
+        (run.t, run.y if output is None else run.y[output], run.x, None),
+        layout,
+        _title("Initial", sys.name),
+        run.success,
+        run.message,
+        issiso=sys.issiso() or output is not None,
+        output_labels=sys.output_labels if output is None else sys.output_labels[output],
         input_labels=None,
-        state_labels=sys.state_labels,
-        sysname=sys.name,
-        title=_title("Initial", sys.name),
         trace_types=["initial"],
-        transpose=transpose,
-        return_x=return_x,
-        squeeze=squeeze,
-        success=success,
-        message=message,
     )
-    return _finalise(_set_meta(resp, run), run.get("states_finite", False))
+    return _finalise(run.computed.stamp(resp), run.states_finite)
 
 
 def _single_index(index, what: str):
@@ -978,7 +1010,7 @@ def _traces(kind, sys, T, auto, X0_of, U_of, inputs, output, opts, params):
             continue
         labels.append(f"From {sys.input_labels[i]}")
         U = U_of(i)
-        r = _forced(sys, T, U, X0_of(i), False, params, False, None, True, opts, auto=auto)
+        r = _forced(sys, T, U, X0_of(i), _Layout(params, False, None, True), False, opts, auto)
         if r.t.size != T.size:  # the generic engine cut a blow-up short: pad
             r = _padded(r, T)
         k = i if inputs is None else 0
@@ -1009,22 +1041,10 @@ def _as_lti_statespace(sys):
 
 
 def step_response(
-    sysdata,
-    timepts=None,
-    initial_state=0.0,
-    input_indices=None,
-    output_indices=None,
-    timepts_num=None,
-    transpose=False,
-    return_states=False,
-    squeeze=None,
-    params=None,
-    *,
-    method="rk4",
-    substeps: int = 1,
-    engine="auto",
-    **kwargs,
-):
+    sysdata, timepts=None, initial_state=0.0, input_indices=None, output_indices=None,
+    timepts_num=None, transpose=False, return_states=False, squeeze=None, params=None,
+    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+):  # fmt: skip
     """Step response computed by a fixed-step method.
 
     The same call as python-control 0.10.2's `control.step_response`: a
@@ -1057,32 +1077,20 @@ def step_response(
     >>> round(float(r.outputs[-1]), 6), r.method.name, r.substeps
     (1.0, 'rk4', 2)
     """
-    v = _with_aliases(
-        kwargs,
-        timepts=(timepts, None),
-        initial_state=(initial_state, 0.0),
-        input_indices=(input_indices, None),
-        output_indices=(output_indices, None),
-        return_states=(return_states, False),
-        timepts_num=(timepts_num, None),
-    )
-    _not_a_method(v["input_indices"], "input_indices")
-    opts = _Options(method, substeps, engine)
-    T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=True)
+    v, opts, T, auto = _grid_arguments(
+        sysdata, kwargs, (timepts, timepts_num, return_states), (method, substeps, engine),
+        True, "input_indices", initial_state=(initial_state, 0.0),
+        input_indices=(input_indices, None), output_indices=(output_indices, None),
+    )  # fmt: skip
     T = np.atleast_1d(T).reshape(-1)
     args = (v["initial_state"], v["input_indices"], v["output_indices"])
-    rest = (transpose, v["return_states"], squeeze, params, opts)
-    return _each(sysdata, lambda s: _step(s, T, auto, *args, *rest))
+    layout = _Layout(params, transpose, v["return_states"], squeeze)
+    return _each(sysdata, lambda s: _step(s, T, auto, *args, layout, opts))
 
 
-def _step(sys, T, auto, X0, inputs, output, transpose, return_x, squeeze, params, opts):
+def _step(sys, T, auto, X0, inputs, output, layout: _Layout, opts):
     if isinstance(sys, control.TransferFunction) and np.any(np.asarray(X0) != 0):
-        warnings.warn(
-            "Non-zero initial condition given for transfer function system. "
-            "Internal conversion to state space used; may not be consistent "
-            "with given X0.",
-            stacklevel=_stacklevel(),
-        )
+        warnings.warn(_NONZERO_X0_FOR_TF, stacklevel=_stacklevel())
     _check_system(sys)
     sys = _as_lti_statespace(sys)
     inputs = _single_index(inputs, "input")
@@ -1093,63 +1101,36 @@ def _step(sys, T, auto, X0, inputs, output, transpose, return_x, squeeze, params
         U[i, :] = 1.0
         return U
 
-    traces = _traces("step", sys, T, auto, lambda i: X0, U_of, inputs, output, opts, params)
-    shape = (transpose, return_x, squeeze)
-    return _multi_trace("Step", sys, T, traces, inputs, output, shape, params)
+    traces = _traces("step", sys, T, auto, lambda i: X0, U_of, inputs, output, opts, layout.params)
+    return _multi_trace("Step", sys, T, traces, inputs, output, layout)
 
 
-def _multi_trace(kind, sys, T, traces, inputs, output, shape, params):
-    """One response of the traces `_traces` computed (``shape``: transpose,
-    return_x, squeeze, as python-control takes them)."""
+def _multi_trace(kind, sys, T, traces, inputs, output, layout: _Layout):
+    """One response of the traces `_traces` computed, laid out as asked."""
     yout, xout, uout, parts, labels = traces
-    transpose, return_x, squeeze = shape
-    issiso = sys.issiso() or (inputs is not None and output is not None)
-    input_labels = sys.input_labels if inputs is None else sys.input_labels[inputs]
-    output_labels = sys.output_labels if output is None else sys.output_labels[output]
-    meta = _combine(parts) if parts else {}
-    resp = FixedStepResponse(
-        T if not parts else parts[-1].t,
-        yout,
-        xout,
-        uout,
-        issiso=issiso,
-        output_labels=output_labels,
-        input_labels=input_labels,
-        state_labels=sys.state_labels,
-        title=_title(kind, sys.name),
-        transpose=transpose,
-        return_x=return_x,
-        squeeze=squeeze,
-        sysname=sys.name,
-        params=params,
+    computed, success, message = _combine(parts) if parts else (None, True, None)
+    resp = _response(
+        sys,
+        (T if not parts else parts[-1].t, yout, xout, uout),
+        layout,
+        _title(kind, sys.name),
+        success,
+        message,
+        issiso=sys.issiso() or (inputs is not None and output is not None),
+        output_labels=sys.output_labels if output is None else sys.output_labels[output],
+        input_labels=sys.input_labels if inputs is None else sys.input_labels[inputs],
         trace_labels=labels,
         trace_types=[kind.lower()] * len(labels),
         plot_inputs=False,
-        success=meta.get("success", True),
-        message=meta.get("message"),
     )
-    if parts:
-        resp.method, resp.h, resp.substeps = meta["method"], meta["h"], meta["substeps"]
-        resp.steps, resp.nfev = meta["steps"], meta["nfev"]
-        resp.step_rule, resp.note, resp._eigenvalues = meta["step_rule"], meta["note"], meta["eig"]
-    return _finalise(resp)
+    return _finalise(resp if computed is None else computed.stamp(resp))
 
 
 def impulse_response(
-    sysdata,
-    timepts=None,
-    input_indices=None,
-    output_indices=None,
-    timepts_num=None,
-    transpose=False,
-    return_states=False,
-    squeeze=None,
-    *,
-    method="rk4",
-    substeps: int = 1,
-    engine="auto",
-    **kwargs,
-):
+    sysdata, timepts=None, input_indices=None, output_indices=None, timepts_num=None,
+    transpose=False, return_states=False, squeeze=None,
+    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+):  # fmt: skip
     """Impulse response computed by a fixed-step method.
 
     The same call as python-control 0.10.2's `control.impulse_response`.
@@ -1181,23 +1162,18 @@ def impulse_response(
     >>> [round(float(y), 6) for y in r.outputs]   # e^{-t}
     [1.0, 0.606531, 0.367879]
     """
-    v = _with_aliases(
-        kwargs,
-        timepts=(timepts, None),
-        input_indices=(input_indices, None),
-        output_indices=(output_indices, None),
-        return_states=(return_states, False),
-        timepts_num=(timepts_num, None),
-    )
-    _not_a_method(v["input_indices"], "input_indices")
-    opts = _Options(method, substeps, engine)
-    T, auto = _time_grid(sysdata, v["timepts"], v["timepts_num"], is_step=False)
+    v, opts, T, auto = _grid_arguments(
+        sysdata, kwargs, (timepts, timepts_num, return_states), (method, substeps, engine),
+        False, "input_indices",
+        input_indices=(input_indices, None), output_indices=(output_indices, None),
+    )  # fmt: skip
     T = np.atleast_1d(T).reshape(-1)
-    args = (v["input_indices"], v["output_indices"], transpose, v["return_states"], squeeze)
-    return _each(sysdata, lambda s: _impulse(s, T, auto, *args, opts))
+    inputs, output = v["input_indices"], v["output_indices"]
+    layout = _Layout(None, transpose, v["return_states"], squeeze)
+    return _each(sysdata, lambda s: _impulse(s, T, auto, inputs, output, layout, opts))
 
 
-def _impulse(sys, T, auto, inputs, output, transpose, return_x, squeeze, opts):
+def _impulse(sys, T, auto, inputs, output, layout: _Layout, opts):
     if not isinstance(sys, control.LTI):
         raise ValueError("system must be LTI system for impulse response")
     _check_system(sys)
@@ -1222,8 +1198,7 @@ def _impulse(sys, T, auto, inputs, output, transpose, return_x, squeeze, opts):
         return U
 
     traces = _traces("impulse", sys, T, auto, X0_of, U_of, inputs, output, opts, None)
-    shape = (transpose, return_x, squeeze)
-    return _multi_trace("Impulse", sys, T, traces, inputs, output, shape, None)
+    return _multi_trace("Impulse", sys, T, traces, inputs, output, layout)
 
 
 # ---------------------------------------------------------------- nonlinear systems
@@ -1359,39 +1334,44 @@ def _event_function(sys, events):
     )
 
 
-def _io_response(
-    sys,
-    T,
-    U,
-    X0,
-    *,
-    params,
-    transpose,
-    return_x,
-    squeeze,
-    t_eval,
-    max_step,
-    opts,
-    auto,
-    events=None,
-    fast=True,
-):
-    """`input_output_response` for one system."""
-    if not isinstance(sys, control.NonlinearIOSystem):
-        raise TypeError(f"System of type {type(sys)} not valid")
-    if control.isdtime(sys, strict=True):  # a difference equation: control's own loop
-        data = _control_io_response(
-            sys,
-            T,
-            U,
-            X0,
-            params=params,
-            transpose=transpose,
-            return_x=return_x,
-            squeeze=squeeze,
-            evaluation_times=t_eval,
-        )
-        return _wrap(data, note=_discrete_note(sys))
+class _IOOptions(NamedTuple):
+    """`input_output_response`'s fixed-step options for one system."""
+
+    t_eval: object  # 'T', None or times [s]
+    max_step: float | None
+    opts: _Options
+    auto: bool  # the grid was chosen automatically: the step follows auto_step
+    events: object = None
+    fast: bool = True
+
+
+class _IOProblem(NamedTuple):
+    """A continuous-time nonlinear system's checked arguments."""
+
+    T: np.ndarray
+    u_samples: np.ndarray  # (ninputs, len(T))
+    x0: np.ndarray
+    noutputs: int
+    params: dict | None  # the caller's, passed to the switching functions as to control's
+
+
+class _IOTrajectory(NamedTuple):
+    """The stepped states at the output times, and how they were stepped."""
+
+    t: np.ndarray
+    x: np.ndarray
+    keep: np.ndarray  # which samples of the stepped grid are output
+    computed: _Computed
+    success: bool
+    message: str
+    t_events: np.ndarray
+    event_labels: tuple[str, ...]
+    fused: FusedSteps | None  # whose nonlinear outputs were kept from each step's first stage
+    compiled: CompiledInterconnect | None
+
+
+def _io_problem(sys, T, U, X0, params) -> _IOProblem:
+    """``T``, ``U`` and ``X0`` checked by python-control's rules, and the outputs' count."""
     if T is None or np.ndim(T) == 0:
         raise ValueError(
             f"T must be an array of times for a nonlinear system, got {T!r} "
@@ -1401,7 +1381,6 @@ def _io_response(
     u_samples = _nonlinear_inputs(sys, T, U)
     x0 = _nonlinear_state(sys, X0)
     sys._update_params(params)  # as control does, before the output function is first called
-    ninputs = u_samples.shape[0]
     if sys.outfcn is None:
         noutputs = x0.size if sys.noutputs is None else sys.noutputs
     else:
@@ -1411,11 +1390,19 @@ def _io_response(
             f"inconsistent size of outputs; system specified {sys.noutputs}, "
             f"output function returned {noutputs}"
         )
-    u_of_t = linear_input(T, u_samples)  # python-control's interpolation of the samples
-    tab, substeps, step_rule, eig, note = opts.tab, opts.substeps, None, None, None
-    H = float(np.diff(T).max())
-    if auto and x0.size:
-        eig, why = _linearised_eigenvalues(sys, float(T[0]), x0, u_samples[:, 0], params)
+    return _IOProblem(T, u_samples, x0, noutputs, params)
+
+
+def _io_step(sys, prob: _IOProblem, params, io: _IOOptions) -> _Computed:
+    """The method, substeps and step rule (``h`` is set by `_io_grid`): `auto_step`
+    on the linearisation at the initial point with an automatic grid, and
+    ``max_step``'s bound."""
+    tab, substeps, step_rule, eig = io.opts.tab, io.opts.substeps, None, None
+    H = float(np.diff(prob.T).max())
+    if io.auto and prob.x0.size:
+        eig, why = _linearised_eigenvalues(
+            sys, float(prob.T[0]), prob.x0, prob.u_samples[:, 0], params
+        )
         if eig is None:
             step_rule = f"none: the system could not be linearised at the initial point ({why})"
         else:
@@ -1423,132 +1410,145 @@ def _io_response(
             step_rule = f"{rule}, on the linearisation at the initial point"
             if math.isfinite(h_rule):
                 substeps = max(substeps, substeps_for(H, h_rule))
+    max_step = io.max_step
     if max_step is not None:
         if not (isinstance(max_step, (int, float, np.number)) and 0 < max_step < math.inf):
             raise ValueError(f"max_step must be a positive number of seconds, got {max_step!r}")
         substeps = max(substeps, substeps_for(H, float(max_step)))
     sys._update_params(params)  # linearize may have reset them
+    return _Computed(tab, None, substeps, step_rule, eig)
 
+
+def _io_grid(T: np.ndarray, substeps: int, t_eval):
+    """``(grid, at, n_sub)``: the times stepped between, the indices of the output
+    times in it (None: all of them), and the steps per interval of ``grid``."""
     if isinstance(t_eval, str) and t_eval == "T":
-        grid, at, n_sub = T, None, substeps
-    else:
-        grid, n_sub = _step_grid(T, substeps), 1
-        if t_eval is None:  # solve_ivp's own points: here, every step
-            at = None
-        else:
-            te = _evaluation_times(t_eval, T)
-            grid = np.union1d(grid, te)
-            at = np.searchsorted(grid, te)
-    h = float(np.diff(grid).max()) * (1 if n_sub == 1 else 1 / n_sub)
+        return T, None, substeps
+    grid = _step_grid(T, substeps)
+    if t_eval is None:  # solve_ivp's own points: here, every step
+        return grid, None, 1
+    te = _evaluation_times(t_eval, T)
+    grid = np.union1d(grid, te)
+    return grid, np.searchsorted(grid, te), 1
 
+
+def _io_static(prob: _IOProblem, grid, at, computed: _Computed) -> _IOTrajectory:
+    """A static system: nothing to integrate, its output function is evaluated."""
+    computed.note = (
+        "the system has no states: its output function was evaluated, nothing integrated"
+    )
+    t_out = grid if at is None else grid[at]
+    x = np.zeros((0, t_out.size))
+    keep = np.empty(0, dtype=int)  # no stepped grid
+    return _IOTrajectory(t_out, x, keep, computed, True, "", np.empty(0), (), None, None)
+
+
+def _io_integrate(sys, prob: _IOProblem, grid, at, n_sub, computed: _Computed, io, u_of_t):
+    """Step the states over ``grid``: the fused interconnection, the compiled
+    right-hand side or ``sys._rhs``; with events, each kink stepped to exactly."""
+    tab, T, u_samples, x0 = computed.method, prob.T, prob.u_samples, prob.x0
     t_events: np.ndarray = np.empty(0)
     event_labels: tuple[str, ...] = ()
-    compiled = compile_interconnect(sys) if fast else None
+    compiled = compile_interconnect(sys) if io.fast else None
     fused = None
-    if x0.size == 0:  # a static system: nothing to integrate
-        t_out = grid if at is None else grid[at]
-        steps = nfev = 0
-        x = np.zeros((0, t_out.size))
-        success, message = True, ""
-        note = "the system has no states: its output function was evaluated, nothing integrated"
+    rhs = sys._rhs
+
+    def f(t, x):
+        return rhs(t, x, u_of_t(t))
+
+    g, labels = _event_function(sys, io.events)
+    if compiled is not None:  # the interconnection solved once (qc_control.numerics.interconnect)
+        stages = stage_times(grid, tab, substeps=n_sub)
+        dt = uniform_step(grid)
+        if g is None and dt is not None:
+            fused = compiled.fused(tab, dt / n_sub, stages, (T, u_samples), n_sub)
+        if fused is None:
+            f = compiled.make_rhs(u_of_t, (T, u_samples), stages)
+    if fused is not None:  # whole steps at once (qc_control.numerics.interconnect.FusedSteps)
+        sol = integrate_stepper(fused.stepper(), grid, x0, tab, substeps=n_sub)
+    elif g is None:
+        sol = integrate(f, grid, x0, tab, substeps=n_sub)
     else:
-        rhs = sys._rhs
+        current = getattr(sys, "_current_params", prob.params or {})
 
-        def f(t, x):
-            return rhs(t, x, u_of_t(t))
+        def switching(t, x):
+            return g(t, x, u_of_t(t), current)
 
-        g, labels = _event_function(sys, events)
-        if (
-            compiled is not None
-        ):  # the interconnection solved once (qc_control.numerics.interconnect)
-            stages = stage_times(grid, tab, substeps=n_sub)
-            dt = uniform_step(grid)
-            if g is None and dt is not None:
-                fused = compiled.fused(tab, dt / n_sub, stages, (T, u_samples), n_sub)
-            if fused is None:
-                f = compiled.make_rhs(u_of_t, (T, u_samples), stages)
-        if fused is not None:  # whole steps at once (qc_control.numerics.interconnect.FusedSteps)
-            sol = integrate_stepper(fused.stepper(), grid, x0, tab, substeps=n_sub)
-        elif g is None:
-            sol = integrate(f, grid, x0, tab, substeps=n_sub)
-        else:
-            current = getattr(sys, "_current_params", params or {})
+        sol = integrate(f, grid, x0, tab, substeps=n_sub, events=switching)
+        t_events = sol.t_events
+        event_labels = tuple(
+            labels[i] if i < len(labels) else str(i) for i in sol.i_events.tolist()
+        )
+    computed.steps, computed.nfev = sol.steps, sol.nfev
+    keep = np.arange(sol.t.size) if at is None else at[at < sol.t.size]
+    t_out, x = (sol.t, sol.x) if at is None else (sol.t[keep], sol.x[:, keep])
+    return _IOTrajectory(
+        t_out, x, keep, computed, sol.success, sol.message, t_events, event_labels, fused, compiled
+    )
 
-            def switching(t, x):
-                return g(t, x, u_of_t(t), current)
 
-            sol = integrate(f, grid, x0, tab, substeps=n_sub, events=switching)
-            t_events = sol.t_events
-            event_labels = tuple(
-                labels[i] if i < len(labels) else str(i) for i in sol.i_events.tolist()
-            )
-        steps, nfev = sol.steps, sol.nfev
-        success, message = sol.success, sol.message
-        if at is None:
-            keep = np.arange(sol.t.size)
-            t_out, x = sol.t, sol.x
-        else:
-            keep = at[at < sol.t.size]
-            t_out, x = sol.t[keep], sol.x[:, keep]
-    u = np.empty((ninputs, t_out.size))
-    y = np.empty((noutputs, t_out.size))
+def _io_signals(sys, prob: _IOProblem, traj: _IOTrajectory, u_of_t):
+    """The inputs and outputs at the output times, from the stepped states."""
+    t_out, x, T = traj.t, traj.x, prob.T
+    u = np.empty((prob.u_samples.shape[0], t_out.size))
+    y = np.empty((prob.noutputs, t_out.size))
     with np.errstate(over="ignore", invalid="ignore"):
         if t_out.size == T.size and np.array_equal(t_out, T):
-            u[:] = u_samples  # the samples themselves (u_of_t returns them at T)
+            u[:] = prob.u_samples  # the samples themselves (u_of_t returns them at T)
         else:
             for i, t in enumerate(t_out.tolist()):
                 u[:, i] = u_of_t(t)
+        fused, compiled = traj.fused, traj.compiled
         if fused is not None:  # the nonlinear outputs kept from each step's first stage
-            y[:] = fused.compiled.outputs_known(x, u, fused.nonlinear_outputs(keep, t_out, x, u))
-        elif compiled is not None and x0.size:
+            y[:] = fused.compiled.outputs_known(
+                x, u, fused.nonlinear_outputs(traj.keep, t_out, x, u)
+            )
+        elif compiled is not None and prob.x0.size:
             y[:] = compiled.outputs(t_out, x, u)
         else:
             for i, t in enumerate(t_out.tolist()):
                 y[:, i] = sys._out(t, x[:, i], u[:, i])
-    resp = FixedStepResponse(
-        t_out,
-        y,
-        x if x0.size else None,
-        u,
-        params=params,
-        issiso=sys.issiso(),
-        output_labels=sys.output_labels,
-        input_labels=sys.input_labels,
-        state_labels=sys.state_labels,
-        sysname=sys.name,
-        title="Input/output response for " + sys.name,
-        transpose=transpose,
-        return_x=return_x,
-        squeeze=squeeze,
-        success=success,
-        message=message or None,
+    return u, y
+
+
+def _io_response(sys, T, U, X0, layout: _Layout, io: _IOOptions):
+    """`input_output_response` for one system: the arguments, the step, the
+    trajectory, then its signals as a `FixedStepResponse`."""
+    if not isinstance(sys, control.NonlinearIOSystem):
+        raise TypeError(f"System of type {type(sys)} not valid")
+    if control.isdtime(sys, strict=True):
+        return _difference_equation(
+            _control_io_response, sys, T, U, X0, layout,
+            return_x=layout.return_x, evaluation_times=io.t_eval,
+        )  # fmt: skip
+    prob = _io_problem(sys, T, U, X0, layout.params)
+    u_of_t = linear_input(prob.T, prob.u_samples)  # python-control's interpolation of the samples
+    computed = _io_step(sys, prob, layout.params, io)
+    grid, at, n_sub = _io_grid(prob.T, computed.substeps, io.t_eval)
+    computed.h = float(np.diff(grid).max()) * (1 if n_sub == 1 else 1 / n_sub)
+    if prob.x0.size == 0:
+        traj = _io_static(prob, grid, at, computed)
+    else:
+        traj = _io_integrate(sys, prob, grid, at, n_sub, computed, io, u_of_t)
+    u, y = _io_signals(sys, prob, traj, u_of_t)
+    resp = _response(
+        sys,
+        (traj.t, y, traj.x if prob.x0.size else None, u),
+        layout,
+        "Input/output response for " + sys.name,
+        traj.success,
+        traj.message,
     )
-    resp.method, resp.h, resp.substeps = tab, h, substeps
-    resp.steps, resp.nfev, resp.step_rule, resp.note = steps, nfev, step_rule, note
-    resp.t_events, resp.event_labels = t_events, event_labels
-    resp._eigenvalues = eig
-    return _finalise(resp)
+    resp.t_events, resp.event_labels = traj.t_events, traj.event_labels
+    return _finalise(traj.computed.stamp(resp))
 
 
 def input_output_response(
-    sys,
-    timepts=None,
-    inputs=0.0,
-    initial_state=0.0,
-    params=None,
-    ignore_errors=False,
-    transpose=False,
-    return_states=False,
-    squeeze=None,
-    solve_ivp_kwargs=None,
+    sys, timepts=None, inputs=0.0, initial_state=0.0, params=None, ignore_errors=False,
+    transpose=False, return_states=False, squeeze=None, solve_ivp_kwargs=None,
     evaluation_times="T",
-    *,
-    method="rk4",
-    substeps: int = 1,
-    events=None,
-    fast: bool = True,
-    **kwargs,
-):
+    *, method="rk4", substeps: int = 1, events=None, fast: bool = True, **kwargs,
+):  # fmt: skip
     """Response of a nonlinear (or any) input/output system, at a fixed step.
 
     The same call as python-control 0.10.2's
@@ -1712,16 +1712,6 @@ def input_output_response(
         )
     _not_a_method(transpose, "transpose")
     opts = _Options(_check_fixed_step_method(method), substeps, "generic")
-    args = dict(
-        params=params,
-        transpose=transpose,
-        return_x=return_x,
-        squeeze=squeeze,
-        t_eval=t_eval,
-        max_step=max_step,
-        opts=opts,
-        auto=False,
-        events=events,
-        fast=fast,
-    )
-    return _each(sys, lambda s: _io_response(s, T, U, X0, **args))
+    layout = _Layout(params, transpose, return_x, squeeze)
+    io = _IOOptions(t_eval, max_step, opts, False, events, fast)
+    return _each(sys, lambda s: _io_response(s, T, U, X0, layout, io))

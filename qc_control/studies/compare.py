@@ -32,6 +32,7 @@ from ..models.registry import MODELS, model_for_params, model_for_system
 from ..models.vehicle import VehicleModel
 from ..numerics.integrate import DivergenceWarning, check_time_grid, uniform_step
 from ..numerics.limits import check_memory
+from ..numerics.lti import is_nonlinear_system
 from ..numerics.methods import ButcherTableau, get_method
 from ..numerics.stability import max_stable_step, numerical_modes
 from ..responses.timeresp import (
@@ -691,7 +692,7 @@ def _as_model(sys, U, params) -> tuple[control.NonlinearIOSystem, VehicleModel |
     """
     if isinstance(sys, VehicleModel):
         return sys.system, sys, sys.params
-    if _is_nonlinear(sys):
+    if is_nonlinear_system(sys):
         model = _nonlinear_model(sys, params)
         return sys, model, None if model is None else model.params
     if sys is None or isinstance(sys, dict):
@@ -1015,7 +1016,7 @@ def compare_methods(
     """
     sys, model, params = _as_model(sys, U, params)
     problem = _checked_problem(sys, model, params, T, X0, U, methods, h, repeats)
-    if _is_nonlinear(sys):
+    if is_nonlinear_system(sys):
         measured = _measure_nonlinear(problem, events, levels, timing, progress)
     else:
         if events is not None or levels is not None:
@@ -1270,10 +1271,6 @@ class NonlinearStudy:
     error_floor: float
     linearization: control.StateSpace
     linearization_note: str
-
-
-def _is_nonlinear(sys) -> bool:
-    return isinstance(sys, control.NonlinearIOSystem) and not isinstance(sys, control.StateSpace)
 
 
 def _switching_labels(sys) -> tuple[str, ...]:

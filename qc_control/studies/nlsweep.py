@@ -75,7 +75,7 @@ from ..responses.timeresp import (
 )
 from ..ride.metrics import METRICS, Metric, MetricStream, RideSignals
 
-__all__ = ["simulate_batch", "BatchResponse", "nonlinear_sweep", "is_nonlinear", "BLOCK"]
+__all__ = ["simulate_batch", "BatchResponse", "nonlinear_sweep", "BLOCK"]
 
 #: Samples per block: the states of a block, ``(n, m, BLOCK)``, are turned into
 #: outputs and reduced together (a few MB for a thousand designs).
@@ -106,12 +106,6 @@ class BatchResponse:
     outputs: dict
     success: np.ndarray
     t_events: list
-
-
-def is_nonlinear(model: VehicleModel) -> bool:
-    """Whether `qc_control.sweep` must take the nonlinear path for ``model``:
-    it has a vectorised right-hand side, or its system is not a StateSpace."""
-    return model.batch_dynamics is not None or not hasattr(model.system, "A")
 
 
 def _inputs(dynamics, T: np.ndarray, U) -> np.ndarray:

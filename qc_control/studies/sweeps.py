@@ -9,6 +9,7 @@ import warnings
 from collections.abc import Mapping, Sequence
 from concurrent.futures import Executor
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -21,6 +22,7 @@ from ..numerics.limits import check_memory
 from ..numerics.lti import OutputStream, TailBound, affine_scan, step_matrices
 from ..numerics.methods import ButcherTableau, get_method
 from ..numerics.stability import step_is_stable
+from ..responses.timeresp import check_initial_state, check_input_samples
 from ..ride.iso2631 import wk_discrete
 from ..ride.metrics import (
     METRICS,
@@ -31,7 +33,7 @@ from ..ride.metrics import (
     metric_columns,
 )
 from ..ride.spectral import SPECTRAL_METRICS, ISO8608Road, spectral_metrics
-from .nlsweep import is_nonlinear, nonlinear_sweep
+from .nlsweep import nonlinear_sweep
 
 __all__ = [
     "sweep",
@@ -186,75 +188,113 @@ def _keep_heap() -> None:
     np.empty(2**21)  # not written to: no page is touched
 
 
-def _run_chunk(batch: BatchedModel, *args, eig=None):
+@dataclass(frozen=True, eq=False)
+class _ChunkTask:
+    """What every chunk of a linear sweep shares; picklable, for executors.
+
+    ``metric_items`` are ``(column, name or callable, corner)``: registered
+    metrics travel by name (their formulas live in this module's imports).
+    """
+
+    labels: tuple[str, ...]
+    roles: SignalRoles
+    T: np.ndarray
+    X0: np.ndarray
+    U: np.ndarray | None
+    method: ButcherTableau
+    substeps: int
+    metric_items: list
+    keep_states: bool
+
+
+class _ChunkResult(NamedTuple):
+    """One chunk's designs: ``stable (m,)``, column -> ``(m,)``, states or None."""
+
+    stable: np.ndarray
+    metrics: dict
+    states: np.ndarray | None
+
+
+def _run_chunk(batch: BatchedModel, task: _ChunkTask, *, eig=None) -> _ChunkResult:
     """Simulate one chunk of designs; module level so that executors can pickle it.
 
     The chunk is computed `VECTOR_DESIGNS` designs at a time (the size at
     which a segment of streamed outputs stays in cache; `FREE_VECTOR_DESIGNS`
     for a streamed free sweep), whatever its size. ``eig``: the designs'
-    ``np.linalg.eig(A)``, when the caller has it. ``args`` are
-    `_run_designs`'s after the batch.
+    ``np.linalg.eig(A)``, when the caller has it.
     """
     _keep_heap()
     m = batch.A.shape[0]
-    _, _, _, _, U, _, _, metric_items, keep_states = args
-    vector = _vector_designs(U, metric_items, keep_states)
+    vector = _vector_designs(task.U, task.metric_items, task.keep_states)
     if m <= vector:
-        return _run_designs(batch, *args, eig=eig)
+        return _run_designs(batch, task, eig=eig)
     parts = [
         _run_designs(
             _take(batch, slice(s, s + vector)),
-            *args,
+            task,
             eig=None if eig is None else tuple(e[s : s + vector] for e in eig),
         )
         for s in range(0, m, vector)
     ]
-    result = {key: np.concatenate([r[key] for r, _ in parts]) for key in parts[0][0]}
-    states = None if parts[0][1] is None else np.concatenate([x for _, x in parts])
-    return result, states
+    return _ChunkResult(
+        np.concatenate([p.stable for p in parts]),
+        {column: np.concatenate([p.metrics[column] for p in parts]) for column in parts[0].metrics},
+        None if parts[0].states is None else np.concatenate([p.states for p in parts]),
+    )
 
 
-def _run_designs(
-    batch: BatchedModel,
-    labels: tuple[str, ...],
-    roles: SignalRoles,
-    T: np.ndarray,
-    X0: np.ndarray,
-    U: np.ndarray | None,
-    method: ButcherTableau,
-    substeps: int,
-    metric_items,
-    keep_states: bool,
-    *,
-    eig=None,
-):
+def _run_designs(batch: BatchedModel, task: _ChunkTask, *, eig=None) -> _ChunkResult:
     """Simulate up to `VECTOR_DESIGNS` designs together.
 
-    ``metric_items`` are ``(column, name or callable, corner)``: registered
-    metrics travel by name (their formulas live in this module's imports).
-    ``eig`` is ``np.linalg.eig(A)`` if the caller has it (else computed here).
+    Registered metrics without states are streamed (`_stream_chunk`); custom
+    metrics and ``states=True`` get whole trajectories. ``eig`` is
+    ``np.linalg.eig(A)`` if the caller has it (else computed here).
     """
-    A, B, C, D = batch.A, batch.B, batch.C, batch.D
-    m, n = A.shape[0], A.shape[-1]
-    if not keep_states and all(isinstance(metric, str) for _, metric, _ in metric_items):
+    metric_items, labels, roles = task.metric_items, task.labels, task.roles
+    if not task.keep_states and all(isinstance(metric, str) for _, metric, _ in metric_items):
         items = [(column, METRICS[name], corner) for column, name, corner in metric_items]
         if MetricStream.supports(items, roles):
-            result = _stream_chunk(batch, labels, roles, T, X0, U, method, substeps, items, eig=eig)
-            return result, None
+            return _stream_chunk(batch, task, items, eig=eig)
     # only the outputs the metrics read (a custom metric may read any)
     wanted = _outputs_read(metric_items, roles, labels)
     rows = [labels.index(label) for label in wanted]
-    if len(rows) < len(labels):
-        C, D, labels = C[:, rows], D[:, rows], wanted
+    y, x = _trajectories(batch, task, rows)
+    T, method, substeps = task.T, task.method, task.substeps
     H = (T[-1] - T[0]) / (T.size - 1)
-    phi, g0, g1 = step_matrices(method, A, B, H, substeps)
+    with np.errstate(over="ignore", invalid="ignore"):
+        lam = np.linalg.eigvals(batch.A) if eig is None else eig[0]
+        stable = step_is_stable(method, H / substeps, lam)
+        signals = RideSignals(
+            T,
+            {label: y[:, i] for i, label in enumerate(wanted)},
+            roles,
+            batch.tire_stiffness,
+            batch.static_load,
+        )
+        metrics = {}
+        for column, metric, corner in metric_items:
+            if isinstance(metric, str):
+                metrics[column] = np.asarray(METRICS[metric].formula(signals, corner))
+            else:
+                metrics[column] = np.asarray(metric(signals), dtype=float)
+    return _ChunkResult(stable, metrics, x)
+
+
+def _trajectories(batch: BatchedModel, task: _ChunkTask, rows: list[int]):
+    """``(y, x)``: the outputs ``rows`` of every design over ``T``, time last, and
+    the states when kept (else None), by one blocked scan of the step maps."""
+    A, B, C, D = batch.A, batch.B, batch.C[:, rows], batch.D[:, rows]
+    T, U, X0 = task.T, task.U, task.X0
+    m, n = A.shape[0], A.shape[-1]
+    H = (T[-1] - T[0]) / (T.size - 1)
+    phi, g0, g1 = step_matrices(task.method, A, B, H, task.substeps)
     W = None
     if U is not None:
         if U.shape[0] == 1:  # one input: a broadcast product beats a matmul of inner size 1
             W = U[0, None, :-1, None] * g0[:, None, :, 0] + U[0, None, 1:, None] * g1[:, None, :, 0]
         else:
             W = U[:, :-1].T @ np.swapaxes(g0, -1, -2) + U[:, 1:].T @ np.swapaxes(g1, -1, -2)
-    if keep_states:  # observe the states too: [I; C]
+    if task.keep_states:  # observe the states too: [I; C]
         C = np.concatenate([np.broadcast_to(np.eye(n), (m, n, n)), C], axis=1)
     with np.errstate(over="ignore", invalid="ignore"):
         # time last, so that every metric reduces contiguous memory
@@ -267,92 +307,48 @@ def _run_designs(
             C=C,
             time_last=True,
         )
-        x = y[:, :n] if keep_states else None
-        y = y[:, n:] if keep_states else y
+        x = y[:, :n] if task.keep_states else None
+        y = y[:, n:] if task.keep_states else y
         if U is not None:  # the feedthrough D u, on the outputs that have one
             through = np.flatnonzero(np.any(D != 0, axis=(0, 2)))
             if through.size:
                 y[:, through] += D[:, through] @ U
-        stable = step_is_stable(
-            method, H / substeps, np.linalg.eigvals(A) if eig is None else eig[0]
-        )
-        signals = RideSignals(
-            T,
-            {label: y[:, i] for i, label in enumerate(labels)},
-            roles,
-            batch.tire_stiffness,
-            batch.static_load,
-        )
-        result = {"stable": stable}
-        for column, metric, corner in metric_items:
-            if isinstance(metric, str):
-                result[column] = np.asarray(METRICS[metric].formula(signals, corner))
-            else:
-                result[column] = np.asarray(metric(signals), dtype=float)
-    return result, x
+    return y, x
 
 
-def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps, items, eig=None):
+class _Scan(NamedTuple):
+    """The step map and observation a chunk's outputs are streamed from."""
+
+    phi: np.ndarray  # (m, n, n)
+    x0: np.ndarray  # (m, n)
+    C: np.ndarray  # (m, p, n)
+    D: np.ndarray  # (m, p, k)
+    g0: np.ndarray  # (m, n, k)
+    g1: np.ndarray  # (m, n, k)
+
+
+def _stream_chunk(batch: BatchedModel, task: _ChunkTask, items, eig=None) -> _ChunkResult:
     """One chunk's registered metrics, streamed (`qc_control.numerics.lti.OutputStream`
     into `qc_control.ride.metrics.MetricStream`): no ``(designs, outputs, samples)``
     array, only a segment of it at a time.
-
-    When a metric reads the Wk-weighted acceleration, the filter (exact for
-    an input linear between samples, `qc_control.ride.iso2631.wk_discrete`) runs
-    inside the scan: its state ``x̃`` joins the car's, so it is carried from
-    block to block,
-
-    .. math:: \\begin{bmatrix} x \\\\ \\tilde x \\end{bmatrix}_{k+1} =
-              \\begin{bmatrix} Φ & 0 \\\\ \\tilde B C_a & A_d \\end{bmatrix}
-              \\begin{bmatrix} x \\\\ \\tilde x \\end{bmatrix}_k + \\dots, \\quad
-              a_w = C_w \\tilde x + \\tilde D a, \\quad \\tilde x_0 = -B_1 a_0,
-
-    the same recursion `qc_control.ride.iso2631.wk_weighted` evaluates by FFT.
 
     With ``eig = np.linalg.eig(A)`` (the sweep has it, for its ordering), its
     eigenvalues give ``stable`` and its eigenvectors, which the step map
     ``R(hA)`` shares, the `TailBound`: no decomposition per chunk.
     """
-    A, B, C, D = batch.A, batch.B, batch.C, batch.D
-    m, n = A.shape[0], A.shape[-1]
-    stream = MetricStream(items, roles, T, batch.tire_stiffness, batch.static_load)
+    T, U, labels = task.T, task.U, task.labels
+    m, n = batch.A.shape[0], batch.A.shape[-1]
+    stream = MetricStream(items, task.roles, T, batch.tire_stiffness, batch.static_load)
     read = list(stream.labels)
     rows = [labels.index(label) for label in read]
-    C, D = C[:, rows], D[:, rows]
     H = (T[-1] - T[0]) / (T.size - 1)
-    phi, g0, g1 = step_matrices(method, A, B, H, substeps)
-    x0 = np.broadcast_to(X0, (m, n))
+    phi, g0, g1 = step_matrices(task.method, batch.A, batch.B, H, task.substeps)
+    scan = _Scan(phi, np.broadcast_to(task.X0, (m, n)), batch.C[:, rows], batch.D[:, rows], g0, g1)
     if stream.weighted:
-        acc = labels.index(roles.body_acc)
-        Ca, Da = batch.C[:, acc], batch.D[:, acc]  # (m, n), (m, k)
-        Ad, Bt, Cw, Dt, B1 = wk_discrete(round(float(H), 15))
-        nw = Ad.shape[0]
-        big = np.zeros((m, n + nw, n + nw))
-        big[:, :n, :n] = phi
-        big[:, n:, :n] = Bt[:, None] * Ca[:, None, :]
-        big[:, n:, n:] = Ad
-        phi = big
-        a0 = Ca @ X0 + (Da @ U[:, 0] if U is not None else 0.0)
-        x0 = np.concatenate([x0, -a0[:, None] * B1], axis=1)
-        weighted = np.concatenate([Dt * Ca, np.broadcast_to(Cw[0], (m, nw))], axis=1)
-        C = np.concatenate([np.pad(C, ((0, 0), (0, 0), (0, nw))), weighted[:, None]], axis=1)
-        D = np.concatenate([D, Dt * Da[:, None]], axis=1)
-        g0 = np.concatenate([g0, Bt[:, None] * Da[:, None, :]], axis=1)
-        g1 = np.pad(g1, ((0, 0), (0, nw), (0, 0)))
+        scan = _with_wk_filter(scan, batch, labels.index(task.roles.body_acc), task, H)
         read.append(WEIGHTED_ACC)
     with np.errstate(over="ignore", invalid="ignore"):
-        sums, tail = None, None
-        if U is None:  # longer blocks: no input Toeplitz to pay for, fewer scan rounds
-            out = OutputStream(phi, x0, T.size, C, block=64)
-            # every sum of squares of the free response is the block Gram form
-            # (OutputStream.sum_squares): no samples needed for it
-            gram = [i for i, label in enumerate(read) if "sumsq" in stream.kinds(label)]
-            if gram:
-                total = out.sum_squares()
-                first = np.einsum("mra,ma->mr", C, x0)  # y_0 = C x0
-                sums = {read[i]: (total[:, i], first[:, i]) for i in gram}
-        else:
-            out = OutputStream(phi, x0, T.size, C, D=D, g0=g0, g1=g1, U=U, block=16)
+        out, sums = _output_stream(scan, U, stream, read)
         final = {label: out.final[:, i] for i, label in enumerate(read)}
         stream.start(final, sums)
         rows = [
@@ -363,38 +359,99 @@ def _stream_chunk(batch: BatchedModel, labels, roles, T, X0, U, method, substeps
         if len(rows) < len(read):
             out.keep_rows(rows)
         streamed = [read[i] for i in rows]
+        tail = None
         if U is None and streamed:
             # the free response decays: once no later sample can move a peak, a
             # lift-off count or the settling time (TailBound, the modal bound on
             # every later output), the rest of the samples are not needed
             # the car's eigenvectors fit Φ = R(hA) (not the Wk filter's extended Φ)
             vectors = None if eig is None or stream.weighted else eig[1]
-            tail = TailBound(phi, C[:, rows], vectors=vectors)
-        cut = False
-        for index, y in out:
-            stream.update(index, {label: y[:, i] for i, label in enumerate(streamed)})
-            if tail is not None and out.carry is not None:
-                bound = tail(out.carry)
-                done = stream.settled(
-                    {label: bound[:, i] for i, label in enumerate(streamed)}, band=False
-                )
-                if done.all():
-                    cut = True
-                    break
-        if cut and tail is not None:
-            settling = [i for i, label in enumerate(streamed) if "settle" in stream.kinds(label)]
-            if settling:
-                carries = out.block_carries()
-                for i in settling:
-                    end, M = stream.settling_state(streamed[i])
-                    last = _last_outside(out, tail, carries, i, end, 0.02 * M, T.size)
-                    stream.set_last_outside(streamed[i], last)
+            tail = TailBound(scan.phi, scan.C[:, rows], vectors=vectors)
+        if _stream_outputs(out, stream, streamed, tail):
+            _settle_after_cut(out, stream, streamed, tail, T.size)
         stream.update(np.array([T.size - 1]), {k: v[:, None] for k, v in final.items()})
-        lam = np.linalg.eigvals(A) if eig is None else eig[0]
-        result = {"stable": step_is_stable(method, H / substeps, lam)}
-        for column, values in stream.result().items():
-            result[column] = values
-    return result
+        lam = np.linalg.eigvals(batch.A) if eig is None else eig[0]
+        stable = step_is_stable(task.method, H / task.substeps, lam)
+        return _ChunkResult(stable, dict(stream.result()), None)
+
+
+def _with_wk_filter(scan: _Scan, batch: BatchedModel, acc: int, task: _ChunkTask, H) -> _Scan:
+    """The scan with the Wk filter's state carried beside the car's.
+
+    The filter (exact for an input linear between samples,
+    `qc_control.ride.iso2631.wk_discrete`) runs inside the scan: its state
+    ``x̃`` joins the car's, so it is carried from block to block,
+
+    .. math:: \\begin{bmatrix} x \\\\ \\tilde x \\end{bmatrix}_{k+1} =
+              \\begin{bmatrix} Φ & 0 \\\\ \\tilde B C_a & A_d \\end{bmatrix}
+              \\begin{bmatrix} x \\\\ \\tilde x \\end{bmatrix}_k + \\dots, \\quad
+              a_w = C_w \\tilde x + \\tilde D a, \\quad \\tilde x_0 = -B_1 a_0,
+
+    the same recursion `qc_control.ride.iso2631.wk_weighted` evaluates by FFT;
+    its output ``a_w`` is the last row of the observation.
+    """
+    m, n = scan.x0.shape
+    Ca, Da = batch.C[:, acc], batch.D[:, acc]  # (m, n), (m, k)
+    Ad, Bt, Cw, Dt, B1 = wk_discrete(round(float(H), 15))
+    nw = Ad.shape[0]
+    big = np.zeros((m, n + nw, n + nw))
+    big[:, :n, :n] = scan.phi
+    big[:, n:, :n] = Bt[:, None] * Ca[:, None, :]
+    big[:, n:, n:] = Ad
+    a0 = Ca @ task.X0 + (Da @ task.U[:, 0] if task.U is not None else 0.0)
+    x0 = np.concatenate([scan.x0, -a0[:, None] * B1], axis=1)
+    weighted = np.concatenate([Dt * Ca, np.broadcast_to(Cw[0], (m, nw))], axis=1)
+    C = np.concatenate([np.pad(scan.C, ((0, 0), (0, 0), (0, nw))), weighted[:, None]], axis=1)
+    D = np.concatenate([scan.D, Dt * Da[:, None]], axis=1)
+    g0 = np.concatenate([scan.g0, Bt[:, None] * Da[:, None, :]], axis=1)
+    g1 = np.pad(scan.g1, ((0, 0), (0, nw), (0, 0)))
+    return _Scan(big, x0, C, D, g0, g1)
+
+
+def _output_stream(scan: _Scan, U, stream: MetricStream, read: list[str]):
+    """``(out, sums)``: the `OutputStream` of the scan, and for a free response the
+    sums of squares its block Gram form gives without samples (else None)."""
+    if U is not None:
+        out = OutputStream(scan.phi, scan.x0, stream.T.size, scan.C, D=scan.D, g0=scan.g0,
+                           g1=scan.g1, U=U, block=16)  # fmt: skip
+        return out, None
+    # longer blocks: no input Toeplitz to pay for, fewer scan rounds
+    out = OutputStream(scan.phi, scan.x0, stream.T.size, scan.C, block=64)
+    # every sum of squares of the free response is the block Gram form
+    # (OutputStream.sum_squares): no samples needed for it
+    gram = [i for i, label in enumerate(read) if "sumsq" in stream.kinds(label)]
+    if not gram:
+        return out, None
+    total = out.sum_squares()
+    first = np.einsum("mra,ma->mr", scan.C, scan.x0)  # y_0 = C x0
+    return out, {read[i]: (total[:, i], first[:, i]) for i in gram}
+
+
+def _stream_outputs(out: OutputStream, stream: MetricStream, streamed, tail) -> bool:
+    """Feed the output segments to the metrics; True when `TailBound` proved that no
+    later sample can change them and the stream was cut short."""
+    for index, y in out:
+        stream.update(index, {label: y[:, i] for i, label in enumerate(streamed)})
+        if tail is not None and out.carry is not None:
+            bound = tail(out.carry)
+            done = stream.settled(
+                {label: bound[:, i] for i, label in enumerate(streamed)}, band=False
+            )
+            if done.all():
+                return True
+    return False
+
+
+def _settle_after_cut(out: OutputStream, stream: MetricStream, streamed, tail, N: int) -> None:
+    """After a cut, each settling time's last excursion, searched backwards (`_last_outside`)."""
+    settling = [i for i, label in enumerate(streamed) if "settle" in stream.kinds(label)]
+    if not settling:
+        return
+    carries = out.block_carries()
+    for i in settling:
+        end, M = stream.settling_state(streamed[i])
+        last = _last_outside(out, tail, carries, i, end, 0.02 * M, N)
+        stream.set_last_outside(streamed[i], last)
 
 
 def _last_outside(out: OutputStream, tail: TailBound, carries, row, final, band, N, width=8):
@@ -565,32 +622,10 @@ def sweep(
     if T is None:
         raise ValueError("give T (a time grid) for a simulated sweep, or road= for a spectral one")
     model = quarter_car_model(road=U is not None) if model is None else model
-    if isinstance(designs, Mapping):
-        designs = design_grid(designs, model.params)
-    designs = list(designs)
-    if not designs:
-        raise ValueError("designs is empty: give at least one design")
+    designs = _design_list(designs, model)
     tab = get_method(method)
-    T = check_time_grid(T, "T")
-    if uniform_step(T) is None:
-        raise ValueError("T must be uniformly spaced for a sweep")
+    T, X0, U = _sweep_signals(model.system, T, X0, U)
     substeps = check_substeps(substeps)
-    sys_ = model.system
-    n, k = sys_.nstates, sys_.ninputs
-    X0 = np.asarray(X0, dtype=float)
-    if X0.shape != (n,) or not np.all(np.isfinite(X0)):
-        raise ValueError(
-            f"X0 must be {n} finite numbers {list(sys_.state_labels)}, got {X0.tolist()}"
-        )
-    if U is not None:
-        given = np.shape(U)
-        U = np.asarray(U, dtype=float)
-        U = U.reshape(1, -1) if U.ndim == 1 else U
-        if U.shape != (k, T.size) or not np.all(np.isfinite(U)):
-            raise ValueError(
-                f"U must be finite, of shape ({T.size},) or ({k}, {T.size}) for the inputs "
-                f"{list(sys_.input_labels)} on T, got shape {given}"
-            )
     if chunk_size is not None and (
         isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1
     ):
@@ -601,28 +636,70 @@ def sweep(
     if chunk_size is None:
         chunk_size = _vector_designs(U, metric_items, states)
     streamed = not states and not isinstance(metrics, Mapping)
-    rows = min(chunk_size, len(designs), VECTOR_DESIGNS) * (sys_.noutputs + n * states)
-    # streamed: a segment of outputs (~1 MB), a run of carries (~2 MB) and the padded
-    # input; otherwise a chunk's outputs (and states) with the scan's temporaries,
-    # plus every kept trajectory
-    per_chunk = (2**22 + 16 * T.size) if streamed else 3 * rows * T.size * 8
-    check_memory(
-        per_chunk + states * len(designs) * n * T.size * 8,
-        f"a sweep of {len(designs)} designs over {T.size} samples"
-        + (" keeping their states" if states else ""),
-        "use fewer samples, a smaller chunk_size" + (" or states=False" if states else ""),
-    )
-
+    _check_sweep_memory(model.system, len(designs), T.size, chunk_size, streamed, states)
     params, errors = _validate(designs, type(model.params))
-    if is_nonlinear(model):  # stepped in a batch (qc_control.studies.nlsweep), or one by one
+    if model.is_nonlinear:  # stepped in a batch (qc_control.studies.nlsweep), or one by one
         stable, table, kept = nonlinear_sweep(
             model, params, T, X0, U, tab, substeps, metric_items, states,
             events=events, executor=executor, chunk_size=nl_chunk,
         )  # fmt: skip
-        frame, err_frame = _tables(designs, params, errors, model, stable, table)
-        return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)
-    if events:
+    elif events:
         raise ValueError("events=True applies to a nonlinear model; this one is linear")
+    else:
+        task = _ChunkTask(
+            tuple(model.system.output_labels), model.roles, T, X0, U, tab, substeps,
+            metric_items, states,
+        )  # fmt: skip
+        chunks, batch, eig = _linear_chunks(model, params, chunk_size, free=U is None and streamed)
+        results = _chunk_results(executor, chunks, batch, task, eig)
+        stable, table, kept = _gather(chunks, results, len(designs), task, progress)
+    frame, err_frame = _tables(designs, params, errors, model, stable, table)
+    return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)
+
+
+def _design_list(designs, model: VehicleModel) -> list:
+    """The designs as a list: a grid dict expanded over the model's parameters."""
+    if isinstance(designs, Mapping):
+        designs = design_grid(designs, model.params)
+    designs = list(designs)
+    if not designs:
+        raise ValueError("designs is empty: give at least one design")
+    return designs
+
+
+def _sweep_signals(system, T, X0, U):
+    """``T`` (uniform), ``X0`` and ``U`` (None: the free response) checked as the
+    responses check them (`qc_control.responses.timeresp.check_initial_state`,
+    ``check_input_samples``)."""
+    T = check_time_grid(T, "T")
+    if uniform_step(T) is None:
+        raise ValueError("T must be uniformly spaced for a sweep")
+    X0 = check_initial_state(X0, system.nstates, system.state_labels)
+    if U is not None:
+        U = check_input_samples(U, system.ninputs, T.size, system.input_labels)
+    return T, X0, U
+
+
+def _check_sweep_memory(system, designs: int, N: int, chunk_size, streamed, states) -> None:
+    """Refuse a sweep whose chunks (and kept states) would not fit in memory."""
+    n = system.nstates
+    rows = min(chunk_size, designs, VECTOR_DESIGNS) * (system.noutputs + n * states)
+    # streamed: a segment of outputs (~1 MB), a run of carries (~2 MB) and the padded
+    # input; otherwise a chunk's outputs (and states) with the scan's temporaries,
+    # plus every kept trajectory
+    per_chunk = (2**22 + 16 * N) if streamed else 3 * rows * N * 8
+    check_memory(
+        per_chunk + states * designs * n * N * 8,
+        f"a sweep of {designs} designs over {N} samples"
+        + (" keeping their states" if states else ""),
+        "use fewer samples, a smaller chunk_size" + (" or states=False" if states else ""),
+    )
+
+
+def _linear_chunks(model: VehicleModel, params, chunk_size: int, free: bool):
+    """``(chunks, batch, eig)``: the valid designs' matrices, and chunks of them as
+    ``(design indices, rows of batch)``; ``eig`` is the batch's decomposition
+    when a free sweep orders its designs by decay (else None)."""
     good = [i for i, p in enumerate(params) if p is not None]
     batch = (
         model.batch([params[i] for i in good])
@@ -631,7 +708,7 @@ def sweep(
     )
     order = np.arange(len(good))
     eig = None
-    if U is None and streamed and len(good) > VECTOR_DESIGNS:
+    if free and len(good) > VECTOR_DESIGNS:
         # a free chunk stops once its slowest design has decayed past what its
         # metrics can see (TailBound): chunk designs of like decay together,
         # by their slowest mode's decay rate, fastest first (results go back by
@@ -644,20 +721,27 @@ def sweep(
         ([good[i] for i in order[s : s + chunk_size]], order[s : s + chunk_size])
         for s in range(0, len(good), chunk_size)
     ]
-    args = (tuple(sys_.output_labels), model.roles, T, X0, U, tab, substeps, metric_items, states)
+    return chunks, batch, eig
+
+
+def _chunk_results(executor, chunks, batch: BatchedModel, task: _ChunkTask, eig):
+    """Each chunk's `_ChunkResult`, in order: computed here, or by ``executor``."""
     if executor is None:
-        results = (_run_chunk(_take(batch, sl), *args, eig=_eig_part(eig, sl)) for _, sl in chunks)
-    elif isinstance(executor, Executor) or hasattr(executor, "submit"):
+        return (_run_chunk(_take(batch, sl), task, eig=_eig_part(eig, sl)) for _, sl in chunks)
+    if isinstance(executor, Executor) or hasattr(executor, "submit"):
         futures = [
-            executor.submit(_run_chunk, _take(batch, sl), *args, eig=_eig_part(eig, sl))
+            executor.submit(_run_chunk, _take(batch, sl), task, eig=_eig_part(eig, sl))
             for _, sl in chunks
         ]
-        results = (f.result() for f in futures)
-    else:
-        raise TypeError(
-            f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}"
-        )
+        return (f.result() for f in futures)
+    raise TypeError(
+        f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}"
+    )
 
+
+def _gather(chunks, results, ndesigns: int, task: _ChunkTask, progress):
+    """``(stable, table, states)`` by design index from the chunks' results,
+    with a progress bar on a terminal."""
     quiet = progress is False or (progress is None and not sys.stderr.isatty())
     bar = tqdm(
         results,
@@ -667,20 +751,18 @@ def sweep(
         disable=quiet,
         delay=0 if progress else 1.0,
     )
-    columns = [column for column, _, _ in metric_items]
-    table = {column: np.full(len(designs), np.nan) for column in columns}
-    stable = np.zeros(len(designs), dtype=bool)
-    kept = np.full((len(designs), n, T.size), np.nan) if states else None
-    for (idx, _), (result, x) in zip(chunks, bar):
-        stable[idx] = result["stable"]
-        for column in columns:
-            table[column][idx] = result[column]
+    table = {column: np.full(ndesigns, np.nan) for column, _, _ in task.metric_items}
+    stable = np.zeros(ndesigns, dtype=bool)
+    n, N = task.X0.size, task.T.size
+    kept = np.full((ndesigns, n, N), np.nan) if task.keep_states else None
+    for (idx, _), result in zip(chunks, bar):
+        stable[idx] = result.stable
+        for column, values in result.metrics.items():
+            table[column][idx] = values
         if kept is not None:
-            kept[idx] = x
+            kept[idx] = result.states
     bar.close()
-
-    frame, err_frame = _tables(designs, params, errors, model, stable, table)
-    return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)
+    return stable, table, kept
 
 
 def _eig_part(eig, idx):
@@ -722,11 +804,7 @@ def _spectral_sweep(designs, T, U, road, metrics, model) -> SweepResult:
             "over the unbounded band"
         )
     model = quarter_car_model(road=True) if model is None else model
-    if isinstance(designs, Mapping):
-        designs = design_grid(designs, model.params)
-    designs = list(designs)
-    if not designs:
-        raise ValueError("designs is empty: give at least one design")
+    designs = _design_list(designs, model)
     names = (
         SPECTRAL_METRICS
         if metrics is None
