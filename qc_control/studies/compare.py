@@ -22,6 +22,7 @@ import scipy
 import scipy.signal
 from scipy.integrate import solve_ivp
 
+from .. import compat
 from ..models.halfcar import FullCarParams, HalfCarParams
 from ..models.modal import ModalAnalysis, modal_analysis
 from ..models.nonlinear import NONLINEAR_OUTPUTS, nonlinear_quarter_car_model
@@ -949,8 +950,8 @@ def nonlinear_reference(
     x0 = check_initial_state(X0, sys.nstates)
     u = check_input_samples(U, sys.ninputs, T.size)
     u_of_t = linear_input(T, u)
-    sys._update_params(params)
-    current = getattr(sys, "_current_params", params or {})
+    compat.update_params(sys, params)
+    current = compat.current_params(sys, params or {})
     if events is True:
         g = getattr(sys, "switching", None)
         if g is None:
@@ -960,8 +961,10 @@ def nonlinear_reference(
     else:
         raise TypeError(f"events must be None, True or a callable, got {events!r}")
 
+    derivative = compat.state_derivative(sys)
+
     def rhs(t, x):
-        return sys._rhs(t, x, u_of_t(t))
+        return derivative(t, x, u_of_t(t))
 
     switching = None if g is None else (lambda t, x: np.atleast_1d(g(t, x, u_of_t(t), current)))
     # the input is linear between samples: its slope jumps where its second difference is
