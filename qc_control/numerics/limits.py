@@ -13,6 +13,8 @@ from __future__ import annotations
 import functools
 import os
 
+import psutil
+
 __all__ = ["ResourceLimitError", "memory_limit", "check_memory", "format_bytes", "ENV_VAR"]
 
 #: The environment variable that sets the memory limit.
@@ -34,9 +36,14 @@ def format_bytes(n: float) -> str:
 
 
 def _physical_memory() -> int | None:
+    """The machine's physical memory in bytes (None where it cannot be read).
+
+    psutil reads it on Linux, macOS and Windows alike (``os.sysconf``, the
+    POSIX way, does not exist on Windows).
+    """
     try:
-        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+        return int(psutil.virtual_memory().total)
+    except (OSError, RuntimeError):  # pragma: no cover - a platform psutil cannot read
         return None
 
 

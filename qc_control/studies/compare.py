@@ -13,14 +13,14 @@ import time
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import control
 import numpy as np
 import pandas as pd
 import scipy
 import scipy.signal
-from scipy.integrate import solve_ivp
+from scipy.integrate import OdeSolution, solve_ivp
 
 from .. import compat
 from ..models.halfcar import FullCarParams, HalfCarParams
@@ -351,7 +351,7 @@ def exact_reference(sys, T, X0, U=None, *, outputs=None, repeats: int = 0) -> Re
         other = C @ (V @ (z0[:, None] * np.exp(np.outer(lam, T - T[0])))).real
         how = "the modal closed form C·V·exp(Λt)·V⁻¹·x0"
     else:
-        lti = scipy.signal.StateSpace(A, np.asarray(sys.B, dtype=float), C, D)
+        lti = (A, np.asarray(sys.B, dtype=float), C, D)  # lsim builds its StateSpace from these
         _, y, _ = scipy.signal.lsim(lti, U.T if U.shape[0] > 1 else U[0], T - T[0], X0=X0)
         other = np.atleast_2d(y.T) if y.ndim > 1 else y[None]
         how = "scipy.signal.lsim"
@@ -898,12 +898,12 @@ def _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks=()):
                 )
             t_end = float(sol.t[-1])
             inside = (T >= t) & (T <= t_end)
-            out[:, inside] = sol.sol(T[inside])
+            out[:, inside] = cast(OdeSolution, sol.sol)(T[inside])  # dense_output=True gives it
             if sol.status != 1 or t_end >= t_stop:
                 t, x = t_end, sol.y[:, -1]
                 break
             events.append(t_end)
-            fired = [k for k, te in enumerate(sol.t_events) if te.size and te[-1] == t_end]
+            fired = [k for k, te in enumerate(sol.t_events or []) if te.size and te[-1] == t_end]
             which.append(fired[0] if fired else -1)
             # past the root, where the switching function has its new sign
             past = min(t_end + nudge, t_stop)
