@@ -579,8 +579,15 @@ def compile_interconnect(sys) -> CompiledInterconnect | None:
     Fx = AL + BL @ Ux[uL]
     Fn = [BL @ Un[np.ix_(uL, np.arange(starts[i], starts[i + 1]))] for i in range(nn)]
     Fw = BL @ Uw[uL]
-    Ox = O[:, yL] @ Gx
-    On = [O[:, yL] @ Gn[:, starts[i] : starts[i + 1]] + O[:, yN[i]] for i in range(nn)]
-    Ow = O[:, yL] @ Gw
+    # the outputs read subsystem outputs (O's first columns) and may read subsystem inputs
+    Ou = O[:, y_off[-1] :]
+    Ox = O[:, yL] @ Gx + Ou @ Ux
+    On = [
+        O[:, yL] @ Gn[:, starts[i] : starts[i + 1]]
+        + O[:, yN[i]]
+        + Ou @ Un[:, starts[i] : starts[i + 1]]
+        for i in range(nn)
+    ]
+    Ow = O[:, yL] @ Gw + Ou @ Uw
     nonlin = [(subs[i], slice(x_off[i], x_off[i + 1]), uN[j]) for j, i in enumerate(non)]
     return CompiledInterconnect(sys, xL, nonlin, order, (Px, Pn, Pw, Fx, Fn, Fw, Ox, On, Ow))
