@@ -87,10 +87,9 @@ def _add_architecture(app, docname, source):
         source[0] = source[0].replace("\n   api\n", "\n   api\n   architecture\n")
 
 
-# Docstrings in modules this docs stream does not own write |x| for a norm or a
-# magnitude, which reStructuredText reads as a substitution (an error under -W).
-# Until their owners write ``|x|`` (or escape the bars) there, the bars of exactly these
-# docstrings are escaped outside inline literals. Reported to the coordinator.
+# These docstrings write |x| for a norm or a magnitude, which reStructuredText reads
+# as a substitution (an error under -W). Their bars are escaped outside inline
+# literals; a docstring that writes ``|x|`` (or escapes the bars) needs no entry here.
 _BARS = {
     "qc_control.models.modal.Mode",
     "qc_control.studies.compare.MethodComparison",

@@ -241,12 +241,12 @@ _LAZY: dict[str, str] = {
     "half_car_model": "models.halfcar",
     "full_car": "models.halfcar",
     "full_car_model": "models.halfcar",
-    # nonlinear quarter car (issue 11)
+    # nonlinear quarter car
     "nonlinear_quarter_car": "models.nonlinear",
     "nonlinear_quarter_car_model": "models.nonlinear",
     "BumpStop": "models.nonlinear",
     "PiecewiseDamper": "models.nonlinear",
-    # batched nonlinear sweeps (issue 11 item 7)
+    # batched nonlinear sweeps
     "NonlinearQuarterCarBatch": "models.nonlinear",
     "simulate_batch": "studies.nlsweep",
     "BatchResponse": "studies.nlsweep",

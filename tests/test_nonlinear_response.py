@@ -608,3 +608,42 @@ def test_fused_steps_cut_a_divergent_run_as_integrate_does():
     early = r.t <= 0.9
     np.testing.assert_allclose(x[early], ref.x[0, early], rtol=1e-12, atol=0)
     assert np.all(np.isfinite(x)) and np.array_equal(y, x)  # y = x, from the states
+
+
+def _wired(plant, ctrl):
+    """``plant`` under ``ctrl``, with outputs that name a subsystem input."""
+    return control.interconnect(
+        [plant, ctrl],
+        connections=[["ctrl.y", "plant.y"], ["plant.u", "ctrl.u"]],
+        inplist=["ctrl.r"],
+        outlist=["plant.y", "plant.u", "ctrl.r"],
+        name="cl",
+    )
+
+
+@pytest.mark.parametrize("fused", [True, False])
+def test_outputs_that_name_subsystem_inputs_are_controls_outputs(fused):
+    """An interconnection's outputs may name subsystem inputs (the input
+    columns of control's ``output_map``). At qc's own states and inputs they
+    equal python-control's public ``sys.output`` to rounding (1e-12 relative:
+    the same sums in another order), for a linear plant under a static
+    controller (whole steps fused) and under one with a state (the compiled
+    right-hand side)."""
+    plant = control.ss(
+        [[0.0, 1.0], [-4.0, -0.4]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]],
+        inputs="u", outputs="y", name="plant",
+    )  # fmt: skip
+    ctrl = control.nlsys(
+        None if fused else (lambda t, x, u, p: [u[0] - u[1]]),
+        lambda t, x, u, p: [-np.tanh(3.0 * (u[0] - u[1]) + (0.0 if fused else x[0]))],
+        inputs=["r", "y"],
+        outputs="u",
+        states=None if fused else ["z"],
+        name="ctrl",
+    )
+    cl = _wired(plant, ctrl)
+    x0 = [0.5, 0.0] if fused else [0.5, 0.0, 0.0]
+    T = grid(0.01, 2.0)
+    r = qc.input_output_response(cl, T, 0.5 + 0.1 * T, x0)
+    theirs = np.array([cl.output(t, r.states[:, k], r.inputs[:, k]) for k, t in enumerate(T)]).T
+    np.testing.assert_allclose(r.outputs, theirs, rtol=1e-12, atol=1e-14)

@@ -1,11 +1,13 @@
 """The report writer under faults: one complete report afterwards, no litter,
 nothing of the user's lost (issue 14 items 15-19)."""
 
-import fcntl
 import os
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
+import filelock
 import numpy as np
 import pytest
 
@@ -116,16 +118,57 @@ def test_a_fault_at_any_stage_leaves_one_complete_report(cmp, tmp_path, monkeypa
 
 
 def test_a_second_run_into_the_same_place_stops_with_one_line(cmp, tmp_path):
-    """Item 17: a run holding the lock makes another stop cleanly (not ENOTEMPTY)."""
-    fd = os.open(tmp_path, os.O_RDONLY)
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX)
+    """Item 17: a run holding the lock makes another stop cleanly (not ENOTEMPTY).
+
+    The other run is this test holding the report's lock file as a run does
+    (filelock's locks exclude each other within one process too)."""
+    held = filelock.FileLock(rep._lock_file(tmp_path / "R"), timeout=0)
+    with held:
         with pytest.raises(ReportError, match="another qc-control run is writing a report"):
             write_report(cmp, tmp_path / "R", ("md",))
-    finally:
-        os.close(fd)
-    write_report(cmp, tmp_path / "R", ("md",))  # the lock is released with the descriptor
+        assert not (tmp_path / "R").exists()
+    write_report(cmp, tmp_path / "R", ("md",))  # the lock is free again
     assert (tmp_path / "R" / "report.md").exists()
+    assert [p.name for p in tmp_path.iterdir()] == ["R"]  # no lock file left behind
+
+
+def test_a_writer_in_another_process_holds_off_a_second(cmp, tmp_path):
+    """Two processes: one holds the report's lock as a run does while it
+    swaps; the other's write_report stops with the one line, and succeeds
+    once the first is done."""
+    script = (
+        "import sys, time\n"
+        "from pathlib import Path\n"
+        "from qc_control import report as rep\n"
+        "out = Path(sys.argv[1])\n"
+        "with rep._exclusive(out.parent, out):\n"
+        "    print('held', flush=True)\n"
+        "    sys.stdin.readline()\n"
+    )
+    out = tmp_path / "R"
+    holder = subprocess.Popen(
+        [sys.executable, "-c", script, str(out)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
+        with pytest.raises(ReportError, match="another qc-control run is writing a report"):
+            write_report(cmp, out, ("md",))
+    finally:
+        holder.communicate("done\n", timeout=60)
+    assert holder.returncode == 0
+    write_report(cmp, out, ("md",))
+    assert (out / "report.md").exists() and [p.name for p in tmp_path.iterdir()] == ["R"]
+
+
+def test_a_lock_file_left_by_a_killed_run_is_taken_and_removed(cmp, tmp_path):
+    """A run killed while holding the lock leaves its lock file, unlocked (the
+    system drops the lock with the process): the next run goes ahead."""
+    rep._lock_file(tmp_path / "R").write_text("")
+    write_report(cmp, tmp_path / "R", ("md",))
+    assert [p.name for p in tmp_path.iterdir()] == ["R"]
 
 
 def test_the_report_directory_follows_the_umask(cmp, tmp_path):

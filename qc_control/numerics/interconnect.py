@@ -50,6 +50,7 @@ from collections.abc import Callable
 import control
 import numpy as np
 
+from .. import compat
 from .sampled import linear_input
 from .stepper import affine_rk_steps, sample_steps
 
@@ -101,7 +102,7 @@ class CompiledInterconnect:
             for i, Pn in self._Pn[j]:
                 u = u + Pn @ ys[i]
             us[j] = u
-            y = sub._out(t, x[xs], u)
+            y = compat.output_function(sub)(t, x[xs], u)
             ys[j] = y
         return ys, us
 
@@ -127,7 +128,7 @@ class CompiledInterconnect:
         xdot[self._lin_x] = dl
         for (sub, xs, _), u in zip(self._nonlin, us):
             if sub.nstates:
-                xdot[xs] = sub._rhs(t, x[xs], u)
+                xdot[xs] = compat.state_derivative(sub)(t, x[xs], u)
         return xdot
 
     def out(self, t: float, x: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -154,8 +155,9 @@ class CompiledInterconnect:
             for i, Pn in self._Pn[j]:
                 U = U + Pn @ Ys[i]
             Xj = X[xs]
+            out = compat.output_function(sub)
             Ys[j] = (
-                np.array([sub._out(t, Xj[:, k], U[:, k]) for k, t in enumerate(ts)], dtype=float)
+                np.array([out(t, Xj[:, k], U[:, k]) for k, t in enumerate(ts)], dtype=float)
                 .reshape(len(ts), -1)
                 .T
             )
@@ -203,7 +205,7 @@ class CompiledInterconnect:
             get, asarray = index.get, np.asarray
             if sub.outfcn is None:  # the output is the (empty) state: nothing to feed back
                 return f_plain(Fx, fw_rows, get, direct)
-            outfcn, params = sub.outfcn, sub._current_params
+            outfcn, params = sub.outfcn, compat.current_params(sub)
             n = Fx.shape[0]
             G = np.vstack([Fx, Px])  # one product gives both x's derivative part and u
             # ... and one sum adds the input's terms to both: [Fw w; Pw w] per stage
@@ -376,7 +378,7 @@ class FusedSteps:
                     u = u + Pn_ji @ y[y_start[i] : y_start[i + 1]]
                 sub = nonlin[j][0]
                 y[y_start[j] : y_start[j + 1]] = np.asarray(
-                    sub.outfcn(t, empty, u, sub._current_params)
+                    sub.outfcn(t, empty, u, compat.current_params(sub))
                 ).reshape(-1)
 
         self._phi = phi
@@ -413,7 +415,7 @@ class FusedSteps:
         if self._single and self._p == 1:
             # the common case (one static controller, one output): a number, no y vector
             sub = self._sub
-            outfcn, params, empty = sub.outfcn, sub._current_params, np.empty(0)
+            outfcn, params, empty = sub.outfcn, compat.current_params(sub), np.empty(0)
 
             def one(t, z):
                 r = outfcn(t, empty, z, params)
@@ -487,10 +489,7 @@ def compile_interconnect(sys) -> CompiledInterconnect | None:
         return None
     if control.isdtime(sys, strict=True):
         return None
-    subs = list(sys.syslist)
-    K = np.asarray(sys.connect_map, dtype=float)
-    E = np.asarray(sys.input_map, dtype=float)
-    O = np.asarray(sys.output_map, dtype=float)
+    subs, K, E, O = compat.interconnection_maps(sys)
     x_off = np.cumsum([0] + [s.nstates for s in subs])
     u_off = np.cumsum([0] + [s.ninputs for s in subs])
     y_off = np.cumsum([0] + [s.noutputs for s in subs])
@@ -559,8 +558,15 @@ def compile_interconnect(sys) -> CompiledInterconnect | None:
     Fx = AL + BL @ Ux[uL]
     Fn = [BL @ Un[np.ix_(uL, np.arange(starts[i], starts[i + 1]))] for i in range(nn)]
     Fw = BL @ Uw[uL]
-    Ox = O[:, yL] @ Gx
-    On = [O[:, yL] @ Gn[:, starts[i] : starts[i + 1]] + O[:, yN[i]] for i in range(nn)]
-    Ow = O[:, yL] @ Gw
+    # the outputs read subsystem outputs (O's first columns) and may read subsystem inputs
+    Ou = O[:, y_off[-1] :]
+    Ox = O[:, yL] @ Gx + Ou @ Ux
+    On = [
+        O[:, yL] @ Gn[:, starts[i] : starts[i + 1]]
+        + O[:, yN[i]]
+        + Ou @ Un[:, starts[i] : starts[i + 1]]
+        for i in range(nn)
+    ]
+    Ow = O[:, yL] @ Gw + Ou @ Uw
     nonlin = [(subs[i], slice(x_off[i], x_off[i + 1]), uN[j]) for j, i in enumerate(non)]
     return CompiledInterconnect(sys, xL, nonlin, order, (Px, Pn, Pw, Fx, Fn, Fw, Ox, On, Ow))

@@ -13,6 +13,11 @@ from __future__ import annotations
 import functools
 import os
 
+try:
+    import psutil
+except ImportError:  # pragma: no cover - a dependency, but see _physical_memory
+    psutil = None
+
 __all__ = ["ResourceLimitError", "memory_limit", "check_memory", "format_bytes", "ENV_VAR"]
 
 #: The environment variable that sets the memory limit.
@@ -34,9 +39,20 @@ def format_bytes(n: float) -> str:
 
 
 def _physical_memory() -> int | None:
+    """The machine's physical memory in bytes (None where it cannot be read).
+
+    psutil reads it on Linux, macOS and Windows alike; where psutil cannot
+    be imported (its Linux backend needs the POSIX-only ``resource``),
+    ``os.sysconf`` gives it on POSIX systems.
+    """
+    if psutil is not None:
+        try:
+            return int(psutil.virtual_memory().total)
+        except (OSError, RuntimeError):  # pragma: no cover - a platform psutil cannot read
+            pass
     try:
         return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - neither
         return None
 
 

@@ -15,7 +15,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import datetime as _dt
-import fcntl
 import functools
 import os
 import platform
@@ -27,6 +26,7 @@ from importlib.metadata import version
 from pathlib import Path
 from typing import TYPE_CHECKING, NamedTuple
 
+import filelock
 import numpy as np
 import pandas as pd
 
@@ -575,25 +575,37 @@ def check_target(out_dir, overwrite: bool = True) -> Path:
     return out
 
 
+def _lock_file(out: Path) -> Path:
+    """The lock file beside the report directory ``out`` (see `write_document`)."""
+    return out.parent / f".{out.name}.lock"
+
+
 @contextlib.contextmanager
 def _exclusive(parent: Path, out: Path):
-    """Hold a lock on the report's parent directory while the report is swapped.
+    """Hold the report's lock (`_lock_file`) while the report is swapped in.
 
-    ``flock`` on the directory itself: nothing is left behind, and a second
-    run into the same place stops with one clear line instead of racing.
+    A second run into the same place stops with one clear line instead of
+    racing. The lock file is removed while the lock is still held, so nothing
+    is left behind: a run that opened the old file before the removal is
+    refused its lock (filelock checks that the file it locked still has a
+    name), and one that comes later locks a new file. Where a file cannot be
+    removed while open (Windows), filelock removes it on release. A killed
+    run leaves the file, unlocked: the next run takes it and removes it.
     """
-    fd = os.open(parent, os.O_RDONLY)
+    lock = filelock.FileLock(_lock_file(out), timeout=0)
     try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise ReportError(
-                f"another qc-control run is writing a report in {str(parent)!r}; wait for it "
-                f"to finish, or choose another --out than {str(out)!r}"
-            ) from None
+        lock.acquire()
+    except filelock.Timeout:
+        raise ReportError(
+            f"another qc-control run is writing a report in {str(parent)!r}; wait for it "
+            f"to finish, or choose another --out than {str(out)!r}"
+        ) from None
+    try:
         yield
     finally:
-        os.close(fd)  # closing the descriptor releases the lock
+        with contextlib.suppress(OSError):
+            _lock_file(out).unlink()
+        lock.release()
 
 
 def _recover(out: Path) -> None:

@@ -37,18 +37,12 @@ from typing import NamedTuple
 import control
 import numpy as np
 
-# python-control's own argument handling and default time grid, reused so
-# that every alias, legacy keyword, default and automatic grid means exactly
-# what it means in control (these are private names of control 0.10.2).
-from control.config import _process_kwargs, _process_param
-
 # Captured at import, so that a caller who routes control's function to this
 # module (as tests/peer does) still reaches control's own difference equation.
-from control.nlsys import _process_vector_argument
 from control.nlsys import input_output_response as _control_io_response
-from control.timeresp import _check_convert_array, _default_time_vector, _timeresp_aliases
 from control.timeresp import forced_response as _control_forced_response
 
+from .. import compat
 from ..numerics.integrate import (
     DivergenceWarning,
     check_substeps,
@@ -632,7 +626,7 @@ def _each(sysdata, respond):
 def _time_grid(sysdata, T, T_num, is_step: bool):
     """``(T, auto)``: python-control's own default grid when T is None or a final time."""
     if T is None or np.asarray(T).size == 1:
-        return _default_time_vector(sysdata, N=T_num, tfinal=T, is_step=is_step), True
+        return compat.default_time_vector(sysdata, N=T_num, tfinal=T, is_step=is_step), True
     return T, False
 
 
@@ -752,9 +746,9 @@ def _combine(parts: list[FixedStepResponse]) -> tuple[_Computed, bool, str | Non
 
 def _with_aliases(kwargs: dict, **named) -> dict:
     """python-control's keyword processing: aliases, legacy names and their errors."""
-    _process_kwargs(kwargs, _timeresp_aliases)
+    compat.process_time_response_kwargs(kwargs)
     values = {
-        name: _process_param(name, value, kwargs, _timeresp_aliases, sigval=sigval)
+        name: compat.process_time_response_param(name, value, kwargs, sigval=sigval)
         for name, (value, sigval) in named.items()
     }
     if kwargs:
@@ -1240,7 +1234,7 @@ def _nonlinear_inputs(sys, T: np.ndarray, U) -> np.ndarray:
         U = np.vstack(rows)
     ninputs = sys.ninputs
     legal = [(ntimepts,), (1, ntimepts)] if ninputs in (None, 1) else [(ninputs, ntimepts)]
-    U = _check_convert_array(U, legal, "Parameter `U`: ", squeeze=False)
+    U = compat.check_convert_array(U, legal, "Parameter `U`: ", squeeze=False)
     if np.iscomplexobj(U):
         raise ValueError("U must be real: the fixed-step engines integrate real states")
     U = np.asarray(U, dtype=float).reshape(-1, ntimepts)
@@ -1252,7 +1246,7 @@ def _nonlinear_inputs(sys, T: np.ndarray, U) -> np.ndarray:
 
 def _nonlinear_state(sys, X0) -> np.ndarray:
     """``X0`` by python-control's rules (lists are stacked, short ones zero-padded), checked."""
-    x0, _ = _process_vector_argument(X0, "X0", sys.nstates)
+    x0, _ = compat.process_vector_argument(X0, "X0", sys.nstates)
     raw = np.asarray(x0)
     if raw.dtype.kind == "c":
         raise ValueError(
@@ -1380,11 +1374,11 @@ def _io_problem(sys, T, U, X0, params) -> _IOProblem:
     T = check_time_grid(np.asarray(T, dtype=float).reshape(-1), "T")
     u_samples = _nonlinear_inputs(sys, T, U)
     x0 = _nonlinear_state(sys, X0)
-    sys._update_params(params)  # as control does, before the output function is first called
+    compat.update_params(sys, params)  # as control does, before the output function is first called
     if sys.outfcn is None:
         noutputs = x0.size if sys.noutputs is None else sys.noutputs
     else:
-        noutputs = np.shape(sys._out(T[0], x0, u_samples[:, 0]))[0]
+        noutputs = np.shape(compat.output_function(sys)(T[0], x0, u_samples[:, 0]))[0]
     if sys.noutputs is not None and sys.noutputs != noutputs:
         raise RuntimeError(
             f"inconsistent size of outputs; system specified {sys.noutputs}, "
@@ -1415,7 +1409,7 @@ def _io_step(sys, prob: _IOProblem, params, io: _IOOptions) -> _Computed:
         if not (isinstance(max_step, (int, float, np.number)) and 0 < max_step < math.inf):
             raise ValueError(f"max_step must be a positive number of seconds, got {max_step!r}")
         substeps = max(substeps, substeps_for(H, float(max_step)))
-    sys._update_params(params)  # linearize may have reset them
+    compat.update_params(sys, params)  # linearize may have reset them
     return _Computed(tab, None, substeps, step_rule, eig)
 
 
@@ -1451,7 +1445,7 @@ def _io_integrate(sys, prob: _IOProblem, grid, at, n_sub, computed: _Computed, i
     event_labels: tuple[str, ...] = ()
     compiled = compile_interconnect(sys) if io.fast else None
     fused = None
-    rhs = sys._rhs
+    rhs = compat.state_derivative(sys)
 
     def f(t, x):
         return rhs(t, x, u_of_t(t))
@@ -1469,7 +1463,7 @@ def _io_integrate(sys, prob: _IOProblem, grid, at, n_sub, computed: _Computed, i
     elif g is None:
         sol = integrate(f, grid, x0, tab, substeps=n_sub)
     else:
-        current = getattr(sys, "_current_params", prob.params or {})
+        current = compat.current_params(sys, prob.params or {})
 
         def switching(t, x):
             return g(t, x, u_of_t(t), current)
@@ -1506,8 +1500,9 @@ def _io_signals(sys, prob: _IOProblem, traj: _IOTrajectory, u_of_t):
         elif compiled is not None and prob.x0.size:
             y[:] = compiled.outputs(t_out, x, u)
         else:
+            out = compat.output_function(sys)
             for i, t in enumerate(t_out.tolist()):
-                y[:, i] = sys._out(t, x[:, i], u[:, i])
+                y[:, i] = out(t, x[:, i], u[:, i])
     return u, y
 
 
@@ -1672,15 +1667,15 @@ def input_output_response(
     >>> bool(np.max(abs(r.states - ref.states)) < 1e-7)
     True
     """
-    _process_kwargs(kwargs, _timeresp_aliases)
-    T = _process_param("timepts", timepts, kwargs, _timeresp_aliases)
-    U = _process_param("inputs", inputs, kwargs, _timeresp_aliases, sigval=0.0)
-    X0 = _process_param("initial_state", initial_state, kwargs, _timeresp_aliases, sigval=0.0)
-    return_x = _process_param(
-        "return_states", return_states, kwargs, _timeresp_aliases, sigval=False
+    compat.process_time_response_kwargs(kwargs)
+    T = compat.process_time_response_param("timepts", timepts, kwargs)
+    U = compat.process_time_response_param("inputs", inputs, kwargs, sigval=0.0)
+    X0 = compat.process_time_response_param("initial_state", initial_state, kwargs, sigval=0.0)
+    return_x = compat.process_time_response_param(
+        "return_states", return_states, kwargs, sigval=False
     )
-    t_eval = _process_param(
-        "evaluation_times", evaluation_times, kwargs, _timeresp_aliases, sigval="T"
+    t_eval = compat.process_time_response_param(
+        "evaluation_times", evaluation_times, kwargs, sigval="T"
     )
     if "solve_ivp_method" in kwargs:
         value = kwargs.pop("solve_ivp_method")

@@ -13,15 +13,16 @@ import time
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, NamedTuple, Protocol, runtime_checkable
+from typing import Any, NamedTuple, Protocol, cast, runtime_checkable
 
 import control
 import numpy as np
 import pandas as pd
 import scipy
 import scipy.signal
-from scipy.integrate import solve_ivp
+from scipy.integrate import OdeSolution, solve_ivp
 
+from .. import compat
 from ..models.modal import ModalAnalysis, modal_analysis
 from ..models.quarter import (
     SEED_X0,
@@ -396,7 +397,7 @@ def exact_reference(sys, T, X0, U=None, *, outputs=None, repeats: int = 0) -> Re
         other = C @ (V @ (z0[:, None] * np.exp(np.outer(lam, T - T[0])))).real
         how = "the modal closed form C·V·exp(Λt)·V⁻¹·x0"
     else:
-        lti = scipy.signal.StateSpace(A, np.asarray(sys.B, dtype=float), C, D)
+        lti = (A, np.asarray(sys.B, dtype=float), C, D)  # lsim builds its StateSpace from these
         _, y, _ = scipy.signal.lsim(lti, U.T if U.shape[0] > 1 else U[0], T - T[0], X0=X0)
         other = np.atleast_2d(y.T) if y.ndim > 1 else y[None]
         how = "scipy.signal.lsim"
@@ -1102,12 +1103,12 @@ def _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks=()):
                 )
             t_end = float(sol.t[-1])
             inside = (T >= t) & (T <= t_end)
-            out[:, inside] = sol.sol(T[inside])
+            out[:, inside] = cast(OdeSolution, sol.sol)(T[inside])  # dense_output=True gives it
             if sol.status != 1 or t_end >= t_stop:
                 t, x = t_end, sol.y[:, -1]
                 break
             events.append(t_end)
-            fired = [k for k, te in enumerate(sol.t_events) if te.size and te[-1] == t_end]
+            fired = [k for k, te in enumerate(sol.t_events or []) if te.size and te[-1] == t_end]
             which.append(fired[0] if fired else -1)
             # past the root, where the switching function has its new sign
             past = min(t_end + nudge, t_stop)
@@ -1154,8 +1155,8 @@ def nonlinear_reference(
     x0 = check_initial_state(X0, sys.nstates)
     u = check_input_samples(U, sys.ninputs, T.size)
     u_of_t = linear_input(T, u)
-    sys._update_params(params)
-    current = getattr(sys, "_current_params", params or {})
+    compat.update_params(sys, params)
+    current = compat.current_params(sys, params or {})
     if events is True:
         g = getattr(sys, "switching", None)
         if g is None:
@@ -1165,8 +1166,10 @@ def nonlinear_reference(
     else:
         raise TypeError(f"events must be None, True or a callable, got {events!r}")
 
+    derivative = compat.state_derivative(sys)
+
     def rhs(t, x):
-        return sys._rhs(t, x, u_of_t(t))
+        return derivative(t, x, u_of_t(t))
 
     switching = None if g is None else (lambda t, x: np.atleast_1d(g(t, x, u_of_t(t), current)))
     # the input is linear between samples: its slope jumps where its second difference is

@@ -428,7 +428,7 @@ def pareto_front(
     frame["feasible"], frame["pareto"] = feasible, pareto
     front = frame[pareto].sort_values(cols[0]).reset_index(drop=True)
 
-    marks: dict[str, Mapping] = {}
+    marks: dict[str, pd.Series] = {}
     seed_row = spectral_ride(model, road, wk=wk).iloc[0]
     marks["passive (this car)"] = seed_row
     for goal in ("comfort", "road_holding"):

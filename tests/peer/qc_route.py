@@ -62,6 +62,7 @@ import numpy as np
 import pytest
 
 import qc_control.responses.timeresp as qc_response
+from qc_control import compat
 
 MODE = os.environ.get("QC_PEER_MODE", "qc")
 SCOPE = os.environ.get("QC_PEER_SCOPE", "direct")
@@ -194,7 +195,7 @@ def _jacobian(system, name: str, args, kwargs) -> np.ndarray:
     """
     try:
         X0 = _argument(name, args, kwargs, "initial_state")
-        x0, _ = _NLSYS._process_vector_argument(0.0 if X0 is None else X0, "X0", system.nstates)
+        x0, _ = compat.process_vector_argument(0.0 if X0 is None else X0, "X0", system.nstates)
         U = _argument(name, args, kwargs, "inputs")
         u = np.asarray(0.0 if U is None else U, dtype=float)
         # the first sample: U is (ninputs, N), (N,) for one input, or a number
@@ -217,7 +218,7 @@ def _fine_substeps(name: str, args, kwargs) -> int:
         if name == "forced_response":
             return 1
         try:
-            T = ct_timeresp._default_time_vector(
+            T = compat.default_time_vector(
                 sysdata,
                 N=_argument(name, args, kwargs, "timepts_num"),
                 tfinal=T,
