@@ -58,7 +58,7 @@ from typing import Any, ClassVar
 import control
 import numpy as np
 
-from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel
+from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel, params_as
 
 __all__ = [
     "HalfCarParams",
@@ -161,6 +161,10 @@ class _VehicleParams:
             for f in fields(self)  # type: ignore[arg-type]
         ]
 
+    def model(self, *, road: bool = False, actuator: bool = False) -> VehicleModel:
+        """This car as a `VehicleModel` (`half_car_model` or `full_car_model`)."""
+        return _model(self, road, actuator)
+
     @property
     def wheelbase(self) -> float:
         """``a + b`` [m]."""
@@ -209,12 +213,11 @@ class HalfCarParams(_VehicleParams):
     (2.814, 730.0)
     """
 
-    kind: ClassVar[str] = "half"
-
     ms: float = 730.0
     Iy: float = 1230.0
     a: float = 1.011
     b: float = 1.803
+    kind: ClassVar[str] = "half"  # the body above; one wheel per axle below
     ks_front: float = 19960.0
     ks_rear: float = 17500.0
     cs_front: float = 1290.0
@@ -224,10 +227,6 @@ class HalfCarParams(_VehicleParams):
     ku_front: float = 175500.0
     ku_rear: float = 175500.0
     seat_x: float = 0.0
-
-    def model(self, *, road: bool = False, actuator: bool = False) -> VehicleModel:
-        """``half_car_model(self, ...)``."""
-        return half_car_model(self, road=road, actuator=actuator)
 
 
 @dataclass(frozen=True)
@@ -265,26 +264,24 @@ class FullCarParams(_VehicleParams):
     ms: float = 1460.0
     Ix: float = 460.0
     Iy: float = 2460.0
-    a: float = 1.011
-    b: float = 1.803
+    # the axles' positions and each wheel are the half car's: one source for
+    # Ikenaga et al.'s geometry and axle data
+    a: float = HalfCarParams.a
+    b: float = HalfCarParams.b
     track_front: float = 1.522
     track_rear: float = 1.522
-    ks_front: float = 19960.0
-    ks_rear: float = 17500.0
-    cs_front: float = 1290.0
-    cs_rear: float = 1620.0
-    mu_front: float = 40.0
-    mu_rear: float = 35.5
-    ku_front: float = 175500.0
-    ku_rear: float = 175500.0
+    ks_front: float = HalfCarParams.ks_front
+    ks_rear: float = HalfCarParams.ks_rear
+    cs_front: float = HalfCarParams.cs_front
+    cs_rear: float = HalfCarParams.cs_rear
+    mu_front: float = HalfCarParams.mu_front
+    mu_rear: float = HalfCarParams.mu_rear
+    ku_front: float = HalfCarParams.ku_front
+    ku_rear: float = HalfCarParams.ku_rear
     arb_front: float = 0.0
     arb_rear: float = 0.0
     seat_x: float = 0.0
     seat_y: float = 0.0
-
-    def model(self, *, road: bool = False, actuator: bool = False) -> VehicleModel:
-        """``full_car_model(self, ...)``."""
-        return full_car_model(self, road=road, actuator=actuator)
 
 
 def _labels(kind: str) -> dict[str, list[str]]:
@@ -428,16 +425,6 @@ def _inputs(kind: str, road: bool, actuator: bool) -> list[str]:
     return (labels["road"] if road else []) + (labels["actuator"] if actuator else [])
 
 
-def _as(params, cls):
-    if params is None:
-        return cls()
-    if isinstance(params, cls):
-        return params
-    if isinstance(params, Mapping):
-        return cls.from_mapping(params)
-    raise TypeError(f"params must be a {cls.__name__}, a dict or None, got {type(params).__name__}")
-
-
 def _system(p, road: bool, actuator: bool, name: str) -> control.StateSpace:
     A, B, C, D = vehicle_abcd(p.kind, p.to_dict(), road=road, actuator=actuator)
     labels = _labels(p.kind)
@@ -457,6 +444,9 @@ def half_car(
     params=None, *, road: bool = False, actuator: bool = False, name: str = "half_car"
 ) -> control.StateSpace:
     """The 4-DOF bounce-pitch half car as a continuous-time ``control.StateSpace``.
+
+    The body heaves and pitches on one wheel per axle: the side view of a
+    car whose left and right sides move alike.
 
     Parameters
     ----------
@@ -493,7 +483,7 @@ def half_car(
     >>> sys.input_labels, sys.nstates
     (['zr_front', 'zr_rear'], 8)
     """
-    return _system(_as(params, HalfCarParams), road, actuator, name)
+    return _system(params_as(HalfCarParams, params), road, actuator, name)
 
 
 def full_car(
@@ -528,7 +518,7 @@ def full_car(
     >>> sys.nstates, sys.input_labels[0]
     (14, 'zr_fl')
     """
-    return _system(_as(params, FullCarParams), road, actuator, name)
+    return _system(params_as(FullCarParams, params), road, actuator, name)
 
 
 def _corners(p, road: bool) -> tuple[Corner, ...]:
@@ -579,19 +569,19 @@ def half_car_model(params=None, *, road: bool = False, actuator: bool = False) -
     >>> [c.name for c in m.corners], m.road_inputs()
     (['front', 'rear'], ['zr_front', 'zr_rear'])
     """
-    return _model(_as(params, HalfCarParams), road, actuator)
+    return _model(params_as(HalfCarParams, params), road, actuator)
 
 
 def full_car_model(params=None, *, road: bool = False, actuator: bool = False) -> VehicleModel:
     """The full car as a `VehicleModel`: four corners, static loads
     ``(ms·b/(2L) + mu_front)·g`` in front and ``(ms·a/(2L) + mu_rear)·g`` at the rear."""
-    return _model(_as(params, FullCarParams), road, actuator)
+    return _model(params_as(FullCarParams, params), road, actuator)
 
 
 def _batch(designs: Sequence[Any], *, kind: str, road: bool, actuator: bool) -> BatchedModel:
     """The matrices of many designs at once (no loop per design)."""
     cls = HalfCarParams if kind == "half" else FullCarParams
-    ps = [_as(d, cls) for d in designs]
+    ps = [params_as(cls, d) for d in designs]
     names = [f.name for f in fields(cls)]
     values = {n: np.array([getattr(p, n) for p in ps], dtype=float) for n in names}
     A, B, C, D = vehicle_abcd(kind, values, road=road, actuator=actuator)

@@ -27,7 +27,7 @@ from typing import Any
 import control
 import numpy as np
 
-from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel
+from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel, params_as
 
 __all__ = [
     "QuarterCarParams",
@@ -326,15 +326,7 @@ _NUMBER_TYPES = frozenset({float, int, np.float64, np.float32, np.int64, np.int3
 
 def as_params(params) -> QuarterCarParams:
     """``params`` as `QuarterCarParams`: the seed's car for None, a dict by field name."""
-    if params is None:
-        return QuarterCarParams()
-    if isinstance(params, QuarterCarParams):
-        return params
-    if isinstance(params, Mapping):
-        return QuarterCarParams.from_mapping(params)
-    raise TypeError(
-        f"params must be a QuarterCarParams, a dict or None, got {type(params).__name__}"
-    )
+    return params_as(QuarterCarParams, params)
 
 
 def seed_matrices(ms, mu, ks, ku, cs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -34,6 +34,7 @@ __all__ = [
     "VehicleModel",
     "BatchedModel",
     "stack_models",
+    "params_as",
     "STANDARD_GRAVITY",
 ]
 
@@ -235,3 +236,19 @@ def stack_models(models: Sequence[VehicleModel]) -> BatchedModel:
     )
     load = tuple(np.array([m.corners[i].static_load for m in models]) for i in range(corners))
     return BatchedModel(A, B, C, D, stiffness, load)
+
+
+def params_as(cls, params):
+    """``params`` as an instance of the parameter class ``cls``.
+
+    None gives ``cls()`` (the model's defaults), an instance is kept, and a
+    mapping is read by field name with ``cls.from_mapping`` (which names an
+    unknown key); anything else raises ``TypeError``.
+    """
+    if params is None:
+        return cls()
+    if isinstance(params, cls):
+        return params
+    if isinstance(params, Mapping):
+        return cls.from_mapping(params)
+    raise TypeError(f"params must be a {cls.__name__}, a dict or None, got {type(params).__name__}")

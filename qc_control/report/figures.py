@@ -286,15 +286,17 @@ def convergence_figure(cmp) -> Figure:
                 tab.order,
                 colors[tab.name],
             )
-    step_ticks(ax, conv["h"])
-    ax.set(
-        xlabel="step h [s]",
-        ylabel=f"max |{_body_wheel(cmp)[0]} error| [m]",
-        title="Convergence (dotted: slope of the method's order)",
-    )
-    ax.grid(alpha=0.3, which="both")
+    title = "Convergence (dotted: slope of the method's order)"
+    convergence_axes(ax, conv["h"], _body_wheel(cmp)[0], title)
     _legend(fig, coincidence_note(cmp))
     return fig
+
+
+def convergence_axes(ax, steps, output: str, title: str) -> None:
+    """A convergence figure's axes: the steps tried as ticks, the largest error of ``output``."""
+    step_ticks(ax, steps)
+    ax.set(xlabel="step h [s]", ylabel=f"max |{output} error| [m]", title=title)
+    ax.grid(alpha=0.3, which="both")
 
 
 def step_ticks(ax, steps) -> None:

@@ -15,7 +15,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from .document import Heading, Image, Paragraph, Table, fmt
-from .figures import step_ticks
+from .figures import convergence_axes
 from .plotting import output_signal
 
 __all__ = [
@@ -89,13 +89,7 @@ def event_convergence_figure(cmp) -> Figure:
         ls=":",
         label="10x the reference's own error (not fitted below)",
     )
-    step_ticks(ax, conv["h"])
-    ax.set(
-        xlabel="step h [s]",
-        ylabel=f"max |{_body(cmp)} error| [m]",
-        title="With and without events",
-    )
-    ax.grid(alpha=0.3, which="both")
+    convergence_axes(ax, conv["h"], _body(cmp), "With and without events")
     fig.legend(loc="outside right upper", fontsize="small")
     return fig
 

@@ -1135,19 +1135,17 @@ def impulse_response(
 
     Parameters
     ----------
-    sysdata : StateSpace, TransferFunction or list of them
-    timepts (or T) : array_like or float, optional
-        As in `initial_response` (automatic grid when None or a final time).
-    input_indices (or input), output_indices (or output) : int, optional
-    timepts_num (or T_num) : int, optional
-    transpose, return_states (or return_x), squeeze
-        As in python-control.
+    sysdata, timepts (or T), input_indices (or input), output_indices (or output)
+        As in `step_response`; there is no initial state (the impulse sets it).
+    timepts_num (or T_num), transpose, return_states (or return_x), squeeze
+        As in `step_response`.
     method, substeps, engine : keyword-only
         As in `forced_response`.
 
     Returns
     -------
     FixedStepResponse or control.TimeResponseList
+        Indexed (output, input, time), as python-control's.
 
     Examples
     --------

@@ -22,22 +22,15 @@ Every number is here; `qc_control.report.control` formats them.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import control
 import numpy as np
 import pandas as pd
 
-from ..models.controllers import (
-    add_damper,
-    closed_loop,
-    groundhook,
-    hinf_controller,
-    hybrid,
-    lqr_controller,
-    skyhook,
-)
+from ..models import controllers
+from ..models.controllers import closed_loop
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
 from ..models.vehicle import VehicleModel
 from ..numerics.integrate import check_time_grid
@@ -125,44 +118,41 @@ def _design_set(p: QuarterCarParams, road_class, speed, cmax, which, hinf_beta):
     c_sky, c_gnd = 3000.0, 1000.0
     semi = {"semi_active": "on-off", "cmin": 0.0, "cmax": cmax}
     device = f"on-off damper 0-{cmax:.0f} N·s/m in parallel with cs"
-    makers = {
+    laws = {  # the controllers closed around the same car
+        "skyhook": lambda: controllers.skyhook(c_sky),
+        "skyhook semi-active": lambda: controllers.skyhook(c_sky, **semi),
+        "groundhook": lambda: controllers.groundhook(c_gnd),
+        "groundhook semi-active": lambda: controllers.groundhook(c_sky, **semi),
+        "hybrid": lambda: controllers.hybrid(c_sky, 0.5),
+        "hybrid semi-active": lambda: controllers.hybrid(c_sky, 0.5, **semi),
+        "ADD": lambda: controllers.add_damper(0.0, cmax),
+        "LQR": lambda: controllers.lqr_controller(car),
+    }
+    what = {
+        "skyhook": f"ideal, c_sky = {c_sky:.0f}",
+        "skyhook semi-active": f"c_sky = {c_sky:.0f}, {device}",
+        "groundhook": f"ideal, c_gnd = {c_gnd:.0f} (unstable beyond ~1.2e3 on the seed car)",
+        "groundhook semi-active": f"c_gnd = {c_sky:.0f}, {device}",
+        "hybrid": f"ideal, c = {c_sky:.0f}, α = 0.5",
+        "hybrid semi-active": f"c = {c_sky:.0f}, α = 0.5, {device}",
+        "ADD": f"acceleration-driven damper, {device}, 50 Hz accelerometer",
+        "LQR": "full state, default weights (1 m/s², 5 cm, 5 mm, 1 kN)",
+    }
+    makers: dict[str, Callable[[], tuple[VehicleModel, str]]] = {
         "passive (seed)": lambda: (quarter_car_model(p, road=True), f"cs = {p.cs:.0f} N·s/m"),
         "passive optimum": lambda: _passive_optimum(p, road_class, speed),
-        "skyhook": lambda: (closed_loop(car, skyhook(c_sky)), f"ideal, c_sky = {c_sky:.0f}"),
-        "skyhook semi-active": lambda: (
-            closed_loop(car, skyhook(c_sky, **semi)),
-            f"c_sky = {c_sky:.0f}, {device}",
-        ),
-        "groundhook": lambda: (
-            closed_loop(car, groundhook(c_gnd)),
-            f"ideal, c_gnd = {c_gnd:.0f} (unstable beyond ~1.2e3 on the seed car)",
-        ),
-        "groundhook semi-active": lambda: (
-            closed_loop(car, groundhook(c_sky, **semi)),
-            f"c_gnd = {c_sky:.0f}, {device}",
-        ),
-        "hybrid": lambda: (
-            closed_loop(car, hybrid(c_sky, 0.5)),
-            f"ideal, c = {c_sky:.0f}, α = 0.5",
-        ),
-        "hybrid semi-active": lambda: (
-            closed_loop(car, hybrid(c_sky, 0.5, **semi)),
-            f"c = {c_sky:.0f}, α = 0.5, {device}",
-        ),
-        "ADD": lambda: (
-            closed_loop(car, add_damper(0.0, cmax)),
-            f"acceleration-driven damper, {device}, 50 Hz accelerometer",
-        ),
-        "LQR": lambda: (
-            closed_loop(car, lqr_controller(car)),
-            "full state, default weights (1 m/s², 5 cm, 5 mm, 1 kN)",
-        ),
+        **{name: _closed(car, laws[name], what[name]) for name in laws},
         "H∞": lambda: _hinf(car, hinf_beta),
     }
     unknown = [w for w in which if w not in makers]
     if unknown:
         raise ValueError(f"unknown design {unknown[0]!r}; choose from {list(makers)}")
     return {name: makers[name]() for name in which}
+
+
+def _closed(car: VehicleModel, law: Callable, what: str) -> Callable[[], tuple[VehicleModel, str]]:
+    """The design that closes ``law()`` around ``car``, built when asked."""
+    return lambda: (closed_loop(car, law()), what)
 
 
 def _passive_optimum(p, road_class, speed):
@@ -172,7 +162,7 @@ def _passive_optimum(p, road_class, speed):
 
 
 def _hinf(car, beta):
-    design = hinf_controller(car, beta)
+    design = controllers.hinf_controller(car, beta)
     what = (
         f"MATLAB active-suspension weights, β = {beta:g}, γ = {design.gamma:.4f} "
         f"(closed-loop ‖·‖∞ {design.norm:.4f})"
