@@ -35,6 +35,7 @@ from ..numerics.integrate import DivergenceWarning, check_time_grid, uniform_ste
 from ..numerics.limits import check_memory
 from ..numerics.lti import is_nonlinear_system
 from ..numerics.methods import ButcherTableau, get_method
+from ..numerics.sampled import linear_input
 from ..numerics.stability import max_stable_step, numerical_modes
 from ..responses.timeresp import (
     check_initial_state,
@@ -42,7 +43,6 @@ from ..responses.timeresp import (
     forced_response,
     initial_response,
     input_output_response,
-    linear_input,
 )
 from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
 
@@ -263,8 +263,7 @@ def _refined_input(T, U, level):
     """U on the refined grid: linear interpolation keeps the same input function."""
     if U is None:
         return None
-    Tf = _refined(T, level)
-    return np.vstack([np.interp(Tf, T, row) for row in U])
+    return linear_input(T, U).at(_refined(T, level)).T
 
 
 def _simulate(sys, T, X0, U, method, substeps, engine="auto"):
