@@ -178,3 +178,29 @@ def test_a_cost_beyond_any_run_is_unreached_not_a_number():
     kinds = cmp.cost_kind.loc[:, "euler"]
     assert (kinds == "unreached").all(), kinds
     assert cmp.cost.loc[:, "euler"].isna().all()
+
+
+# --------------------------------------------------- a bare system's vehicle
+
+
+def test_a_bare_half_car_under_a_road_is_measured_as_the_half_car():
+    """A half car's system without its VehicleModel is found by its signals,
+    road inputs included, so the comparison computes its ride metrics as for
+    the model itself (the same corners, the same columns)."""
+    model = qc.half_car_model(road=True)
+    T = np.linspace(0.0, 1.0, 201)
+    U = np.vstack([qc.road.bump(T, height=0.02, speed=10.0)] * 2)
+    X0 = np.zeros(model.system.nstates)
+    bare = qc.compare_methods(model.system, T, X0, U=U, methods=["rk4"], timing=False)
+    full = qc.compare_methods(model, T, X0, U=U, methods=["rk4"], timing=False)
+    assert bare.model.road_inputs() == ["zr_front", "zr_rear"]
+    assert bare.ride is not None
+    assert list(bare.ride.columns) == list(full.ride.columns)
+
+
+def test_parameters_of_another_vehicle_are_refused_naming_both():
+    """A quarter car's system with a half car's parameters describes no model:
+    the error names the parameters and the system's signals."""
+    sys = qc.quarter_car(road=True)
+    with pytest.raises(ValueError, match=r"HalfCarParams.*'quarter_car'.*\['zr'\]"):
+        qc.compare_methods(sys, params=qc.HalfCarParams(), methods=["rk4"], timing=False)

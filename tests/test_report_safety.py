@@ -141,7 +141,7 @@ def test_a_writer_in_another_process_holds_off_a_second(cmp, tmp_path):
         "from pathlib import Path\n"
         "from qc_control import report as rep\n"
         "out = Path(sys.argv[1])\n"
-        "with rep._exclusive(out.parent, out):\n"
+        "with rep._exclusive(out):\n"
         "    print('held', flush=True)\n"
         "    sys.stdin.readline()\n"
     )

@@ -3,8 +3,7 @@
 `qc_control.studies.nlsweep` steps many designs of `qc_control.nonlinear_quarter_car`
 together. Written with NumPy over the designs, each stage of each step is a
 dozen NumPy calls on arrays of a thousand numbers, and the calls' fixed cost
-(about a microsecond each) is most of the time: 1,000 designs over 10 s at
-1 ms took 1-2.5 s, whatever the machine's arithmetic could do. This
+(about a microsecond each), not the arithmetic, sets the time. This
 module writes the right-hand side as a loop over the designs
 (`_accelerations`) and hands it to the compiled stage loop of the numerics
 (`qc_control.numerics.compiled_stepper.stage_loop`), compiled together with

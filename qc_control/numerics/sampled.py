@@ -51,10 +51,11 @@ class SampledInput:
     def __call__(self, t: float) -> np.ndarray:
         """The inputs ``(k,)`` at the time ``t``."""
         i = bisect.bisect_right(self._times, t) - 1
+        # a copy at the ends, as between samples: a right-hand side may change its u
         if i > self._last:  # at (or past) the last sample: the sample, as np.interp
-            return self._rows[-1]
+            return self._rows[-1].copy()
         if i < 0:
-            return self._rows[0]
+            return self._rows[0].copy()
         # np.interp's own expression, slope·(t - T_i) + U_i, so that `at` agrees to the bit
         return self._slopes[i] * (t - self._times[i]) + self._rows[i]
 

@@ -581,7 +581,7 @@ def _lock_file(out: Path) -> Path:
 
 
 @contextlib.contextmanager
-def _exclusive(parent: Path, out: Path):
+def _exclusive(out: Path):
     """Hold the report's lock (`_lock_file`) while the report is swapped in.
 
     A second run into the same place stops with one clear line instead of
@@ -597,8 +597,8 @@ def _exclusive(parent: Path, out: Path):
         lock.acquire()
     except filelock.Timeout:
         raise ReportError(
-            f"another qc-control run is writing a report in {str(parent)!r}; wait for it "
-            f"to finish, or choose another --out than {str(out)!r}"
+            f"another qc-control run is writing a report into {str(out)!r}; wait for it "
+            "to finish, or choose another --out"
         ) from None
     try:
         yield
@@ -707,7 +707,7 @@ def write_document(
         )
     out = check_target(out_dir, overwrite)
     out.parent.mkdir(parents=True, exist_ok=True)
-    with _exclusive(out.parent, out):
+    with _exclusive(out):
         _recover(out)
         check_target(out, overwrite)  # again: recovery may have put a report back
         return _write(out, title, blocks, figures, tables, formats, extra, command)

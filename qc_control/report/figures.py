@@ -102,7 +102,7 @@ def _legend(fig, note: str = "", **kw):
     return fig.legend(**kw)
 
 
-def _body_wheel(cmp) -> tuple[str, str | None, str | None]:
+def body_wheel_road(cmp) -> tuple[str, str | None, str | None]:
     """(body displacement, wheel displacement, first road input) labels:
     ``xs``, ``xu``, ``zr`` on a quarter car, ``z``, ``xu_front``, ``zr_front``
     on a half car. The wheel is the model's registry entry's ``wheel_disp``
@@ -110,9 +110,10 @@ def _body_wheel(cmp) -> tuple[str, str | None, str | None]:
     model = getattr(cmp, "model", None)
     outputs = list(cmp.system.output_labels)
     body = model.body_disp if model is not None else "xs"
-    entry = None if model is None else model_for_params(model.params)
-    if entry is None:
-        entry = model_for_system(cmp.system)
+    # the signals decide first: the quarter and the nonlinear car share a parameter class
+    entry = model_for_system(cmp.system)
+    if entry is None and model is not None:
+        entry = model_for_params(model.params)
     wheel = None if entry is None else entry.wheel_disp
     wheel = wheel if wheel in outputs else None
     roads = model.road_inputs() if model is not None else ["zr"]
@@ -123,7 +124,7 @@ def _body_wheel(cmp) -> tuple[str, str | None, str | None]:
 def reference_figure(cmp) -> Figure:
     """The exact response the methods are measured against (and the road, if any)."""
     ref = cmp.reference
-    body, wheel, road = _body_wheel(cmp)
+    body, wheel, road = body_wheel_road(cmp)
     fig = Figure(figsize=(8, 3.4), layout="constrained")
     ax = fig.subplots()
     if cmp.U is not None and road is not None:
@@ -153,7 +154,7 @@ def method_figure(cmp, method: str) -> Figure:
     underneath.
     """
     resp, ref = cmp.responses[method], cmp.reference
-    body, wheel, _ = _body_wheel(cmp)
+    body, wheel, _ = body_wheel_road(cmp)
     fig = Figure(figsize=(8, 3.4), layout="constrained")
     ax = fig.subplots()
     drawn = [(body, "body", "r-", "suspension (sprung mass)")]
@@ -180,7 +181,7 @@ def overlay_figure(cmp) -> Figure:
     fig = Figure(figsize=(8, 3.6), layout="constrained")
     ax = fig.subplots()
     ref = cmp.reference
-    body = _body_wheel(cmp)[0]
+    body = body_wheel_road(cmp)[0]
     ax.plot(ref.time, output_signal(ref, body) * _MM, color="k", lw=4, alpha=0.25, label="exact")
     for name, resp in cmp.responses.items():
         ax.plot(
@@ -209,7 +210,7 @@ def error_figure(cmp) -> Figure:
     colors, rank = _colors(cmp.responses), _rank(cmp)
     fig = Figure(figsize=(8, 3.6), layout="constrained")
     ax = fig.subplots()
-    body = _body_wheel(cmp)[0]
+    body = body_wheel_road(cmp)[0]
     exact = output_signal(cmp.reference, body)
     clipped = False
     for name, resp in cmp.responses.items():
@@ -287,7 +288,7 @@ def convergence_figure(cmp) -> Figure:
                 colors[tab.name],
             )
     title = "Convergence (dotted: slope of the method's order)"
-    convergence_axes(ax, conv["h"], _body_wheel(cmp)[0], title)
+    convergence_axes(ax, conv["h"], body_wheel_road(cmp)[0], title)
     _legend(fig, coincidence_note(cmp))
     return fig
 
@@ -334,7 +335,7 @@ def work_precision_figure(cmp) -> Figure:
         right.loglog(rows["time"] * 1e3, rows["error"], **{**style, "ls": "none"})
     left.set(
         xlabel="right-hand-side evaluations",
-        ylabel=f"max |{_body_wheel(cmp)[0]} error| [m]",
+        ylabel=f"max |{body_wheel_road(cmp)[0]} error| [m]",
         title="Against work",
     )
     right.set(

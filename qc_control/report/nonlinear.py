@@ -15,7 +15,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from .document import Heading, Image, Paragraph, Table, fmt
-from .figures import convergence_axes
+from .figures import body_wheel_road, convergence_axes
 from .plotting import output_signal
 
 __all__ = [
@@ -100,10 +100,10 @@ def parting_figure(cmp) -> Figure:
     ref = cmp.reference
     fig = Figure(figsize=(8, 5.2), layout="constrained")
     top, bottom = fig.subplots(2, 1, sharex=True)
-    body = _body(cmp)
+    body, wheel, _ = body_wheel_road(cmp)
     top.plot(ref.time, output_signal(ref, body) * _MM, "r-", lw=1.2, label=f"body {body}")
-    if "xu" in ref.output_labels:
-        top.plot(ref.time, output_signal(ref, "xu") * _MM, "b--", lw=1.1, label="wheel xu")
+    if wheel is not None:
+        top.plot(ref.time, output_signal(ref, wheel) * _MM, "b--", lw=1.1, label=f"wheel {wheel}")
     top.set(ylabel="displacement [mm]", title="Reference (solve_ivp DOP853)")
     top.grid(alpha=0.3)
     _spans(top, study)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import itertools
 import math
 import time
 import warnings
@@ -26,7 +27,6 @@ from .. import compat
 from ..models.modal import ModalAnalysis, modal_analysis
 from ..models.quarter import (
     SEED_X0,
-    QuarterCarParams,
     as_params,
 )
 from ..models.registry import MODELS, model_for_params, model_for_system
@@ -714,22 +714,28 @@ def _as_model(sys, U, params) -> tuple[control.NonlinearIOSystem, VehicleModel |
         p, like = None, model_for_system(sys)
     if like is None:
         return sys, None, None
-    try:
-        model = like.model(p, road=_has_road(sys), **_actuated(sys))
-    except (TypeError, ValueError):
-        return sys, None, None
-    if params is None and list(model.system.output_labels) != list(sys.output_labels):
-        return sys, None, None
-    return sys, model, params
+    model = _model_like(like, p, sys)
+    if model is None and params is not None:
+        raise ValueError(
+            f"params ({type(params).__name__}) do not describe system {sys.name!r}: no "
+            f"{like.name} model has its inputs {list(sys.input_labels)} and outputs "
+            f"{list(sys.output_labels)}"
+        )
+    return sys, model, None if model is None else params
 
 
-def _actuated(sys) -> dict[str, bool]:
-    """``{'actuator': True}`` for a system with the actuator force input ``fa``."""
-    return {"actuator": True} if "fa" in sys.input_labels else {}
-
-
-def _has_road(sys) -> bool:
-    return "zr" in sys.input_labels
+def _model_like(entry, params, sys) -> VehicleModel | None:
+    """The entry's model (of ``params``) with exactly the system's inputs and
+    outputs, with or without its road and actuator inputs; None if none has."""
+    signals = (list(sys.input_labels), list(sys.output_labels))
+    for road, actuator in itertools.product((False, True), repeat=2):
+        try:
+            model = entry.model(params, road=road, actuator=actuator)
+        except (TypeError, ValueError):  # a model without that input
+            continue
+        if (list(model.system.input_labels), list(model.system.output_labels)) == signals:
+            return model
+    return None
 
 
 def _tableaus(methods: Sequence) -> tuple[ButcherTableau, ...]:
@@ -924,7 +930,7 @@ def compare_methods(
     timing: bool = True,
     progress: Callable[[str], None] | None = None,
     input_description: str = "",
-    params: QuarterCarParams | None = None,
+    params: Any = None,
     events: bool | None = None,
     levels: int | None = None,
 ) -> MethodComparison:
@@ -938,15 +944,16 @@ def compare_methods(
     Parameters
     ----------
     sys : control.StateSpace, control.NonlinearIOSystem, VehicleModel, or parameters
-        The vehicle. Parameters (`QuarterCarParams`, `HalfCarParams`,
-        `FullCarParams`) build their model with the road inputs when
-        ``U`` is given (``quarter_car_model(params, road=U is not None)``);
-        a half or full car then needs ``X0`` of its 8 or 14 states. A
+        The vehicle. The parameters of a registered model
+        (`QuarterCarParams`, `HalfCarParams`, `FullCarParams`, or a model
+        added with `qc_control.register_model`) build it through its
+        registry entry, with its road inputs when ``U`` is given; a half or
+        full car then needs ``X0`` of its 8 or 14 states. A bare system with
+        the signals of a registered model gets that model's roles. A
         `VehicleModel` whose ``system`` is a `control.NonlinearIOSystem`
         (`qc_control.nonlinear_quarter_car_model`, or `closed_loop` with a
-        semi-active controller), or a bare NonlinearIOSystem with the
-        nonlinear car's or the quarter car's labels, is compared against a
-        tight ``solve_ivp`` (see Notes).
+        semi-active controller), or such a bare system, is compared against
+        a tight ``solve_ivp`` (see Notes).
     T : array_like, optional
         Uniform output grid [s]; default 0-10 s at 0.01 s.
     X0 : array_like, default ``(0, 0, 0.05, 0)``
@@ -970,9 +977,10 @@ def compare_methods(
     input_description : str, optional
         What the input is (e.g. "ISO 8608 class C road at 20 m/s"), for
         the report.
-    params : QuarterCarParams, optional
-        The vehicle behind ``sys`` when ``sys`` is a quarter-car system: the
-        ride metrics need its masses for the static wheel load.
+    params : parameters of a registered model, optional
+        The vehicle behind a bare ``sys`` (the ride metrics need its masses
+        for the static wheel load); the model they build must have the
+        system's inputs and outputs, or ``ValueError`` says which differ.
     events : bool, optional
         Nonlinear systems only: whether the methods step to each switching
         time (``qc.input_output_response(..., events=True)``). Default: when
@@ -1301,7 +1309,9 @@ def _nonlinear_model(sys, params) -> VehicleModel | None:
     if isinstance(params, dict):
         params = entry.params.from_mapping(params)
     p = entry.params() if params is None else params
-    like = entry.model(p, road=_has_road(sys))  # the car whose labels these are
+    like = entry.model(p, road=True)  # the car whose labels these are, with or without road
+    if not set(like.road_inputs()) <= set(sys.input_labels):
+        like = entry.model(p)
     units = {**like.units, "fa": "N"}
     units.update({s: units.get(s, "-") for s in sys.state_labels})
     units.update({u: units.get(u, "-") for u in sys.input_labels})

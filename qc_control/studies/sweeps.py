@@ -631,7 +631,7 @@ def sweep(
     ):
         raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
     metric_items = _metric_items(metrics, model.roles)
-    # by default the designs computed together (a nonlinear sweep: VECTOR_DESIGNS, as before)
+    # by default the designs computed together (a nonlinear sweep: VECTOR_DESIGNS)
     nl_chunk = VECTOR_DESIGNS if chunk_size is None else chunk_size
     if chunk_size is None:
         chunk_size = _vector_designs(U, metric_items, states)
