@@ -144,15 +144,17 @@ def test_report_html_renders_every_image_and_fits_the_page(browser, road_report,
     assert verdict["blocked"] == []
 
 
+def _page(folder: Path, body: str) -> Path:
+    """A small page with ``body``, written into ``folder``."""
+    page = folder / "page.html"
+    page.write_text(f"<!DOCTYPE html><html><body>{body}</body></html>", encoding="utf-8")
+    return page
+
+
 def test_the_probe_sees_broken_images_and_overflow(browser, tmp_path):
     """The check itself is checked: a page that is wrong in both ways fails it."""
-    page = tmp_path / "bad.html"
-    page.write_text(
-        '<!DOCTYPE html><html><body><img src="missing.png" alt="missing">'
-        '<div style="width: 5000px">wide</div></body></html>',
-        encoding="utf-8",
-    )
-    verdict = check_in_browser(browser, page, tmp_path, 800)
+    body = '<img src="missing.png" alt="missing"><div style="width: 5000px">wide</div>'
+    verdict = check_in_browser(browser, _page(tmp_path, body), tmp_path, 800)
     assert verdict["broken"] == ["missing"]
     assert verdict["scrollWidth"] > verdict["clientWidth"]
 
@@ -160,12 +162,7 @@ def test_the_probe_sees_broken_images_and_overflow(browser, tmp_path):
 def test_requests_off_the_machine_are_blocked(browser, tmp_path):
     """A page that reaches for the internet is held to 127.0.0.1: the request
     is aborted, recorded, and its image does not load."""
-    page = tmp_path / "online.html"
-    page.write_text(
-        '<!DOCTYPE html><html><body><img src="https://example.org/x.png" alt="remote">'
-        "</body></html>",
-        encoding="utf-8",
-    )
-    verdict = check_in_browser(browser, page, tmp_path, 800)
+    body = '<img src="https://example.org/x.png" alt="remote">'
+    verdict = check_in_browser(browser, _page(tmp_path, body), tmp_path, 800)
     assert verdict["blocked"] == ["https://example.org/x.png"]
     assert verdict["broken"] == ["remote"]
