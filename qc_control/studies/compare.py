@@ -1075,58 +1075,156 @@ class NonlinearReference:
     state_accuracy: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0))
 
 
-def _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks=()):
-    """DOP853 from event to event: no step straddles a kink of the right-hand side.
+#: The evaluation budget of one solve of `nonlinear_reference`: this many right-hand-side
+#: evaluations per output sample, plus `_BUDGET_BASE` (see there for the measurements).
+_BUDGET_PER_SAMPLE = 1000
+_BUDGET_BASE = 100_000
+#: The value an event function takes where its switching function is exactly 0: the
+#: segment's side, as the smallest normal number (scipy only compares signs and brackets).
+_ON_THE_KINK = float(np.finfo(float).tiny)
 
-    ``breaks``: times where the input's slope jumps (samples of a piecewise-linear
-    input); each is a restart too, so no step straddles one or steps over an input
-    that starts after a quiet stretch.
+
+class _BudgetSpent(Exception):
+    """Raised inside a solve when the reference's evaluation budget is spent."""
+
+    def __init__(self, t: float):
+        super().__init__(t)
+        self.t = t
+
+
+def _sided_events(switching, sides: np.ndarray, t_start: float) -> list:
+    """Terminal event functions for one segment of the piecewise solve.
+
+    Each reports a sign change of its switching function *away from the side
+    ``sides[k]`` the segment starts on*: at ``t_start`` it takes that side
+    whatever its value (a restart just after a root may sit a rounding on the
+    old side, and scipy would find the same root again at the start, for ever),
+    and wherever the function is exactly 0 it keeps the side too (a state
+    resting on a kink, e.g. a bump stop of clearance 0 at rest, has not crossed
+    it: scipy counts a 0 as a crossing at every step).
     """
-    span = float(T[-1] - T[0])
-    nudge = 1e-10 * span
-    n_ev = 0 if switching is None else int(np.size(switching(float(T[0]), x0)))
     funcs = []
-    for k in range(n_ev):
+    for k, side in enumerate(sides):
 
-        def g(t, x, k=k):
-            return float(switching(t, x)[k])
+        def g(t, x, k=k, side=side):
+            value = float(switching(t, x)[k])
+            if t == t_start or value == 0.0:
+                return value if value * side > 0.0 else side * _ON_THE_KINK
+            return value
 
         g.terminal = True  # type: ignore[attr-defined]
         funcs.append(g)
+    return funcs
+
+
+def _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks, budget):
+    """DOP853 from event to event: no step straddles a kink of the right-hand side.
+
+    Each segment ends at the first sign change of a switching function (a
+    terminal event); the next starts at that root, on the function's other
+    side (`_sided_events`), so any number of events between two samples, or
+    at the same instant, each get their restart and every sample is read from
+    the segment that holds it. ``breaks``: times where the input's slope jumps
+    (samples of a piecewise-linear input); each is a restart too, so no step
+    straddles one or steps over an input that starts after a quiet stretch.
+    ``budget``: right-hand-side evaluations, over all segments, after which
+    `_BudgetSpent` is raised (a stalled solve).
+    """
+    spent = 0
+
+    def counted(t, x):
+        nonlocal spent
+        spent += 1
+        if spent > budget:
+            raise _BudgetSpent(t)
+        return rhs(t, x)
+
     t, x = float(T[0]), np.asarray(x0, dtype=float)
+    # a switching function exactly 0 at the start has no side yet: the free side (+1, a
+    # stop not engaged, a tire in contact) costs at most one restart if it leaves to the other
+    sides = np.where(np.atleast_1d(switching(t, x)) < 0.0, -1.0, 1.0) if switching else []
     out = np.empty((x.size, T.size))
     events: list[float] = []
     which: list[int] = []
-    nfev = 0
     kw = dict(method="DOP853", rtol=rtol, atol=atol, dense_output=True)
     stops = sorted({float(b) for b in breaks if T[0] < b < T[-1]} | {float(T[-1])})
     for t_stop in stops:
         while t < t_stop:
-            sol = solve_ivp(rhs, (t, t_stop), x, events=funcs or None, **kw)
-            nfev += sol.nfev
+            funcs = _sided_events(switching, sides, t) if switching else None
+            sol = solve_ivp(counted, (t, t_stop), x, events=funcs or None, **kw)
             if not sol.success and sol.status != 1:
                 raise RuntimeError(
                     f"the reference solve_ivp failed at t = {t:.6g} s: {sol.message}"
                 )
             t_end = float(sol.t[-1])
             inside = (T >= t) & (T <= t_end)
-            out[:, inside] = cast(OdeSolution, sol.sol)(T[inside])  # dense_output=True gives it
-            if sol.status != 1 or t_end >= t_stop:
-                t, x = t_end, sol.y[:, -1]
+            if inside.any():  # a root within rounding of the last one holds no sample
+                out[:, inside] = cast(OdeSolution, sol.sol)(T[inside])
+            t, x = t_end, sol.y[:, -1]
+            if sol.status != 1:
                 break
-            events.append(t_end)
             fired = [k for k, te in enumerate(sol.t_events or []) if te.size and te[-1] == t_end]
+            sides[fired] = -sides[fired]
+            events.append(t_end)
             which.append(fired[0] if fired else -1)
-            # past the root, where the switching function has its new sign
-            past = min(t_end + nudge, t_stop)
-            step = solve_ivp(rhs, (t_end, past), sol.y[:, -1], **kw)
-            nfev += step.nfev
-            t, x = float(step.t[-1]), step.y[:, -1]
-    return out, np.array(events), nfev, which
+    return out, np.array(events), spent, which
+
+
+def _checked_budget(max_nfev, samples: int) -> int:
+    """The evaluation budget of one solve: ``max_nfev``, or the default for ``samples``."""
+    if max_nfev is None:
+        return _BUDGET_PER_SAMPLE * samples + _BUDGET_BASE
+    if isinstance(max_nfev, bool) or not isinstance(max_nfev, (int, np.integer)) or max_nfev < 1:
+        raise ValueError(f"max_nfev must be a positive integer or None, got {max_nfev!r}")
+    return int(max_nfev)
+
+
+def _stalled(spent: _BudgetSpent, T, budget: int) -> ValueError:
+    """The error for a reference solve that spent its budget: the likely cause, and the cure."""
+    return ValueError(
+        f"the nonlinear reference (DOP853, restarted at each event) spent its budget of {budget} "
+        f"right-hand-side evaluations and reached only t = {spent.t:.6g} s of "
+        f"{T[0]:g}-{T[-1]:g} s: its steps shrank without end, as they do at a force law "
+        "that jumps (e.g. a friction term c·sign(v) in a damper or spring) without a "
+        "switching function. Smooth the law (e.g. c·tanh(v/0.01) for c·sign(v)), or, if the "
+        "state crosses the jump rather than sticking at it, give the system a switching "
+        "function that changes sign there (sys.switching, or events=); a merely very stiff "
+        "system may raise max_nfev"
+    )
+
+
+def _refined_solves(rhs, switching, T, x0, rtol: float, breaks, budget: int):
+    """The reference solve at ``rtol`` and the same at 100x tighter tolerances.
+
+    ``atol = rtol · max|x_i|`` per state, the scale from a first solve at rtol 1e-6.
+    Returns ``(x, tighter, t_events, nfev, which, atol)``.
+    """
+    try:
+        rough, _, _, _ = _piecewise_ivp(rhs, switching, T, x0, 1e-6, 1e-9, breaks, budget)
+        scale = np.maximum(np.max(np.abs(rough), axis=1), 1e-12)
+        atol = rtol * scale
+        x, t_events, nfev, which = _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks, budget)
+        with warnings.catch_warnings():
+            # scipy raises an rtol below 100·eps (2.2e-14) to it, and says so
+            warnings.filterwarnings("ignore", "At least one element of `rtol` is too small")
+            tighter, _, _, _ = _piecewise_ivp(
+                rhs, switching, T, x0, rtol / 100, atol / 100, breaks, budget
+            )
+    except _BudgetSpent as spent:
+        raise _stalled(spent, T, budget) from None
+    return x, tighter, t_events, nfev, which, atol
 
 
 def nonlinear_reference(
-    sys, T, U=0.0, X0=0.0, *, events=None, params=None, rtol: float = 1e-12
+    sys,
+    T,
+    U=0.0,
+    X0=0.0,
+    *,
+    events=None,
+    params=None,
+    rtol: float = 1e-12,
+    max_nfev: int | None = None,
 ) -> NonlinearReference:
     """The reference for a nonlinear system: solve_ivp (DOP853) restarted at each event.
 
@@ -1134,13 +1232,26 @@ def nonlinear_reference(
     reference is scipy's DOP853 at ``rtol`` with ``atol = rtol · max|x_i|``
     per state (the scale from a first solve at ``rtol = 1e-6``), stopped at
     every sign change of the switching functions (``events``, as in
-    `qc_control.input_output_response`) and restarted just past it, so that
-    no step straddles a kink. The input is python-control's: linear between
-    the samples; the solve also restarts at each sample where the input's
-    slope changes (a kink in time, and no first step that leaps over a
-    bump after a quiet stretch). Its own accuracy is estimated, as the matrix exponential's
-    is for linear systems, against a second solve at ``rtol / 100`` and
-    ``atol / 100`` (scipy raises an rtol below 100·eps, 2.2e-14, to it).
+    `qc_control.input_output_response`) and restarted at the root on the
+    function's other side, so that no step straddles a kink (any number of
+    events between two samples each get their restart; a state resting on
+    a kink, where a function is exactly 0, has not crossed it). The input
+    is python-control's: linear between the samples; the solve also
+    restarts at each sample where the input's slope changes (a kink in
+    time, and no first step that leaps over a bump after a quiet stretch).
+    Its own accuracy is estimated, as the matrix exponential's is for
+    linear systems, against a second solve at ``rtol / 100`` and ``atol /
+    100`` (scipy raises an rtol below 100·eps, 2.2e-14, to it).
+
+    Each of the three solves has a budget of right-hand-side evaluations:
+    by default 1000 per sample of ``T`` plus 100,000. The nonlinear car's
+    runs measured 0.6-33 per sample (33 with a tire of 1e9 N/m, its wheel
+    hop at 800 Hz against samples 0.5 ms apart; 10 with a 1e12 N/m bump
+    stop; 4 on an ISO 8608 road restarted at every sample), so the default
+    leaves a margin of 30x, and costs about 20 s at the car's ~10 µs per
+    evaluation for 1601 samples. A solve that spends it has stalled: DOP853
+    at a force that jumps without a switching function (a friction term
+    ``sign(v)``) shrinks its steps without end.
 
     Parameters
     ----------
@@ -1149,16 +1260,26 @@ def nonlinear_reference(
         As for `qc_control.input_output_response`.
     events : None, True or callable ``events(t, x, u, params)``
     rtol : float, default 1e-12
+    max_nfev : int, optional
+        The evaluation budget of each solve (default above).
 
     Returns
     -------
     NonlinearReference
+
+    Raises
+    ------
+    ValueError
+        For a bad argument, naming it; or when a solve spends its budget,
+        naming the likely cause (a jump without a switching function) and
+        what to do.
     """
     if not isinstance(sys, control.NonlinearIOSystem):
         raise TypeError(f"sys must be a control.NonlinearIOSystem, got {type(sys).__name__}")
     if not (isinstance(rtol, float) and 1e-14 <= rtol < 1e-3):
         raise ValueError(f"rtol must be a float in [1e-14, 1e-3), got {rtol!r}")
     T = check_time_grid(T, "T")
+    budget = _checked_budget(max_nfev, T.size)
     x0 = check_initial_state(X0, sys.nstates)
     u = check_input_samples(U, sys.ninputs, T.size)
     u_of_t = linear_input(T, u)
@@ -1184,16 +1305,13 @@ def nonlinear_reference(
     tiny = 64 * np.finfo(float).eps * np.max(np.abs(u), axis=1, initial=0.0)[:, None]
     kinks = np.flatnonzero(np.any(np.abs(np.diff(u, 2, axis=1)) > tiny, axis=0)) + 1
     breaks = T[kinks]
-    rough, _, _, _ = _piecewise_ivp(rhs, switching, T, x0, 1e-6, 1e-9, breaks)
-    scale = np.maximum(np.max(np.abs(rough), axis=1), 1e-12)
-    atol = rtol * scale
-    x, t_events, nfev, which = _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks)
-    with warnings.catch_warnings():
-        # scipy raises an rtol below 100·eps (2.2e-14) to it, and says so
-        warnings.filterwarnings("ignore", "At least one element of `rtol` is too small")
-        tighter, _, _, _ = _piecewise_ivp(rhs, switching, T, x0, rtol / 100, atol / 100, breaks)
+    x, tighter, t_events, nfev, which, atol = _refined_solves(
+        rhs, switching, T, x0, rtol, breaks, budget
+    )
     per_state = np.max(np.abs(x - tighter), axis=1)
-    accuracy = float(np.max(per_state) / np.max(np.abs(tighter)))
+    # a car at rest throughout has x = 0 exactly in both solves: no error, not 0/0
+    largest = float(np.max(np.abs(tighter)))
+    accuracy = float(np.max(per_state)) / largest if largest > 0 else 0.0
     names = tuple(getattr(sys, "switching_labels", ())) if events is True else ()
     labels = tuple(
         names[k] if 0 <= k < len(names) else (f"event {k}" if k >= 0 else "event") for k in which
