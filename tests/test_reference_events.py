@@ -228,3 +228,11 @@ def test_friction_comparison_ends_with_a_value_error():
     model = qc.nonlinear_quarter_car_model(**FRICTION)
     with pytest.raises(ValueError, match="without a switching function"):
         qc.compare_methods(model, T_LIFT, np.zeros(4))
+
+
+def test_a_road_far_faster_than_the_samples_stops_with_the_other_cause():
+    """A 1e4 Hz road under samples 2 ms apart: the wheel leaves and meets it every period."""
+    car = qc.nonlinear_quarter_car(road=lambda t: 0.01 * math.sin(2 * math.pi * 1e4 * t))
+    with pytest.raises(ValueError, match="far faster than the samples") as info:
+        nonlinear_reference(car, T_LIFT, events=True, max_nfev=20_000)
+    assert "smaller h" in str(info.value) and " events." in str(info.value)

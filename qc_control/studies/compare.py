@@ -1087,9 +1087,10 @@ _ON_THE_KINK = float(np.finfo(float).tiny)
 class _BudgetSpent(Exception):
     """Raised inside a solve when the reference's evaluation budget is spent."""
 
-    def __init__(self, t: float):
-        super().__init__(t)
+    def __init__(self, t: float, events: int):
+        super().__init__(t, events)
         self.t = t
+        self.events = events
 
 
 def _sided_events(switching, sides: np.ndarray, t_start: float) -> list:
@@ -1131,12 +1132,14 @@ def _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks, budget):
     `_BudgetSpent` is raised (a stalled solve).
     """
     spent = 0
+    events: list[float] = []
+    which: list[int] = []
 
     def counted(t, x):
         nonlocal spent
         spent += 1
         if spent > budget:
-            raise _BudgetSpent(t)
+            raise _BudgetSpent(t, len(events))
         return rhs(t, x)
 
     t, x = float(T[0]), np.asarray(x0, dtype=float)
@@ -1144,8 +1147,6 @@ def _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks, budget):
     # stop not engaged, a tire in contact) costs at most one restart if it leaves to the other
     sides = np.where(np.atleast_1d(switching(t, x)) < 0.0, -1.0, 1.0) if switching else []
     out = np.empty((x.size, T.size))
-    events: list[float] = []
-    which: list[int] = []
     kw = dict(method="DOP853", rtol=rtol, atol=atol, dense_output=True)
     stops = sorted({float(b) for b in breaks if T[0] < b < T[-1]} | {float(T[-1])})
     for t_stop in stops:
@@ -1180,16 +1181,18 @@ def _checked_budget(max_nfev, samples: int) -> int:
 
 
 def _stalled(spent: _BudgetSpent, T, budget: int) -> ValueError:
-    """The error for a reference solve that spent its budget: the likely cause, and the cure."""
+    """The error for a reference solve that spent its budget: the likely causes, and cures."""
     return ValueError(
-        f"the nonlinear reference (DOP853, restarted at each event) spent its budget of {budget} "
-        f"right-hand-side evaluations and reached only t = {spent.t:.6g} s of "
-        f"{T[0]:g}-{T[-1]:g} s: its steps shrank without end, as they do at a force law "
-        "that jumps (e.g. a friction term c·sign(v) in a damper or spring) without a "
-        "switching function. Smooth the law (e.g. c·tanh(v/0.01) for c·sign(v)), or, if the "
-        "state crosses the jump rather than sticking at it, give the system a switching "
-        "function that changes sign there (sys.switching, or events=); a merely very stiff "
-        "system may raise max_nfev"
+        f"the nonlinear reference (DOP853, restarted at each event) spent its budget of "
+        f"{budget} right-hand-side evaluations (1000 per sample and 100000; max_nfev) and "
+        f"reached only t = {spent.t:.6g} s of {T[0]:g}-{T[-1]:g} s, after {spent.events} "
+        "events. Either its steps shrank without end, as they do at a force law that jumps "
+        "without a switching function (e.g. a friction term c·sign(v) in a damper or "
+        "spring): smooth the law (e.g. c·tanh(v/0.01) for c·sign(v)), or, if the state "
+        "crosses the jump rather than sticking at it, give the system a switching function "
+        "that changes sign there (sys.switching, or events=); or the motion is far faster "
+        "than the samples (e.g. a road of kHz, an event every few µs): sample it finer "
+        "(a smaller h) or pass a larger max_nfev"
     )
 
 
@@ -1251,7 +1254,10 @@ def nonlinear_reference(
     leaves a margin of 30x, and costs about 20 s at the car's ~10 µs per
     evaluation for 1601 samples. A solve that spends it has stalled: DOP853
     at a force that jumps without a switching function (a friction term
-    ``sign(v)``) shrinks its steps without end.
+    ``sign(v)``) shrinks its steps without end; or it meets motion far
+    faster than its samples (a 1e4 Hz road under samples 0.5 ms apart, the
+    wheel leaving and meeting it in every period), which no fixed-step
+    method on that grid follows either.
 
     Parameters
     ----------
