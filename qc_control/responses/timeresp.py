@@ -44,7 +44,9 @@ from control.timeresp import forced_response as _control_forced_response
 
 from .. import compat
 from ..numerics.integrate import (
+    STEP_BLOCK,
     DivergenceWarning,
+    check_step_memory,
     check_substeps,
     check_time_grid,
     checked_uniform_step,
@@ -1407,6 +1409,20 @@ def _io_step(sys, prob: _IOProblem, params, io: _IOOptions) -> _Computed:
         if not (isinstance(max_step, (int, float, np.number)) and 0 < max_step < math.inf):
             raise ValueError(f"max_step must be a positive number of seconds, got {max_step!r}")
         substeps = max(substeps, substeps_for(H, float(max_step)))
+    if io.events is None:  # without events, a block of steps' times and states is held at once
+        cause = (
+            f"max_step = {max_step!r} s: substeps = {substeps}"
+            if substeps > io.opts.substeps
+            else ""
+        )
+        intervals = min(prob.T.size - 1, STEP_BLOCK)
+        check_step_memory(
+            intervals,
+            substeps,
+            48 + 8 * prob.x0.size,
+            "the step times and states of a block",
+            cause,
+        )
     compat.update_params(sys, params)  # linearize may have reset them
     return _Computed(tab, None, substeps, step_rule, eig)
 
