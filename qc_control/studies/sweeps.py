@@ -571,7 +571,11 @@ def sweep(
     designs : list of parameters or dicts, or a grid dict
         A list of designs (`QuarterCarParams` or dicts of its fields, for the
         default model), or ``{'ks': [...], 'zeta': [...]}`` for the cartesian
-        product over the model's own parameters (see `design_grid`).
+        product over the model's own parameters (see `design_grid`). The
+        designs are counted first (a grid: the product of its axes' lengths)
+        and a sweep that would not fit in memory, `DESIGN_BYTES` a design
+        besides its chunks, raises `qc_control.numerics.limits.ResourceLimitError`
+        with the count before any design is built.
     T : array_like
         Uniform time grid [s] (not with ``road``).
     X0 : array_like, default ``(0, 0, 0.05, 0)``
