@@ -192,3 +192,18 @@ def test_allowed_substeps_still_run(monkeypatch):
     np.testing.assert_allclose(r.states, exact.states, rtol=0, atol=1e-10)
     with pytest.raises(limits.ResourceLimitError, match="30000 steps"):
         qc.input_output_response(car, T, X0=X0, substeps=300)
+
+
+@pytest.mark.usefixtures("limit_16g")
+def test_every_step_kept_is_counted_over_the_whole_run():
+    """With ``evaluation_times=None`` every step is kept: 1e4 substeps on 1e6
+    intervals are 1e10 steps of times, states and outputs (the block alone,
+    128 intervals, would pass), refused with the count."""
+    T_long = np.linspace(0, 1e4, 10**6 + 1)
+    refused_quickly(
+        lambda: qc.input_output_response(
+            qc.quarter_car(), T_long, X0=X0, substeps=10**4, evaluation_times=None
+        ),
+        "the times, states and outputs at every step of 10000000000 steps",
+        "substeps = 10000 in each of 1000000 intervals",
+    )
