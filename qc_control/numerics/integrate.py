@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
+from .limits import check_memory
 from .messages import show
 from .methods import ButcherTableau, get_method
 from .stepper import GridSteps, stage_plan
@@ -30,14 +31,17 @@ __all__ = [
     "integrate_stepper",
     "check_time_grid",
     "check_substeps",
+    "check_step_memory",
+    "STEP_BLOCK",
     "uniform_step",
     "stage_times",
     "UNIFORM_RTOL",
 ]
 
-#: Intervals between checks for a non-finite state. Checking every step would
-#: cost about as much as a stage; a blow-up is still cut at its first bad sample.
-_CHECK_EVERY = 128
+#: Intervals stepped per block: between checks for a non-finite state (checking
+#: every step would cost about as much as a stage; a blow-up is still cut at its
+#: first bad sample). A block's step times and states are held at once.
+STEP_BLOCK = 128
 
 #: `uniform_step`'s tolerance, in units of ``eps·max|T|``: a grid point may
 #: sit this far from ``T[0] + k·dt`` and the grid still counts as uniform.
@@ -220,6 +224,7 @@ def stage_times(t, method="rk4", *, substeps: int = 1) -> np.ndarray:
     t = check_time_grid(t, "t")
     substeps = check_substeps(substeps)
     plan = stage_plan(tab)
+    check_step_memory(t.size - 1, substeps, stage_table_bytes(tab.stages), "the stage-times table")
     dt = uniform_step(t)
     tt = t.tolist()
     if dt is not None:
@@ -237,6 +242,50 @@ def _non_finite_message(tab, t, n_last: int) -> str:
     return (
         f"{tab.name}: the state became non-finite after t = "
         f"{t[n_last]:.6g}; stopped after {n_last} of {t.size - 1} intervals"
+    )
+
+
+def stage_table_bytes(stages: int) -> int:
+    """Peak bytes per step while `stage_times` builds its table: the start time
+    (a Python float, its list slot and its array entry), the step lengths and
+    ``c_i h`` products, and the table with its temporaries. tracemalloc on a
+    million steps: 40 B for Euler, 136 B for RK4; this gives 72 B and 144 B."""
+    return 8 * (6 + 3 * stages)
+
+
+def check_step_memory(
+    intervals: int, substeps: int, bytes_per_step: float, table: str, cause: str = ""
+) -> None:
+    """Refuse a run whose per-step tables would not fit in memory, before they exist.
+
+    The steps themselves are not stored, but the stepper's tables are per step:
+    the stage times of every step (`stage_times`, whole runs), or a block of
+    `STEP_BLOCK` intervals' step times, rows and end states (`integrate`).
+    ``substeps = 1e9`` (or ``max_step = 1e-12``) asks for 1e11 steps on a grid
+    of 100 intervals: terabytes of tables, refused here by
+    `qc_control.numerics.limits.check_memory` with the count.
+
+    Parameters
+    ----------
+    intervals : int
+        Intervals of the grid the table covers.
+    substeps : int
+        Steps per interval.
+    bytes_per_step : float
+        The table's bytes per step.
+    table : str
+        What is allocated, for the message (``"the stage-times table"``).
+    cause : str, optional
+        Where the substeps come from, for the message (default: ``substeps``
+        itself; a response names its ``max_step``).
+    """
+    steps = intervals * substeps
+    check_memory(
+        steps * bytes_per_step,
+        f"{table} of {steps} steps ("
+        + (cause or f"substeps = {substeps}")
+        + f" in each of {intervals} intervals)",
+        "use fewer substeps or a larger max_step",
     )
 
 
@@ -336,7 +385,14 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
         return _integrate_events(f, t, x, tab, substeps, events)
 
     # a uniform grid is stepped with its one step, like the LTI engine
-    grid = GridSteps(tab, t.tolist(), substeps, uniform_step(t))
+    dt = uniform_step(t)
+    grid = GridSteps(tab, t.tolist(), substeps, dt)
+    check_step_memory(
+        min(STEP_BLOCK, t.size - 1),
+        substeps,
+        grid.scratch_bytes(x),
+        "the step times and states of a block",
+    )
 
     def run(x, out, start, stop):
         return grid.run(f, x, out[start:], start, stop)
@@ -390,8 +446,8 @@ def _blocks(run, t, x, tab, substeps, stacklevel) -> Solution:
     with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings():
         # a complex f on a real state would lose its imaginary part in `out`
         warnings.simplefilter("error", np.exceptions.ComplexWarning)
-        for start in range(0, t.size - 1, _CHECK_EVERY):
-            stop = min(start + _CHECK_EVERY, t.size - 1)
+        for start in range(0, t.size - 1, STEP_BLOCK):
+            stop = min(start + STEP_BLOCK, t.size - 1)
             try:
                 x = run(x, out, start, stop)
             except np.exceptions.ComplexWarning:

@@ -215,6 +215,15 @@ class GridSteps:
         if dt is not None:
             self._row = (self.plan.coefficients * (dt / substeps)).tolist()
 
+    def scratch_bytes(self, x: np.ndarray) -> int:
+        """Peak bytes per step of `run`'s block: the step's start time (a Python
+        float and its list slot), its row (a shared list on a uniform grid, else
+        its own list of floats) and its end state in `sample_steps`' buffer.
+        tracemalloc, 100 intervals of 10,000 steps, four states: 72 B uniform,
+        424 B for RK4 on a non-uniform grid; this gives 80 B and 504 B."""
+        row = 0 if self.dt is not None else 64 + 40 * self.plan.coefficients.size
+        return 48 + x.nbytes + row
+
     def steps(self, start: int, stop: int):
         """``(ts, rows)``: every step's start time and row for intervals ``start .. stop - 1``."""
         tt, ns = self.t, self.substeps

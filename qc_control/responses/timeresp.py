@@ -44,7 +44,9 @@ from control.timeresp import forced_response as _control_forced_response
 
 from .. import compat
 from ..numerics.integrate import (
+    STEP_BLOCK,
     DivergenceWarning,
+    check_step_memory,
     check_substeps,
     check_time_grid,
     checked_uniform_step,
@@ -1403,12 +1405,41 @@ def _io_step(sys, prob: _IOProblem, params, io: _IOOptions) -> _Computed:
             if math.isfinite(h_rule):
                 substeps = max(substeps, substeps_for(H, h_rule))
     max_step = io.max_step
+    by_max_step = 0
     if max_step is not None:
         if not (isinstance(max_step, (int, float, np.number)) and 0 < max_step < math.inf):
             raise ValueError(f"max_step must be a positive number of seconds, got {max_step!r}")
-        substeps = max(substeps, substeps_for(H, float(max_step)))
+        by_max_step = substeps_for(H, float(max_step))
+        substeps = max(substeps, by_max_step)
+    _check_io_steps(prob, io, substeps, by_max_step)
     compat.update_params(sys, params)  # linearize may have reset them
     return _Computed(tab, None, substeps, step_rule, eig)
+
+
+def _check_io_steps(prob: _IOProblem, io: _IOOptions, substeps: int, by_max_step: int) -> None:
+    """Refuse ``substeps`` (or the ``max_step`` that set them, ``by_max_step``)
+    whose step tables would not fit, before any is built.
+
+    Without events, `qc_control.numerics.integrate.integrate` holds a block of
+    `STEP_BLOCK` intervals' step times and states (about ``48 + 8n`` B a step);
+    with ``evaluation_times`` None or an array every step is a point of the
+    stepped grid, so the whole run's times, states and outputs are held
+    (``48 + 16(n + p)`` B a step: 184 B measured for the nonlinear car). With
+    events the steps are taken one by one, holding nothing per step.
+    """
+    if io.events is not None:
+        return
+    cause = (
+        f"max_step = {io.max_step!r} s: substeps = {substeps}" if by_max_step == substeps else ""
+    )
+    n, p = prob.x0.size, prob.noutputs
+    if not isinstance(io.t_eval, str):  # None or times: every step is a grid point
+        per_step, what = 48 + 16 * (n + p), "the times, states and outputs at every step"
+        intervals = prob.T.size - 1
+    else:
+        per_step, what = 48 + 8 * n, "the step times and states of a block"
+        intervals = min(prob.T.size - 1, STEP_BLOCK)
+    check_step_memory(intervals, substeps, per_step, what, cause)
 
 
 def _io_grid(T: np.ndarray, substeps: int, t_eval):

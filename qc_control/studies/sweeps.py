@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+import math
 import sys
 import warnings
 from collections.abc import Mapping, Sequence
@@ -89,29 +90,64 @@ class SweepResult:
     road: ISO8608Road | None = None
 
 
-def design_grid(grid: Mapping[str, Sequence], base=None) -> list[dict]:
-    """The cartesian product of a ``{'field': [values]}`` grid, as dicts.
+#: Bytes a sweep holds per design besides its chunks: the design's dict, its
+#: parameters, matrices and eigen-decomposition, and its row of the tables.
+#: Measured with tracemalloc on a grid of 32,000 designs (peak over the run):
+#: 2.5 kB for `design_grid` alone, 2.4 kB for a free sweep, 1.3 kB for one on
+#: a road, 1.6 kB for a spectral sweep; the largest is used for all of them.
+DESIGN_BYTES = 2560
 
-    Fields not in the grid come from ``base`` (the seed's quarter car by
-    default; any parameter dataclass with ``to_dict(changing=...)``). An
-    empty grid, an empty list of values or a key that is not a parameter
-    raises ``ValueError`` naming it.
+
+def _grid_axes(grid: Mapping[str, Sequence], base) -> tuple[list[str], list, int]:
+    """``(keys, values per key, number of designs)`` of a grid, without expanding it.
+
+    The count is the product of the axes' lengths (a Python int: no overflow),
+    so that a grid too large to build is refused before one design exists.
     """
-    base = quarter_car_model().params if base is None else base
     if not grid:
         raise ValueError("the design grid is empty: give at least one {'field': [values]}")
     names = list(base.to_dict())
     unknown = sorted(set(grid) - set(names))
     if unknown:
         raise ValueError(f"unknown parameter {unknown[0]!r} in the grid; expected some of {names}")
-    empty = [k for k, v in grid.items() if len(list(v)) == 0]
+    keys = list(grid)
+    # an axis is read once (a generator could not be read twice), not copied if it has a length
+    axes = [
+        v if hasattr(v, "__len__") and hasattr(v, "__getitem__") else list(v) for v in grid.values()
+    ]
+    empty = [k for k, v in zip(keys, axes) if len(v) == 0]
     if empty:
         raise ValueError(f"the grid gives no values for {empty[0]!r}")
+    return keys, axes, math.prod(len(v) for v in axes)
+
+
+def _grid_shape(keys: list[str], axes: list) -> str:
+    """``'1000 ks × 1000 cs'``: the axes, for a refusal's message."""
+    return " × ".join(f"{len(v)} {k}" for k, v in zip(keys, axes))
+
+
+def design_grid(grid: Mapping[str, Sequence], base=None) -> list[dict]:
+    """The cartesian product of a ``{'field': [values]}`` grid, as dicts.
+
+    Fields not in the grid come from ``base`` (the seed's quarter car by
+    default; any parameter dataclass with ``to_dict(changing=...)``). An
+    empty grid, an empty list of values or a key that is not a parameter
+    raises ``ValueError`` naming it. The designs are counted (the product of
+    the axes' lengths) before any is built: a grid whose dicts would not fit
+    in memory (`DESIGN_BYTES` each) raises
+    `qc_control.numerics.limits.ResourceLimitError` with the count.
+    """
+    base = quarter_car_model().params if base is None else base
+    keys, axes, count = _grid_axes(grid, base)
+    check_memory(
+        count * DESIGN_BYTES,
+        f"a design grid of {count} designs ({_grid_shape(keys, axes)})",
+        "use fewer values per parameter, or split the grid into parts",
+    )
     base_values = base.to_dict(changing=grid)
-    keys = list(grid)
     return [
         {**base_values, **dict(zip(keys, combo))}
-        for combo in itertools.product(*(list(grid[k]) for k in keys))
+        for combo in itertools.product(*(list(v) for v in axes))
     ]
 
 
@@ -535,7 +571,11 @@ def sweep(
     designs : list of parameters or dicts, or a grid dict
         A list of designs (`QuarterCarParams` or dicts of its fields, for the
         default model), or ``{'ks': [...], 'zeta': [...]}`` for the cartesian
-        product over the model's own parameters (see `design_grid`).
+        product over the model's own parameters (see `design_grid`). The
+        designs are counted first (a grid: the product of its axes' lengths)
+        and a sweep that would not fit in memory, `DESIGN_BYTES` a design
+        besides its chunks, raises `qc_control.numerics.limits.ResourceLimitError`
+        with the count before any design is built.
     T : array_like
         Uniform time grid [s] (not with ``road``).
     X0 : array_like, default ``(0, 0, 0.05, 0)``
@@ -622,7 +662,6 @@ def sweep(
     if T is None:
         raise ValueError("give T (a time grid) for a simulated sweep, or road= for a spectral one")
     model = quarter_car_model(road=U is not None) if model is None else model
-    designs = _design_list(designs, model)
     tab = get_method(method)
     T, X0, U = _sweep_signals(model.system, T, X0, U)
     substeps = check_substeps(substeps)
@@ -636,7 +675,13 @@ def sweep(
     if chunk_size is None:
         chunk_size = _vector_designs(U, metric_items, states)
     streamed = not states and not isinstance(metrics, Mapping)
-    _check_sweep_memory(model.system, len(designs), T.size, chunk_size, streamed, states)
+    designs = _design_list(
+        designs,
+        model,
+        lambda count, grid: _check_sweep_memory(
+            model.system, count, T.size, chunk_size, streamed, states, grid
+        ),
+    )
     params, errors = _validate(designs, type(model.params))
     if model.is_nonlinear:  # stepped in a batch (qc_control.studies.nlsweep), or one by one
         stable, table, kept = nonlinear_sweep(
@@ -657,13 +702,21 @@ def sweep(
     return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)
 
 
-def _design_list(designs, model: VehicleModel) -> list:
-    """The designs as a list: a grid dict expanded over the model's parameters."""
+def _design_list(designs, model: VehicleModel, check) -> list:
+    """The designs as a list: a grid dict expanded over the model's parameters.
+
+    ``check(count, grid)`` is called with the number of designs (and the
+    grid's axes as text, or '') before a grid is expanded: a grid of a billion
+    designs is refused by its count, not by running out of memory building it.
+    """
     if isinstance(designs, Mapping):
-        designs = design_grid(designs, model.params)
+        keys, axes, count = _grid_axes(designs, model.params)
+        check(count, _grid_shape(keys, axes))
+        return design_grid(designs, model.params)
     designs = list(designs)
     if not designs:
         raise ValueError("designs is empty: give at least one design")
+    check(len(designs), "")
     return designs
 
 
@@ -680,8 +733,11 @@ def _sweep_signals(system, T, X0, U):
     return T, X0, U
 
 
-def _check_sweep_memory(system, designs: int, N: int, chunk_size, streamed, states) -> None:
-    """Refuse a sweep whose chunks (and kept states) would not fit in memory."""
+def _check_sweep_memory(
+    system, designs: int, N: int, chunk_size, streamed, states, grid=""
+) -> None:
+    """Refuse a sweep whose designs, chunks (and kept states) would not fit in memory
+    (``grid``: the grid's axes, named in the message)."""
     n = system.nstates
     rows = min(chunk_size, designs, VECTOR_DESIGNS) * (system.noutputs + n * states)
     # streamed: a segment of outputs (~1 MB), a run of carries (~2 MB) and the padded
@@ -689,10 +745,13 @@ def _check_sweep_memory(system, designs: int, N: int, chunk_size, streamed, stat
     # plus every kept trajectory
     per_chunk = (2**22 + 16 * N) if streamed else 3 * rows * N * 8
     check_memory(
-        per_chunk + states * designs * n * N * 8,
-        f"a sweep of {designs} designs over {N} samples"
+        per_chunk + designs * DESIGN_BYTES + states * designs * n * N * 8,
+        f"a sweep of {designs} designs"
+        + (f" ({grid})" if grid else "")
+        + f" over {N} samples"
         + (" keeping their states" if states else ""),
-        "use fewer samples, a smaller chunk_size" + (" or states=False" if states else ""),
+        "use fewer designs or samples, a smaller chunk_size"
+        + (" or states=False" if states else ""),
     )
 
 
@@ -804,7 +863,15 @@ def _spectral_sweep(designs, T, U, road, metrics, model) -> SweepResult:
             "over the unbounded band"
         )
     model = quarter_car_model(road=True) if model is None else model
-    designs = _design_list(designs, model)
+    designs = _design_list(
+        designs,
+        model,
+        lambda count, grid: check_memory(
+            count * DESIGN_BYTES,
+            f"a spectral sweep of {count} designs" + (f" ({grid})" if grid else ""),
+            "use fewer designs, or sweep them in parts",
+        ),
+    )
     names = (
         SPECTRAL_METRICS
         if metrics is None
