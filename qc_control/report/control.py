@@ -53,7 +53,7 @@ def transmissibility_chart(cmp, signal: str) -> Figure:
 def control_figures(cmp) -> list[FigureSpec]:
     """The report's figures, numbered in order: one transmissibility chart per
     signal (when a linear design was compared), then the Pareto front."""
-    specs = []
+    specs: list[FigureSpec] = []
     for signal in _SIGNALS if cmp.transmissibility else ():
         what = _SIGNALS[signal][0]
         specs.append(

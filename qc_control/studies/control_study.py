@@ -253,7 +253,9 @@ def _check_run_length(built: dict, road_duration: float, bump_duration: float) -
     )
 
 
-def _measure(model: VehicleModel, runs: dict, method: str) -> tuple[dict, str]:
+def _measure(
+    model: VehicleModel, runs: dict[str, tuple[np.ndarray, np.ndarray]], method: str
+) -> tuple[dict, str]:
     """One design's row of metrics over the bump and road runs, and a note if a run failed."""
     bump_resp = _run(model, *runs["bump"], method)
     road_resp = _run(model, *runs["road"], method)
