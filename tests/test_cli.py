@@ -9,15 +9,21 @@ import subprocess
 import sys
 from pathlib import Path
 
+import filelock
 import pandas as pd
 import pytest
 
 import qc_control
+from qc_control import report as report_package
 from qc_control.cli import console
 from qc_control.cli import parser as cli
 from qc_control.cli.console import main
 from qc_control.cli.parser import build_parser, scenario_from_args
-from qc_control.cli.scenario import BumpRoad, Scenario
+from qc_control.cli.scenario import MAX_CONFIG_BYTES, BumpRoad, Scenario
+from qc_control.studies import control_study
+
+#: Streams without end where the system has them (a large file stands in elsewhere).
+DEVICES = [d for d in ("/dev/zero", "/dev/urandom") if Path(d).exists()]
 
 
 def run(*args):
@@ -384,3 +390,133 @@ def test_nonlinear_report_from_the_command_line(files, capsys):
     report = (files / "NL" / "report.md").read_text(encoding="utf-8")
     assert "Nonlinear system: events and order" in report and "contact regained" in report
     assert 'model = "nonlinear"' in (files / "NL" / "scenario.toml").read_text()
+
+
+# ------------------------------- issue 28 items 4, 5, 9 and 10: exit 0, or 2 with one line
+
+
+def one_line_error(capsys) -> str:
+    """The run's stderr, checked to be one error line and no traceback."""
+    err = capsys.readouterr().err
+    assert err.startswith("qc-control: error: ") and err.count("\n") == 1, err
+    assert "Traceback" not in err
+    return err
+
+
+def never(*args, **kwargs):
+    pytest.fail("computed before refusing")
+
+
+@pytest.fixture
+def no_work(monkeypatch):
+    """Both commands' computations fail the test if reached."""
+    monkeypatch.setattr(Scenario, "run", never)
+    monkeypatch.setattr(cli, "compare_controllers", never)
+
+
+@pytest.fixture
+def quick_figures(monkeypatch):
+    """What is checked is the exit and the files, not the pictures: 40 dpi keeps it quick."""
+    monkeypatch.setattr(report_package, "DPI", 40)
+
+
+@pytest.mark.parametrize("duration", ["1e7", "1e5"])
+def test_control_report_too_long_for_memory_is_refused_before_computing(
+    files, monkeypatch, capsys, duration
+):
+    """Item 4: 1e7 s ended in 'Unable to allocate 14.9 GiB' and a traceback; 1e5 s
+    computed for 33 s first. Refused before any run, leaving nothing behind."""
+    monkeypatch.setenv("QC_CONTROL_MAX_MEMORY", "16G")  # the same verdict on every machine
+    monkeypatch.setattr(control_study, "_run", never)
+    before = set(files.iterdir())
+    assert main(["control-report", "--road-duration", duration, "-q", "--out", "cr"]) == 2
+    err = one_line_error(capsys)
+    assert "a controller comparison over" in err and "of memory, more than the limit" in err
+    assert set(files.iterdir()) == before  # no report, no lock file
+
+
+@pytest.mark.parametrize("command", ["modes", "report", "control-report"])
+@pytest.mark.parametrize("source", [*DEVICES, "big.toml", "deep.toml"])
+def test_configs_that_are_not_text_are_one_line(files, no_work, capsys, command, source):
+    """Item 5: a 200 kB TOML of 100k nested arrays (a RecursionError traceback),
+    /dev/zero (read until MemoryError) and /dev/urandom (read without end); where
+    a system has no such device, a file one byte over the limit stands for it."""
+    (files / "big.toml").write_bytes(b"#" * (MAX_CONFIG_BYTES + 1))
+    (files / "deep.toml").write_text("a = " + "[" * 100_000 + "]" * 100_000 + "\n")
+    assert main([command, "--config", source, *([] if command == "modes" else ["-q"])]) == 2
+    err = one_line_error(capsys)
+    assert f"config file {source!r} is not a scenario config" in err
+
+
+@pytest.mark.parametrize("command", ["report", "control-report"])
+def test_a_second_run_into_a_held_out_stops_before_computing(files, no_work, capsys, command):
+    """Item 9: the second run computed everything and only then exited 2. The
+    other run is this test holding the report's lock file (.R.lock beside R) as a
+    run now does from before its computation to the end of its writing."""
+    with filelock.FileLock(files / ".R.lock", timeout=0):
+        assert main([command, "--out", "R", "-q"]) == 2
+    err = one_line_error(capsys)
+    assert "another qc-control run is writing a report into 'R'" in err
+    assert not (files / "R").exists()
+
+
+def test_folders_made_for_the_lock_are_removed_when_nothing_is_written(files, monkeypatch):
+    """The lock file lives beside the report, so the folders on the way to --out
+    are made before the run; a run that writes nothing leaves none of them."""
+
+    def interrupted(*args, **kwargs):
+        assert (files / "a" / "b" / ".R.lock").exists()  # held through the computation
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Scenario, "run", interrupted)
+    assert main(["report", "--out", "a/b/R", "-q"]) == 130
+    assert not (files / "a").exists()
+
+
+def test_runs_into_two_folders_of_one_parent_both_succeed(files, capsys, quick_figures):
+    """Item 9: with the lock on the parent, '--out reps/one' and '--out reps/two'
+    excluded each other. Each report has its own lock: while one is held (another
+    run computing into reps/one), a run into reps/two writes its report."""
+    (files / "reps").mkdir()
+    argv = ["control-report", "--designs", "skyhook semi-active", "-q"]
+    argv += ["--road-duration", "1", "--bump-duration", "1"]
+    with filelock.FileLock(files / "reps" / ".one.lock", timeout=0):
+        assert main([*argv, "--out", "reps/two"]) == 0
+        assert main([*argv, "--out", "reps/one"]) == 2
+    capsys.readouterr()
+    assert main([*argv, "--out", "reps/one"]) == 0
+    for name in ("one", "two"):
+        assert (files / "reps" / name / "report.html").exists()
+    assert sorted(p.name for p in (files / "reps").iterdir()) == ["one", "two"]
+
+
+@pytest.mark.slow
+def test_two_processes_into_two_folders_of_one_parent_both_succeed(files):
+    """Item 9 as found: two commands started together into --out one and --out two."""
+    argv = [sys.executable, "-m", "qc_control.cli.console", "control-report", "-q"]
+    argv += ["--designs", "skyhook semi-active", "--road-duration", "1", "--bump-duration", "1"]
+    runs = [
+        subprocess.Popen([*argv, "--out", f"reps/{name}"], stderr=subprocess.PIPE, text=True)
+        for name in ("one", "two")
+    ]
+    errors = [run.communicate(timeout=300)[1] for run in runs]
+    assert [run.returncode for run in runs] == [0, 0], errors
+    assert sorted(p.name for p in (files / "reps").iterdir()) == ["one", "two"]
+
+
+def test_control_report_of_a_semi_active_design_alone(files, capsys, quick_figures):
+    """Item 10: a valid name that selects no linear design exited 2 with pandas'
+    'No objects to concatenate' after computing. It writes its report."""
+    argv = ["control-report", "--designs", "skyhook semi-active", "-q", "--out", "cr"]
+    assert main([*argv, "--road-duration", "1", "--bump-duration", "1"]) == 0
+    assert "skyhook semi-active" in capsys.readouterr().out
+    assert (files / "cr" / "report.html").exists() and (files / "cr" / "pareto.png").exists()
+
+
+@pytest.mark.parametrize(
+    "designs, words",
+    [("", "--designs: unknown design ''; choose from ["), (",", "unknown design ''")],
+)
+def test_control_report_empty_designs_are_refused(files, no_work, capsys, designs, words):
+    assert main(["control-report", "--designs", designs, "-q"]) == 2
+    assert words in one_line_error(capsys)

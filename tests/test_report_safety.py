@@ -5,6 +5,7 @@ import os
 import shutil
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import filelock
@@ -192,3 +193,27 @@ def test_a_user_file_in_a_report_is_kept(cmp, tmp_path):
         write_report(cmp, out, ("md",))
     assert (out / "my notes.txt").read_text() == "keep me"
     shutil.rmtree(out)
+
+
+def test_a_run_holding_its_lock_writes_under_it_and_others_are_refused(cmp, tmp_path):
+    """Issue 28 item 9: a command holds its report's lock from before computing
+    (report_lock); its own write goes ahead under it, while a writer in another
+    thread, like one in another process, is refused; nothing is left afterwards."""
+    out = tmp_path / "R"
+    refused = []
+
+    def other_thread():
+        try:
+            write_report(cmp, out, ("md",))
+        except ReportError as exc:
+            refused.append(str(exc))
+
+    with rep.report_lock(out) as held:
+        assert held == out.resolve() and rep._lock_file(held).exists()
+        worker = threading.Thread(target=other_thread)
+        worker.start()
+        worker.join()
+        assert len(refused) == 1 and "another qc-control run is writing a report" in refused[0]
+        write_report(cmp, out, ("md",), command="mine")  # re-entrant in its own thread
+    assert marker_command(out) == "mine"
+    assert [p.name for p in tmp_path.iterdir()] == ["R"]  # no lock file left behind

@@ -8,6 +8,7 @@ directly (run), and TOML read by `tomllib` (the writer's output).
 import inspect
 import math
 import shlex
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -18,6 +19,7 @@ from hypothesis import strategies as st
 from qc_control import QuarterCarParams, compare_methods
 from qc_control.cli.parser import build_parser, scenario_from_args
 from qc_control.cli.scenario import (
+    MAX_CONFIG_BYTES,
     MAX_STEPS,
     ROADS,
     BumpRoad,
@@ -27,6 +29,7 @@ from qc_control.cli.scenario import (
     ScenarioError,
     SineRoad,
     StepRoad,
+    read_config,
 )
 from qc_control.ride import road
 from qc_control.studies.compare import DEFAULT_H, DEFAULT_METHODS, DEFAULT_T_END, DEFAULT_X0
@@ -401,3 +404,73 @@ def test_run_is_compare_methods_on_the_scenario():
 def test_every_kind_is_registered():
     assert set(ROADS) == {"none", "step", "bump", "sine", "iso8608"}
     assert all(cls.kind == kind for kind, cls in ROADS.items())
+
+
+# Issue 28 item 5: configs that are not files of text are refused in one line naming them.
+
+#: A stream without end where the system has one (the tests use a large file elsewhere).
+DEVICES = [d for d in ("/dev/zero", "/dev/urandom") if Path(d).exists()]
+
+
+def nested_arrays(tmp_path, depth=100_000):
+    path = tmp_path / "deep.toml"
+    path.write_text("a = " + "[" * depth + "]" * depth + "\n")  # 200 kB, valid TOML
+    return path
+
+
+@pytest.mark.parametrize("read", [Scenario.from_toml, read_config])
+def test_nesting_beyond_the_parser_is_named(tmp_path, read):
+    """100k nested arrays were a RecursionError traceback out of tomllib."""
+    path = nested_arrays(tmp_path)
+    with pytest.raises(ValueError, match="nested more deeply than the TOML reader") as info:
+        read(path)
+    assert f"config file {str(path)!r} is not a scenario config" in str(info.value)
+
+
+@pytest.mark.parametrize("read", [Scenario.from_toml, read_config])
+@pytest.mark.parametrize("source", [*DEVICES, "large file"])
+def test_a_config_larger_than_the_limit_is_refused_having_read_at_most_it(
+    tmp_path, monkeypatch, read, source
+):
+    """/dev/zero was read until MemoryError, /dev/urandom without end. No more than
+    MAX_CONFIG_BYTES + 1 bytes are read from anything (counted at the file object)."""
+    if source == "large file":
+        path = tmp_path / "big.toml"
+        path.write_text("# " + "x" * MAX_CONFIG_BYTES + "\n")
+    else:
+        path = Path(source)
+    asked = []
+    real_open = Path.open
+
+    def counting_open(self, *args, **kwargs):
+        fh = real_open(self, *args, **kwargs)
+        real_read = fh.read
+        fh.read = lambda n=-1: asked.append(n) or real_read(n)
+        return fh
+
+    monkeypatch.setattr(Path, "open", counting_open)
+    with pytest.raises(ValueError, match=f"holds more than {MAX_CONFIG_BYTES:,} bytes") as info:
+        read(path)
+    assert f"config file {str(path)!r} is not a scenario config" in str(info.value)
+    # a regular file is measured, not opened; a device is read once, by a bounded read
+    assert asked == ([] if source == "large file" else [MAX_CONFIG_BYTES + 1])
+
+
+def test_a_config_of_exactly_the_limit_is_read(tmp_path):
+    """The bound is the file's bytes: MAX_CONFIG_BYTES of comment and a value is read."""
+    path = tmp_path / "padded.toml"
+    head = "ms = 350.0\n# "
+    path.write_bytes((head + "x" * (MAX_CONFIG_BYTES - len(head) - 1) + "\n").encode())
+    assert path.stat().st_size == MAX_CONFIG_BYTES
+    assert Scenario.from_toml(path).vehicle == QuarterCarParams(ms=350.0)
+    assert read_config(path) == ({"ms": 350.0}, {})
+
+
+def test_bytes_that_are_not_utf8_after_a_valid_start_are_named(tmp_path):
+    """Bytes that are not UTF-8 past a valid start: the file and the byte are named."""
+    path = tmp_path / "half.toml"
+    path.write_bytes(b"ms = 350.0\n\xff\xfe")
+    with pytest.raises(ScenarioError, match=r"half\.toml' is not a TOML text file .*0xff"):
+        Scenario.from_toml(path)
+    with pytest.raises(ValueError, match="not a TOML text file"):
+        read_config(path)

@@ -10,6 +10,7 @@ are `qc_control.cli.console`'s, the entry point that imports this module.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 import warnings
@@ -26,7 +27,7 @@ from ..models.controllers import HINF_AVAILABLE
 from ..models.modal import modal_analysis
 from ..models.quarter import QuarterCarParams
 from ..models.registry import MODELS, ModelOption, get_model, parameter_help, parameter_keys
-from ..report import ReportError, check_target, write_report
+from ..report import ReportError, check_target, report_lock, write_report
 from ..report.control import write_control_report
 from ..studies.control_study import DESIGNS, compare_controllers
 from .scenario import (
@@ -430,9 +431,41 @@ def _check_out(out: str) -> Path:
     return path
 
 
+@contextlib.contextmanager
+def _claimed(out: Path, given: str):
+    """Hold ``--out``'s report lock from before the work until the report is written.
+
+    A second run into the same place stops at once with one line, not after
+    computing; runs into different directories, of one parent or not, go
+    ahead together. Folders made on the way to ``--out`` for the lock file
+    are removed again when the run writes nothing there.
+    """
+    made = [d for d in (out.parent, *out.parent.parents) if not d.exists()]
+    stack = contextlib.ExitStack()
+    try:
+        stack.enter_context(report_lock(out))
+    except ReportError as exc:
+        raise UsageError(str(exc).replace(repr(str(out.resolve())), repr(given))) from None
+    except OSError as exc:
+        raise UsageError(f"--out {given!r} cannot be made: {exc.strerror or exc}") from None
+    try:
+        with stack:
+            yield
+    finally:
+        for folder in made:  # the deepest first; one holding anything stays
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+
+
 def _cmd_report(args) -> int:
     scenario = scenario_from_args(args)
     out = _check_out(args.out)  # before the work, not after it
+    with _claimed(out, args.out):
+        return _report(args, scenario, out)
+
+
+def _report(args, scenario: Scenario, out: Path) -> int:
+    """Run the scenario and write its report into ``out`` (its lock held)."""
 
     say = (lambda message: None) if args.quiet else _progress
     road = scenario.road.describe()
@@ -495,6 +528,12 @@ def _cmd_control_report(args) -> int:
         )
     designs = _designs(args.designs)
     out = _check_out(args.out)
+    with _claimed(out, args.out):
+        return _control_report(args, params, designs, out)
+
+
+def _control_report(args, params: QuarterCarParams, designs: list[str], out: Path) -> int:
+    """Compare the designs and write the report into ``out`` (its lock held)."""
     if not args.quiet:
         _progress(f"qc-control control-report: {len(designs)} designs, bump and road runs")
     try:

@@ -85,6 +85,8 @@ __all__ = [
     "ROADS",
     "RoadSpec",
     "MAX_STEPS",
+    "MAX_CONFIG_BYTES",
+    "config_text",
     "road_from_mapping",
     "MODELS",
     "ModelKind",
@@ -105,6 +107,12 @@ __all__ = [
 #: 10,000 steps took 19 s and 0.3 GB for RK4 alone; 100,000 steps are a few
 #: minutes and about 1.5 GB per method. Raise it per scenario (``max_steps``).
 MAX_STEPS = 100_000
+
+#: The largest config file read [bytes]. A config is a few dozen lines (a report's
+#: scenario.toml is under 1 kB): a thousand times that still reads and parses in a
+#: fraction of a second, and a larger file is something else (a device such as
+#: /dev/zero, a log, a binary), refused before more than this is read.
+MAX_CONFIG_BYTES = 1_000_000
 
 
 class ScenarioError(ValueError):
@@ -897,33 +905,18 @@ class Scenario:
     def from_toml(cls, path, *, overrides: Mapping[str, Any] | None = None) -> Scenario:
         """Read a scenario from a TOML file; errors name the file.
 
-        ``overrides`` as in `from_mapping`.
+        ``overrides`` as in `from_mapping`. A file of more than
+        `MAX_CONFIG_BYTES` is refused, having read no more than that.
         """
-        path = str(path)
-        try:
-            with open(path, "rb") as fh:
-                data = fh.read()
-        except OSError as exc:
-            raise ScenarioError(f"config file {path!r} cannot be read: {exc.strerror}") from None
-        try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            raise ScenarioError(
-                f"config file {path!r} is not a TOML text file (not UTF-8: byte "
-                f"{data[exc.start]:#04x} at position {exc.start})"
-            ) from None
-        return cls.from_toml_string(text, overrides=overrides, source=path)
+        text = config_text(path)
+        return cls.from_toml_string(text, overrides=overrides, source=str(path))
 
     @classmethod
     def from_toml_string(
         cls, text: str, *, overrides: Mapping[str, Any] | None = None, source: str | None = None
     ) -> Scenario:
         """A scenario from TOML text, e.g. `to_toml`'s."""
-        try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            where = f"config file {source!r}" if source else "the scenario"
-            raise ScenarioError(f"{where} is not valid TOML: {exc}") from None
+        data = _parse_toml(text, f"config file {source!r}" if source else "the scenario")
         return cls.from_mapping(data, overrides=overrides, source=source)
 
     def to_toml(self) -> str:
@@ -1121,6 +1114,58 @@ def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
     return {"vehicle": vehicle, "run": table, "road": road, "road_section": section}
 
 
+def config_text(path: str | Path) -> str:
+    """The text of the config file ``path``, read with a bound on its size.
+
+    No more than `MAX_CONFIG_BYTES` and one byte are read, so a path to a
+    device (an endless stream of zeros or random bytes) is refused at once
+    rather than read until memory runs out; a regular file is measured
+    before it is opened.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the file: it cannot be read, is larger than `MAX_CONFIG_BYTES`,
+        or is not UTF-8 text.
+    """
+    path = Path(path)
+    name = str(path)
+    too_large = (
+        f"config file {name!r} is not a scenario config: it holds more than "
+        f"{MAX_CONFIG_BYTES:,} bytes (a config is a few lines of TOML)"
+    )
+    try:
+        if path.is_file() and path.stat().st_size > MAX_CONFIG_BYTES:
+            raise ScenarioError(too_large)
+        with path.open("rb") as fh:
+            data = fh.read(MAX_CONFIG_BYTES + 1)
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        raise ScenarioError(f"config file {name!r} cannot be read: {reason}") from None
+    if len(data) > MAX_CONFIG_BYTES:
+        raise ScenarioError(too_large)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(
+            f"config file {name!r} is not a TOML text file (not UTF-8: byte "
+            f"{data[exc.start]:#04x} at position {exc.start})"
+        ) from None
+
+
+def _parse_toml(text: str, where: str) -> dict[str, Any]:
+    """TOML ``text`` as a dict; errors begin with ``where`` (the file, or "the scenario")."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{where} is not valid TOML: {exc}") from None
+    except RecursionError:  # the parser recurses once per level of an array or inline table
+        raise ScenarioError(
+            f"{where} is not a scenario config: its arrays or tables are nested more deeply "
+            "than the TOML reader can follow"
+        ) from None
+
+
 def read_config(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
     """Read a TOML file into ``(parameter values, scenario table)``, unresolved.
 
@@ -1130,13 +1175,7 @@ def read_config(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
     ``ValueError`` naming the file and the key or value.
     """
     path = Path(path)
-    try:
-        with path.open("rb") as fh:
-            data = tomllib.load(fh)
-    except OSError as exc:
-        raise ValueError(f"config file {str(path)!r} cannot be read: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
+    data = _parse_toml(config_text(path), f"config file {str(path)!r}")
     scenario = data.pop("scenario", {})
     if not isinstance(scenario, dict):
         raise ValueError(f"config file {str(path)!r}: 'scenario' must be a table")

@@ -21,6 +21,7 @@ import platform
 import re
 import shutil
 import tempfile
+import threading
 from collections.abc import Callable
 from importlib.metadata import version
 from pathlib import Path
@@ -50,6 +51,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "check_target",
+    "report_lock",
     "write_report",
     "write_document",
     "build_blocks",
@@ -582,7 +584,7 @@ def _lock_file(out: Path) -> Path:
 
 @contextlib.contextmanager
 def _exclusive(out: Path):
-    """Hold the report's lock (`_lock_file`) while the report is swapped in.
+    """Take the report's lock (`_lock_file`) for `report_lock`, or stop with one line.
 
     A second run into the same place stops with one clear line instead of
     racing. The lock file is removed while the lock is still held, so nothing
@@ -606,6 +608,45 @@ def _exclusive(out: Path):
         with contextlib.suppress(OSError):
             _lock_file(out).unlink()
         lock.release()
+
+
+#: The report locks this process holds, as (report directory, thread): a command takes
+#: its report's lock before computing (`report_lock`), and the writer then runs under it.
+_HELD: set[tuple[Path, int]] = set()
+
+
+@contextlib.contextmanager
+def report_lock(out_dir):
+    """Hold the lock of the report ``out_dir`` (`_lock_file`, beside it) for a whole run.
+
+    A command takes it before computing, so that a second run into the same
+    report stops at once instead of after all its work; `write_document`
+    under it does not lock again. Within one thread it is re-entrant; another
+    thread or process is refused. The directory that will hold the report is
+    created if missing (the lock file lives there).
+
+    Yields
+    ------
+    Path
+        The report directory, resolved.
+
+    Raises
+    ------
+    ReportError
+        If another run holds the lock.
+    """
+    out = Path(out_dir).resolve()
+    key = (out, threading.get_ident())
+    if key in _HELD:
+        yield out
+        return
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with _exclusive(out):
+        _HELD.add(key)
+        try:
+            yield out
+        finally:
+            _HELD.discard(key)
 
 
 def _recover(out: Path) -> None:
@@ -696,7 +737,7 @@ def write_document(
     files by name, ``extra`` more text files by name. The directory is built
     beside the target and swapped in under a lock; an existing directory is
     replaced only if it is an earlier report holding nothing foreign
-    (`check_target`).
+    (`check_target`). The lock is the caller's when it holds `report_lock`.
     """
     formats = tuple(formats)
     bad = [f for f in formats if f not in FORMATS]
@@ -706,8 +747,7 @@ def write_document(
             f"choose from {', '.join(FORMATS)}"
         )
     out = check_target(out_dir, overwrite)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with _exclusive(out):
+    with report_lock(out):
         _recover(out)
         check_target(out, overwrite)  # again: recovery may have put a report back
         return _write(out, title, blocks, figures, tables, formats, extra, command)

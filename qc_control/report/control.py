@@ -51,14 +51,15 @@ def transmissibility_chart(cmp, signal: str) -> Figure:
 
 
 def control_figures(cmp) -> list[FigureSpec]:
-    """The report's figures: one transmissibility chart per signal."""
-    specs = []
-    for i, signal in enumerate(_SIGNALS, start=1):
+    """The report's figures, numbered in order: one transmissibility chart per
+    signal (when a linear design was compared), then the Pareto front."""
+    specs: list[FigureSpec] = []
+    for signal in _SIGNALS if cmp.transmissibility else ():
         what = _SIGNALS[signal][0]
         specs.append(
             FigureSpec(
                 f"transmissibility_{signal}.png",
-                f"Figure {i}",
+                f"Figure {len(specs) + 1}",
                 f"|{signal}/zr| of every linear design against frequency: the {what} "
                 "per metre of road height (control.frequency_response).",
                 functools.partial(transmissibility_chart, cmp, signal),
@@ -68,7 +69,7 @@ def control_figures(cmp) -> list[FigureSpec]:
         specs.append(
             FigureSpec(
                 "pareto.png",
-                "Figure 3",
+                f"Figure {len(specs) + 1}",
                 "Passive designs (cs × ks around the car) by exact RMS body acceleration and "
                 "tire load on the road's white road velocity, the non-dominated ones coloured by "
                 "RMS travel; the passive optima and the linear controllers marked.",
@@ -123,8 +124,15 @@ def control_blocks(cmp, command: str | None = None) -> list:
         Heading("Transmissibility"),
     ]
     specs = control_figures(cmp)
-    for spec in specs[:2]:
-        blocks.append(Image(spec.name, spec.caption, spec.label))
+    charts = [s for s in specs if s.name.startswith("transmissibility_")]
+    blocks += [Image(spec.name, spec.caption, spec.label) for spec in charts]
+    if not charts:
+        blocks.append(
+            Paragraph(
+                "No linear design was compared: a semi-active loop is nonlinear and has no "
+                "transmissibility."
+            )
+        )
     if not cmp.exact.empty:
         blocks += [
             Heading("Exact stationary metrics"),
@@ -136,8 +144,7 @@ def control_blocks(cmp, command: str | None = None) -> list:
                 "Table 4",
             ),
         ]
-    for spec in specs[2:]:
-        blocks.append(Image(spec.name, spec.caption, spec.label))
+    blocks += [Image(spec.name, spec.caption, spec.label) for spec in specs[len(charts) :]]
     if cmp.notes:
         blocks.append(Heading("Notes"))
         blocks += [Paragraph(note) for note in cmp.notes]
@@ -152,8 +159,11 @@ def write_control_report(
     """Write the controller comparison into ``out_dir`` (as `qc_control.write_report` does).
 
     Files: ``report.md``/``.html``/``.pdf`` per ``formats``, the two
-    transmissibility PNGs, and with ``'csv'`` ``control_table.csv`` (every
-    number of Tables 2 and 3) and ``transmissibility.csv``.
+    transmissibility PNGs and the Pareto front's, and with ``'csv'``
+    ``control_table.csv`` (every number of Tables 2 and 3),
+    ``transmissibility.csv`` and ``exact_metrics.csv``. A comparison of
+    semi-active designs alone has neither transmissibility nor exact
+    metrics: their figures and files are left out.
     """
 
     def tables() -> dict[str, pd.DataFrame]:
@@ -162,12 +172,12 @@ def write_control_report(
             for sig in _SIGNALS
             for name, mags in cmp.transmissibility.items()
         }
-        trans = pd.DataFrame(cols, index=pd.Index(cmp.freqs_hz, name="f [Hz]"))
-        return {
+        found = {
             "control_table.csv": cmp.table,
-            "transmissibility.csv": trans,
+            "transmissibility.csv": pd.DataFrame(cols, index=pd.Index(cmp.freqs_hz, name="f [Hz]")),
             "exact_metrics.csv": cmp.exact,
         }
+        return {name: frame for name, frame in found.items() if not frame.columns.empty}
 
     return write_document(
         out_dir,

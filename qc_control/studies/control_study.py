@@ -22,7 +22,7 @@ Every number is here; `qc_control.report.control` formats them.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 
 import control
@@ -34,6 +34,7 @@ from ..models.controllers import closed_loop
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
 from ..models.vehicle import VehicleModel
 from ..numerics.integrate import check_time_grid
+from ..numerics.limits import check_memory
 from ..numerics.stepper import substeps_for
 from ..responses.timeresp import auto_step, forced_response, input_output_response
 from ..ride import road
@@ -62,6 +63,15 @@ DESIGNS = (
 BUMP_METRICS = ("peak_body_acc", "peak_susp_travel", "settling_time")
 #: Metrics of the road run.
 ROAD_METRICS = ("rms_body_acc", "rms_body_acc_wk", "rms_susp_travel", "rms_tire_load / static")
+#: The time steps of the road and bump runs [s] (the road's is within
+#: `qc_control.ride.road.largest_step` up to 35 m/s).
+DT_ROAD, DT_BUMP = 0.005, 0.002
+#: Peak memory of a run per sample and per signal (state, output, input) [bytes], keyed by
+#: "is the loop linear": twice what was measured (peak resident memory over 80,000 to
+#: 800,000 samples: 2.5-2.8 float64s per signal and sample for a linear loop, the LTI
+#: engine and the ride metrics' temporaries; 9.5-18 for a semi-active one, stepped by
+#: input_output_response, the most for the ADD with its sensor state).
+_BYTES_PER_SIGNAL = {True: 8 * 6, False: 8 * 36}
 
 
 @dataclass(frozen=True, eq=False)
@@ -170,6 +180,14 @@ def _hinf(car, beta):
     return closed_loop(car, design.controller), what
 
 
+def _exact_table(linear: dict[str, VehicleModel], road_spec) -> pd.DataFrame:
+    """The exact stationary metrics of the linear designs (empty when none is chosen)."""
+    rows = [spectral_ride(m, road_spec).set_axis([n]) for n, m in linear.items()]
+    exact = pd.concat(rows) if rows else pd.DataFrame()
+    exact.index.name = "design"
+    return exact
+
+
 def _run(model: VehicleModel, T, U, method: str):
     """A fixed-step run; a linear loop is substepped to `auto_step`'s accuracy rule.
 
@@ -199,6 +217,63 @@ def _actuator(resp) -> tuple[float, float]:
     return float(math.sqrt(mean_square(fa))), mean_power
 
 
+def _design_names(designs) -> list[str]:
+    """``designs`` as a list of names, at least one (each is checked by `_design_set`)."""
+    if isinstance(designs, str) or not isinstance(designs, Iterable):
+        raise TypeError(
+            f"designs must be a sequence of design names, got {designs!r}; "
+            f"choose from {list(DESIGNS)}"
+        )
+    names = list(designs)
+    if not names:
+        raise ValueError(f"designs must name at least one design; choose from {list(DESIGNS)}")
+    return names
+
+
+def _check_run_length(built: dict, road_duration: float, bump_duration: float) -> None:
+    """Refuse runs that cannot fit in memory, before the time grids are made.
+
+    Each design's runs hold, per sample, its states, outputs and input and the
+    engines' temporaries: `_BYTES_PER_SIGNAL` of them per signal. The samples
+    are counted from the durations, so a run of 1e7 s is refused without
+    allocating its 2e9-sample grid.
+    """
+    samples = road_duration / DT_ROAD + bump_duration / DT_BUMP + 2
+    worst = max(
+        _BYTES_PER_SIGNAL[isinstance(m.system, control.StateSpace)]
+        * (m.system.nstates + m.system.noutputs + m.system.ninputs)
+        for m, _ in built.values()
+    )
+    check_memory(
+        worst * samples,
+        f"a controller comparison over {samples:.3g} samples (a {road_duration:g} s road "
+        f"run at {DT_ROAD * 1e3:g} ms and a {bump_duration:g} s bump run at "
+        f"{DT_BUMP * 1e3:g} ms)",
+        "use a shorter road_duration or bump_duration",
+    )
+
+
+def _measure(
+    model: VehicleModel, runs: dict[str, tuple[np.ndarray, np.ndarray]], method: str
+) -> tuple[dict, str]:
+    """One design's row of metrics over the bump and road runs, and a note if a run failed."""
+    bump_resp = _run(model, *runs["bump"], method)
+    road_resp = _run(model, *runs["road"], method)
+    row = {f"bump: {k}": v for k, v in ride_metrics(bump_resp, model, BUMP_METRICS).items()}
+    row.update({f"road: {k}": v for k, v in ride_metrics(road_resp, model, ROAD_METRICS).items()})
+    row["road: rms actuator force [N]"], row["road: mean actuator power [W]"] = _actuator(road_resp)
+    failed = [r for r in (bump_resp, road_resp) if not r.success]
+    note = f"the fixed-step run did not succeed ({failed[0].message})" if failed else ""
+    return row, note
+
+
+def _transmissibility(model: VehicleModel, f: np.ndarray) -> dict[str, np.ndarray]:
+    """|H| from the road height to the body acceleration and the tire deflection at ``f`` [Hz]."""
+    j = model.system.input_labels.index("zr")
+    H = np.asarray(control.frequency_response(model.system, 2 * np.pi * f).complex)
+    return {s: np.abs(H[model.output(s), j]) for s in ("body_acc", "tire_defl")}
+
+
 def compare_controllers(
     params=None,
     *,
@@ -221,7 +296,9 @@ def compare_controllers(
     params : QuarterCarParams, dict or None
         The car; the seed's by default.
     designs : sequence of str
-        A subset of `DESIGNS` (``'H∞'`` needs slycot).
+        A subset of `DESIGNS`, at least one (``'H∞'`` needs slycot). A
+        selection without a linear design has no transmissibility and no
+        exact metrics; the Pareto front is then the passive one alone.
     road_class, speed, road_duration, road_seed
         The ISO 8608 road [-, m/s, s, -], sampled at 5 ms (within
         `qc_control.ride.road.largest_step` up to 35 m/s).
@@ -241,46 +318,38 @@ def compare_controllers(
     Returns
     -------
     ControlComparison
+
+    Raises
+    ------
+    ValueError
+        For an unknown or empty ``designs``, a bad value (named), or runs
+        whose samples would not fit in memory
+        (`qc_control.numerics.limits.ResourceLimitError`, before any is made).
+    TypeError
+        If ``designs`` is a string or not a sequence.
     """
     p = as_params(params)
     speed = positive("speed", speed, "m/s")
     road_duration = positive("road_duration", road_duration, "s")
     bump_duration = positive("bump_duration", bump_duration, "s")
     positive("cmax", cmax, "N·s/m")
-    built = _design_set(p, road_class, speed, float(cmax), list(designs), hinf_beta)
-    dt_road, dt_bump = 0.005, 0.002
-    T_road = check_time_grid(np.arange(0.0, road_duration + dt_road / 2, dt_road), "T")
-    T_bump = check_time_grid(np.arange(0.0, bump_duration + dt_bump / 2, dt_bump), "T")
-    zr_road = road.iso8608(T_road, road_class, speed=speed, seed=road_seed)
-    zr_bump = road.bump(T_bump, height=bump_height)
+    built = _design_set(p, road_class, speed, float(cmax), _design_names(designs), hinf_beta)
+    _check_run_length(built, road_duration, bump_duration)
+    T_road = check_time_grid(np.arange(0.0, road_duration + DT_ROAD / 2, DT_ROAD), "T")
+    T_bump = check_time_grid(np.arange(0.0, bump_duration + DT_BUMP / 2, DT_BUMP), "T")
+    runs = {
+        "bump": (T_bump, road.bump(T_bump, height=bump_height)),
+        "road": (T_road, road.iso8608(T_road, road_class, speed=speed, seed=road_seed)),
+    }
     f = np.geomspace(0.1, 30.0, 200) if freqs_hz is None else np.asarray(freqs_hz, float)
     rows, trans, notes = {}, {}, []
     for name, (model, _) in built.items():
-        bump_resp = _run(model, T_bump, zr_bump, method)
-        road_resp = _run(model, T_road, zr_road, method)
-        row = {f"bump: {k}": v for k, v in ride_metrics(bump_resp, model, BUMP_METRICS).items()}
-        row.update(
-            {f"road: {k}": v for k, v in ride_metrics(road_resp, model, ROAD_METRICS).items()}
-        )
-        force, power = _actuator(road_resp)
-        row["road: rms actuator force [N]"] = force
-        row["road: mean actuator power [W]"] = power
-        rows[name] = row
-        if not (bump_resp.success and road_resp.success):
-            notes.append(f"{name}: the fixed-step run did not succeed ({road_resp.message})")
+        rows[name], note = _measure(model, runs, method)
+        if note:
+            notes.append(f"{name}: {note}")
         if isinstance(model.system, control.StateSpace):
-            j = model.system.input_labels.index("zr")
-            H = np.asarray(control.frequency_response(model.system, 2 * np.pi * f).complex)
-            trans[name] = {s: np.abs(H[model.output(s), j]) for s in ("body_acc", "tire_defl")}
-    linear = {
-        name: model
-        for name, (model, _) in built.items()
-        if isinstance(model.system, control.StateSpace)
-    }
-    exact = pd.concat(
-        [spectral_ride(m, (road_class, speed)).set_axis([n]) for n, m in linear.items()]
-    )
-    exact.index.name = "design"
+            trans[name] = _transmissibility(model, f)
+    linear = {n: m for n, (m, _) in built.items() if isinstance(m.system, control.StateSpace)}
     critical = 2 * math.sqrt(p.ks * p.ms)
     front = pareto_front(
         p,
@@ -293,7 +362,7 @@ def compare_controllers(
     )
     table = pd.DataFrame.from_dict(rows, orient="index").astype(float)
     table.index.name = "design"
-    semi = [n for n, (m, _) in built.items() if not isinstance(m.system, control.StateSpace)]
+    semi = [n for n in built if n not in linear]
     if semi:
         notes.append(
             "semi-active designs are nonlinear and have no transmissibility: "
@@ -314,8 +383,8 @@ def compare_controllers(
             "seed": road_seed,
         },
         method=method,
-        dt={"bump": dt_bump, "road": dt_road},
-        exact=exact,
+        dt={"bump": DT_BUMP, "road": DT_ROAD},
+        exact=_exact_table(linear, (road_class, speed)),
         pareto=front,
         notes=notes,
     )
