@@ -193,6 +193,23 @@ def test_internal_error_is_not_a_usage_error(files, monkeypatch, error, capsys):
     assert not (files / "R").exists()
 
 
+def test_a_spent_reference_budget_is_one_line(files, monkeypatch, capsys):
+    """The nonlinear reference's budget running out is the scenario's doing
+    (a jump without a switching function, a road too fast for the samples):
+    one line naming it, exit 2, nothing written."""
+    from qc_control.studies.compare import ReferenceBudgetError
+
+    def stalled(*args, **kwargs):
+        raise ReferenceBudgetError("the nonlinear reference spent its budget")
+
+    monkeypatch.setattr("qc_control.cli.scenario.compare_methods", stalled)
+    status = main(["report", "--quiet", "--t-end", "1", "--methods", "rk4", "--out", "R"])
+    err = capsys.readouterr().err
+    assert status == 2
+    assert err == "qc-control: error: the nonlinear reference spent its budget\n"
+    assert not (files / "R").exists()
+
+
 def test_ctrl_c_is_one_line(files, monkeypatch, capsys):
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt

@@ -29,6 +29,7 @@ from ..models.quarter import QuarterCarParams
 from ..models.registry import MODELS, ModelOption, get_model, parameter_help, parameter_keys
 from ..report import ReportError, check_target, report_lock, write_report
 from ..report.control import write_control_report
+from ..studies.compare import ReferenceBudgetError
 from ..studies.control_study import DESIGNS, compare_controllers
 from .scenario import (
     DEFAULT_MODEL,
@@ -474,7 +475,10 @@ def _report(args, scenario: Scenario, out: Path) -> int:
         f"0-{scenario.t_end:g} s" + (f" on {road}" if road else "") + "; each method is "
         "also run at h/2, h/4, ... for the convergence and cost figures"
     )
-    cmp = scenario.run(progress=None if args.quiet else lambda m: _progress(f"  {m}"))
+    try:
+        cmp = scenario.run(progress=None if args.quiet else lambda m: _progress(f"  {m}"))
+    except ReferenceBudgetError as exc:  # the scenario's system, not a bug: say what to change
+        raise UsageError(str(exc)) from None
     try:
         path = write_report(cmp, out, command=scenario.command())
     except ReportError as exc:

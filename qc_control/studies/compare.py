@@ -47,6 +47,7 @@ from ..responses.timeresp import (
 from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
 
 __all__ = [
+    "ReferenceBudgetError",
     "MethodComparison",
     "ComparisonProblem",
     "Provenance",
@@ -1145,7 +1146,9 @@ def _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks, budget):
     t, x = float(T[0]), np.asarray(x0, dtype=float)
     # a switching function exactly 0 at the start has no side yet: the free side (+1, a
     # stop not engaged, a tire in contact) costs at most one restart if it leaves to the other
-    sides = np.where(np.atleast_1d(switching(t, x)) < 0.0, -1.0, 1.0) if switching else []
+    sides: np.ndarray = (
+        np.where(np.atleast_1d(switching(t, x)) < 0.0, -1.0, 1.0) if switching else np.empty(0)
+    )
     out = np.empty((x.size, T.size))
     kw = dict(method="DOP853", rtol=rtol, atol=atol, dense_output=True)
     stops = sorted({float(b) for b in breaks if T[0] < b < T[-1]} | {float(T[-1])})
@@ -1180,9 +1183,15 @@ def _checked_budget(max_nfev, samples: int) -> int:
     return int(max_nfev)
 
 
-def _stalled(spent: _BudgetSpent, T, budget: int) -> ValueError:
+class ReferenceBudgetError(ValueError):
+    """The nonlinear reference spent its evaluation budget: the system, not the
+    code, is the cause (a jump without a switching function, or motion far
+    faster than the samples), so the command line reports it as bad input."""
+
+
+def _stalled(spent: _BudgetSpent, T, budget: int) -> ReferenceBudgetError:
     """The error for a reference solve that spent its budget: the likely causes, and cures."""
-    return ValueError(
+    return ReferenceBudgetError(
         f"the nonlinear reference (DOP853, restarted at each event) spent its budget of "
         f"{budget} right-hand-side evaluations (1000 per sample and 100000; max_nfev) and "
         f"reached only t = {spent.t:.6g} s of {T[0]:g}-{T[-1]:g} s, after {spent.events} "
