@@ -58,7 +58,15 @@ from typing import Any, ClassVar
 import control
 import numpy as np
 
-from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel, params_as
+from .vehicle import (
+    MAX_RATE_SPAN,
+    STANDARD_GRAVITY,
+    BatchedModel,
+    Corner,
+    SignalRoles,
+    VehicleModel,
+    params_as,
+)
 
 __all__ = [
     "HalfCarParams",
@@ -127,18 +135,102 @@ class _VehicleParams:
             if kind == "nonneg" and value < 0:
                 raise ValueError(f"{f.name} ({description}) must be >= 0 {unit}, got {value!r}")
             object.__setattr__(self, f.name, value)
-        # every entry of A must be finite: its largest entry is at most a stiffness
-        # (or damping) times a squared length over the smallest mass or inertia
-        values = {f.name: getattr(self, f.name) for f in fields(self)}  # type: ignore[arg-type]
-        rates = [v for k, v in values.items() if k[:2] in ("ks", "cs", "ku", "ar")]
-        inertias = [v for k, v in values.items() if k[:2] in ("ms", "mu", "Ix", "Iy")]
-        lengths = [abs(v) for k, v in values.items() if _SPEC[k][1] == "m"]
-        largest = max(rates) * max(1.0, max(lengths)) ** 2 / min(inertias)
-        if not math.isfinite(largest):
-            raise ValueError(
-                f"the {self.kind} car's matrix would not be finite: a stiffness or damping "
-                f"over the smallest mass or inertia overflows ({values})"
+        self._check_scales()
+
+    def _rates(self) -> tuple[dict[str, float], dict[str, float]]:
+        """The car's stiffness rates and damping rates [1/s], by plain arithmetic.
+
+        Each mode's natural frequency lies among the stiffness rates:
+        ``sqrt(k/m)`` of every wheel (against its tire and its spring), of
+        the body's heave, and of its pitch (``Σ k l²/Iy``) and roll
+        (``(Σ k t²/4 + arb)/Ix``) about the CG; the damping rates ``c/m``
+        and ``c l²/I`` are the decay rates. Products, not ``**``: an
+        overflow is then ``inf``, refused by name, never an OverflowError.
+        """
+        v = {f.name: getattr(self, f.name) for f in fields(self)}  # type: ignore[arg-type]
+        wheels = 1 if self.kind == "half" else 2  # per axle
+        arm = {"front": v["a"], "rear": v["b"]}
+        stiff = {}
+        damp = {}
+        for ax, l in arm.items():
+            mu = v[f"mu_{ax}"]
+            stiff[f"sqrt(ks_{ax}/mu_{ax})"] = math.sqrt(v[f"ks_{ax}"] / mu)
+            stiff[f"sqrt(ku_{ax}/mu_{ax})"] = math.sqrt(v[f"ku_{ax}"] / mu)
+            damp[f"cs_{ax}/mu_{ax}"] = v[f"cs_{ax}"] / mu
+            damp[f"cs_{ax}*{'a' if ax == 'front' else 'b'}²/Iy"] = (
+                wheels * v[f"cs_{ax}"] * l * l / v["Iy"]
             )
+        ks = {ax: wheels * v[f"ks_{ax}"] for ax in arm}
+        stiff["sqrt(Σks/ms)"] = math.sqrt((ks["front"] + ks["rear"]) / v["ms"])
+        stiff["sqrt(Σks·l²/Iy)"] = math.sqrt(
+            (ks["front"] * arm["front"] * arm["front"] + ks["rear"] * arm["rear"] * arm["rear"])
+            / v["Iy"]
+        )
+        damp["Σcs/ms"] = wheels * (v["cs_front"] + v["cs_rear"]) / v["ms"]
+        if self.kind == "full":
+            roll = sum(
+                v[f"ks_{ax}"] * v[f"track_{ax}"] * v[f"track_{ax}"] / 2 + v[f"arb_{ax}"]
+                for ax in arm
+            )
+            stiff["sqrt(roll stiffness/Ix)"] = math.sqrt(roll / v["Ix"])
+        return stiff, damp
+
+    def _check_scales(self) -> None:
+        """Refuse a car whose matrix overflows or whose modes cannot be resolved.
+
+        As for the quarter car (`QuarterCarParams`): every rate must be
+        finite, and the fastest at most `MAX_RATE_SPAN` times the slowest
+        stiffness rate (light damping is a slow decay, harmless). The seat,
+        where ``seat_acc`` is read, must be in the car: within ten
+        wheelbases of the CG (and ten tracks across), so that its lever arm
+        times the body's rotation stays finite.
+        """
+        stiff, damp = self._rates()
+        rates = {**stiff, **damp}
+        bad = next((k for k, r in rates.items() if not math.isfinite(r)), None)
+        if bad is not None:
+            raise ValueError(
+                f"the {self.kind} car's matrix would not be finite: {bad} overflows to "
+                f"{rates[bad]!r} ({self._values()})"
+            )
+        slow = min(stiff, key=stiff.__getitem__)
+        fast = max(rates, key=rates.__getitem__)
+        if rates[fast] > MAX_RATE_SPAN * stiff[slow]:
+            raise ValueError(
+                f"the {self.kind} car's time scales span more than {MAX_RATE_SPAN:.0e}: {fast} = "
+                f"{rates[fast]:.3g} 1/s against {slow} = {stiff[slow]:.3g} 1/s; its modes "
+                f"cannot be resolved in double precision ({self._values()})"
+            )
+        self._check_lengths()
+        self._check_seat()
+
+    def _check_lengths(self) -> None:
+        # the model divides by the squared track (an anti-roll bar's force per
+        # wheel is its moment over the track): a length 1e7 times shorter than
+        # the wheelbase is a car of no width, and its square underflows first
+        names = ["a", "b", "track_front", "track_rear"][: 2 if self.kind == "half" else 4]
+        for name in names:
+            value = getattr(self, name)
+            if value * MAX_RATE_SPAN < self.wheelbase:
+                raise ValueError(
+                    f"{name} ({_SPEC[name][0]}) = {value!r} m is more than {MAX_RATE_SPAN:.0e} "
+                    f"times shorter than the wheelbase a + b = {self.wheelbase:.6g} m"
+                )
+
+    def _check_seat(self) -> None:
+        reach = {"seat_x": 10 * self.wheelbase}
+        if self.kind == "full":
+            reach["seat_y"] = 10 * max(self.track_front, self.track_rear)  # type: ignore[attr-defined]
+        for name, limit in reach.items():
+            value = getattr(self, name)
+            if abs(value) > limit:
+                raise ValueError(
+                    f"{name} ({_SPEC[name][0]}) must be within {limit:.6g} m of the CG (ten "
+                    f"{'wheelbases' if name == 'seat_x' else 'track widths'}), got {value!r}"
+                )
+
+    def _values(self) -> str:
+        return ", ".join(f"{f.name}={getattr(self, f.name):.6g}" for f in fields(self))  # type: ignore[arg-type]
 
     @classmethod
     def from_mapping(cls, values: Mapping[str, Any]):
