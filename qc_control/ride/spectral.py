@@ -180,6 +180,21 @@ def lyapunov_variances(A, B, C) -> np.ndarray:
     return np.einsum("...ij,...jk,...ik->...i", C, P, C)
 
 
+def require_linear(model: VehicleModel, what: str = "") -> None:
+    """Refuse a nonlinear model for stationary (spectral) metrics, naming it.
+
+    The stationary variances solve a Lyapunov equation of ``(A, B, C)``; a
+    law that switches (semi-active damping, contact, bump stops) has no
+    such matrices, and its ride is found by simulating it on a road.
+    """
+    if model.is_nonlinear:
+        raise ValueError(
+            f"{what or 'model'} {model.name!r} is nonlinear: stationary (spectral) ride "
+            "metrics need a linear vehicle; simulate it on a road instead (qc.ride_metrics, "
+            "or qc.sweep with T and U)"
+        )
+
+
 def white_velocity_system(model: VehicleModel, batch=None):
     """``(Ã, B̃, C)`` of a vehicle whose road inputs are driven by white road velocity.
 
@@ -214,6 +229,7 @@ def white_velocity_system(model: VehicleModel, batch=None):
     """
     if not isinstance(model, VehicleModel):
         raise TypeError(f"model must be a VehicleModel, got {type(model).__name__}")
+    require_linear(model)
     roads = model.road_inputs()
     if not roads:
         raise ValueError(

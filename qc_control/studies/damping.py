@@ -48,7 +48,12 @@ import scipy.optimize
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
 from ..models.vehicle import STANDARD_GRAVITY, VehicleModel
 from ..ride.road import positive
-from ..ride.spectral import iso8608_intensity, white_velocity_variances, white_velocity_wk_variance
+from ..ride.spectral import (
+    iso8608_intensity,
+    require_linear,
+    white_velocity_variances,
+    white_velocity_wk_variance,
+)
 from .sweeps import design_grid
 
 if TYPE_CHECKING:
@@ -207,7 +212,16 @@ def _travel_floor(p: QuarterCarParams, q: float, travel_limit, sigmas: float) ->
     if travel_limit is None:
         return 0.0
     limit = positive("travel_limit", travel_limit, "m") / sigmas
-    return q * (p.ms + p.mu) / (2 * limit**2)
+    floor = q * (p.ms + p.mu) / 2 / limit / limit  # inf, not ZeroDivisionError, on underflow
+    try:  # the damping it asks for must still make a car the model can resolve
+        _with_cs(p, floor)
+    except ValueError:
+        raise ValueError(
+            f"travel_limit={travel_limit!r} m ({sigmas:g}σ) needs cs >= {floor:.3g} N·s/m "
+            "(RMS travel √(q(ms + mu)/(2 cs))), beyond any damper this car's model can "
+            "resolve; give a travel limit of a real rattle space (centimetres)"
+        ) from None
+    return floor
 
 
 def optimal_damping(
@@ -271,6 +285,12 @@ def optimal_damping(
         else quarter_car_model(as_params(params), road=True)
     )
     p = model.params
+    if not model.is_nonlinear and not hasattr(p, "cs"):
+        raise ValueError(
+            f"optimal_damping varies one damper, cs; {type(p).__name__} has one per axle "
+            "(cs_front, cs_rear): sweep them with qc.sweep({'cs_front': [...], 'cs_rear': "
+            "[...]}, model=..., road=qc.ISO8608Road(...))"
+        )
     closed = isinstance(p, QuarterCarParams) and "comfort_wk" not in weights
     closed = closed and not isinstance(params, VehicleModel)
     if method == "closed form" and not closed:
@@ -438,6 +458,7 @@ def pareto_front(
         ).iloc[0]
     for name, ctrl in (controllers or {}).items():
         if isinstance(ctrl, VehicleModel):
+            require_linear(ctrl, f"controllers[{name!r}]: the closed loop")
             marks[name] = spectral_ride(ctrl, road, wk=wk).iloc[0]
         else:
             marks[name] = pd.Series(dict(ctrl))

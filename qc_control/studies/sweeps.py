@@ -33,7 +33,7 @@ from ..ride.metrics import (
     RideSignals,
     metric_columns,
 )
-from ..ride.spectral import SPECTRAL_METRICS, ISO8608Road, spectral_metrics
+from ..ride.spectral import SPECTRAL_METRICS, ISO8608Road, require_linear, spectral_metrics
 from .nlsweep import nonlinear_sweep
 
 __all__ = [
@@ -863,6 +863,7 @@ def _spectral_sweep(designs, T, U, road, metrics, model) -> SweepResult:
             "over the unbounded band"
         )
     model = quarter_car_model(road=True) if model is None else model
+    require_linear(model)
     designs = _design_list(
         designs,
         model,

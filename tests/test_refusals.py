@@ -1,0 +1,65 @@
+"""Documented inputs that a tool cannot take are refused by name (issue 28, items 11 and 13).
+
+Each case used to end in an AttributeError or ZeroDivisionError from inside
+the code; the refusal now names the argument and what to do instead.
+"""
+
+import numpy as np
+import pytest
+
+import qc_control as qc
+
+
+@pytest.fixture(scope="module")
+def semi_active_loop():
+    car = qc.quarter_car_model(actuator=True, road=True)
+    return qc.closed_loop(car, qc.skyhook(2000.0, semi_active="on-off", cmax=3000.0))
+
+
+def test_optimal_damping_of_a_half_car_names_its_two_dampers():
+    with pytest.raises(ValueError, match=r"cs_front, cs_rear"):
+        qc.optimal_damping(qc.half_car_model(road=True), "comfort")
+
+
+def test_a_half_car_spectral_sweep_over_its_dampers_works_instead():
+    # the route the refusal names runs (its values are checked against the
+    # Lyapunov solution in test_spectral.py); here: it gives a metric per design
+    res = qc.sweep(
+        {"cs_front": [800.0, 3000.0]},
+        model=qc.half_car_model(road=True),
+        road=qc.ISO8608Road("C", 20.0),
+    )
+    values = res.metrics.select_dtypes("number").to_numpy()
+    assert values.shape[0] == 2 and np.all(np.isfinite(values))
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: qc.optimal_damping(qc.nonlinear_quarter_car_model(), "comfort"),
+        lambda: qc.sweep(
+            {"cs": [1000.0, 2000.0]},
+            model=qc.nonlinear_quarter_car_model(),
+            road=qc.ISO8608Road("C", 20.0),
+        ),
+    ],
+    ids=["optimal_damping", "spectral_sweep"],
+)
+def test_a_nonlinear_model_is_refused_for_spectral_metrics(call):
+    with pytest.raises(ValueError, match="is nonlinear: stationary"):
+        call()
+
+
+def test_a_semi_active_loop_on_the_pareto_figure_is_named(semi_active_loop):
+    with pytest.raises(ValueError, match=r"controllers\['sky'\].*nonlinear"):
+        qc.pareto_front(controllers={"sky": semi_active_loop})
+
+
+@pytest.mark.parametrize("limit", [1e-300, 1e-9])
+def test_an_impossible_travel_limit_names_the_damping_it_needs(limit):
+    # RMS travel sqrt(q (ms + mu) / (2 cs)) <= limit needs cs >= q (ms+mu)/(2 limit²):
+    # 1.8e18 N·s/m for 1e-9 m at 3σ on class C, inf for 1e-300 m
+    with pytest.raises(ValueError, match=rf"travel_limit={limit!r} m .*needs cs >="):
+        qc.pareto_front(travel_limit=limit)
+    with pytest.raises(ValueError, match=rf"travel_limit={limit!r} m"):
+        qc.optimal_damping(travel_limit=limit)
