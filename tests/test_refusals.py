@@ -63,3 +63,18 @@ def test_an_impossible_travel_limit_names_the_damping_it_needs(limit):
         qc.pareto_front(travel_limit=limit)
     with pytest.raises(ValueError, match=rf"travel_limit={limit!r} m"):
         qc.optimal_damping(travel_limit=limit)
+
+
+def test_switching_functions_that_change_number_are_refused():
+    calls = []
+
+    def growing(t, x):
+        calls.append(t)
+        return np.zeros(1 + len(calls) % 2)
+
+    with pytest.raises(ValueError, match=r"same number of switching functions.*shape \(1,\)"):
+        qc.integrate(lambda t, x: -x, np.linspace(0.0, 1.0, 11), [1.0], events=growing)
+    with pytest.raises(ValueError, match=r"shape \(2, 2\)"):
+        qc.integrate(
+            lambda t, x: -x, np.linspace(0.0, 1.0, 11), [1.0], events=lambda t, x: np.zeros((2, 2))
+        )

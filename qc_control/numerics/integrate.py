@@ -547,6 +547,7 @@ class _EventSteps:
         self.calls = self.steps = 0
         self.t_events: list[float] = []
         self.i_events: list[int] = []
+        self._shape: tuple[int, ...] | None = None  # of the switching functions
 
     def _counted(self, t, x):
         self.calls += 1
@@ -557,7 +558,16 @@ class _EventSteps:
         return self._grid.step(self._counted, t0, x0, h, self._buf)
 
     def switch(self, t, x):
-        return np.atleast_1d(np.asarray(self._events(t, x), dtype=float))
+        g = np.atleast_1d(np.asarray(self._events(t, x), dtype=float))
+        # a sign change is tracked per function: their number and order must not change
+        if g.ndim != 1 or g.shape != (self._shape or g.shape):
+            raise ValueError(
+                f"events(t, x) must return the same number of switching functions at every "
+                f"call (a 1-D array); it returned shape {g.shape} at t = {t:.6g} s"
+                + (f", after {self._shape}" if self._shape else "")
+            )
+        self._shape = g.shape
+        return g
 
     def across(self, ta, tb, x, sign):
         """The state at ``tb`` from ``(ta, x)``, stepping to each event inside first.
