@@ -20,6 +20,7 @@ import os
 import platform
 import re
 import shutil
+import signal
 import tempfile
 import threading
 from collections.abc import Callable
@@ -641,12 +642,43 @@ def report_lock(out_dir):
         yield out
         return
     out.parent.mkdir(parents=True, exist_ok=True)
-    with _exclusive(out):
+    with _exclusive(out), _interrupts_seen():
         _HELD.add(key)
         try:
             yield out
         finally:
             _HELD.discard(key)
+
+
+#: Ctrl-C presses seen while a report lock is held (in the main thread).
+_INTERRUPTED = threading.Event()
+
+
+@contextlib.contextmanager
+def _interrupts_seen():
+    """Remember every Ctrl-C while a report is made, as well as raising it.
+
+    A KeyboardInterrupt raised inside a weakref callback or a ``__del__``
+    (matplotlib's figure teardown has both) is printed as "Exception ignored"
+    and lost, and the run would go on to replace the earlier report. The
+    flag it leaves makes `_write` stop before the swap. Only the main thread
+    receives signals; Python's own handler still raises the interrupt.
+    """
+    previous = signal.getsignal(signal.SIGINT)
+    if threading.current_thread() is not threading.main_thread() or not callable(previous):
+        yield  # another thread, or Ctrl-C ignored or left to the OS: nothing to keep
+        return
+
+    def remember(signum, frame):
+        _INTERRUPTED.set()
+        previous(signum, frame)
+
+    _INTERRUPTED.clear()
+    signal.signal(signal.SIGINT, remember)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _recover(out: Path) -> None:
@@ -778,6 +810,8 @@ def _write(out: Path, title, blocks_of, figures, tables_of, formats, extra, comm
             f"qc-control report\n{command or ''}\nfiles:\n" + "\n".join(written) + "\n",
             encoding="utf-8",
         )
+        if _INTERRUPTED.is_set():  # a Ctrl-C that something swallowed: keep the earlier report
+            raise KeyboardInterrupt
         if out.exists():
             old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
             out.rename(old / out.name)
