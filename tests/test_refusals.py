@@ -78,3 +78,19 @@ def test_switching_functions_that_change_number_are_refused():
         qc.integrate(
             lambda t, x: -x, np.linspace(0.0, 1.0, 11), [1.0], events=lambda t, x: np.zeros((2, 2))
         )
+
+
+def test_a_bump_stop_far_past_its_clearance_gives_inf_not_overflow_error():
+    from qc_control.models.nonlinear import BumpStop
+
+    stop = BumpStop(0.05, 1e5, cubic=1e12)
+    # F = -(k p + k3 p³) in bound; p = 0.1 m: 1e4 + 1e9 N, exact in binary to 1 ulp
+    assert stop.force(-0.15) == pytest.approx(-(1e5 * 0.1 + 1e12 * 0.1**3), rel=1e-12)
+    assert stop.force(-1e300) == -np.inf  # a diverged state: the stop's force overflows
+    assert stop.energy(-1e300) == np.inf
+
+
+def test_a_rear_wheel_delay_that_overflows_names_wheelbase_and_speed():
+    T = np.linspace(0.0, 1.0, 11)
+    with pytest.raises(ValueError, match=r"wheelbase/speed = 1e\+300 m / 1e-300 m/s overflows"):
+        qc.road.axle_inputs(T, np.zeros(11), wheelbase=1e300, speed=1e-300)

@@ -215,12 +215,13 @@ class BumpStop:
 
     def force(self, d: float) -> float:
         """The stops' force on the body against the extension ``d`` [N] (0 inside the clearance)."""
+        # p * p * p, not p**3: a diverging state gives inf, not a Python OverflowError
         p = -d - self.clearance_bound
         if p > 0:
-            return -(self.stiffness * p + self.cubic * p**3)
+            return -(self.stiffness * p + self.cubic * (p * p * p))
         p = d - self.clearance_rebound
         if p > 0:
-            return self.stiffness * p + self.cubic * p**3
+            return self.stiffness * p + self.cubic * (p * p * p)
         return 0.0
 
     def forces(self, d: np.ndarray):
@@ -252,7 +253,8 @@ class BumpStop:
     def energy(self, d: float) -> float:
         """The stops' potential energy at extension ``d`` [J]: ``k p²/2 + k3 p⁴/4``."""
         p = max(-d - self.clearance_bound, d - self.clearance_rebound, 0.0)
-        return 0.5 * self.stiffness * p**2 + 0.25 * self.cubic * p**4
+        p2 = p * p
+        return 0.5 * self.stiffness * p2 + 0.25 * self.cubic * (p2 * p2)
 
 
 def _check_spring(spring, ks: float) -> float | None:

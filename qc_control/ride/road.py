@@ -319,6 +319,11 @@ def axle_inputs(T, zr, wheelbase: float, speed: float) -> np.ndarray:
     later, under the rear one (`delay`); the inputs ``[zr_front, zr_rear]``
     of ``half_car(road=True)``."""
     tau = positive("wheelbase", wheelbase, "m") / positive("speed", speed, "m/s")
+    if not math.isfinite(tau):
+        raise ValueError(
+            f"the rear wheel's delay wheelbase/speed = {wheelbase!r} m / {speed!r} m/s "
+            "overflows; give a car's wheelbase (metres) and a speed it drives (m/s)"
+        )
     return np.vstack([np.asarray(zr, dtype=float), delay(T, zr, tau)])
 
 
