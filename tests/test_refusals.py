@@ -94,3 +94,9 @@ def test_a_rear_wheel_delay_that_overflows_names_wheelbase_and_speed():
     T = np.linspace(0.0, 1.0, 11)
     with pytest.raises(ValueError, match=r"wheelbase/speed = 1e\+300 m / 1e-300 m/s overflows"):
         qc.road.axle_inputs(T, np.zeros(11), wheelbase=1e300, speed=1e-300)
+
+
+@pytest.mark.parametrize(("key", "step"), [("road_duration", 0.005), ("bump_duration", 0.002)])
+def test_a_controller_run_shorter_than_one_step_names_its_duration(key, step):
+    with pytest.raises(ValueError, match=rf"{key}=0.001 s is shorter than one {step * 1e3:g} ms"):
+        qc.compare_controllers(**{key: 0.001})

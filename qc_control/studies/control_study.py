@@ -332,6 +332,12 @@ def compare_controllers(
     speed = positive("speed", speed, "m/s")
     road_duration = positive("road_duration", road_duration, "s")
     bump_duration = positive("bump_duration", bump_duration, "s")
+    for name, value, dt in (("road", road_duration, DT_ROAD), ("bump", bump_duration, DT_BUMP)):
+        if value < dt:
+            raise ValueError(
+                f"{name}_duration={value!r} s is shorter than one {dt * 1e3:g} ms step of the "
+                f"{name} run; give at least {dt:g} s"
+            )
     positive("cmax", cmax, "N·s/m")
     built = _design_set(p, road_class, speed, float(cmax), _design_names(designs), hinf_beta)
     _check_run_length(built, road_duration, bump_duration)
