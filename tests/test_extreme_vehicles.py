@@ -13,6 +13,8 @@ import io
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from qc_control.cli.parser import run
 from qc_control.models.halfcar import FullCarParams, HalfCarParams
@@ -82,3 +84,45 @@ def test_the_command_line_refuses_in_one_line(argv):
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
         assert run(["modes", *argv]) == 2
     assert err.getvalue().count("\n") == 1 and "Traceback" not in err.getvalue()
+
+
+def _decades(cls):
+    """Each field times 10^k, k in [-6, 6]: twelve decades around the default car."""
+    defaults = cls()
+    names = [f.name for f in dataclasses.fields(cls)]
+    return st.fixed_dictionaries(
+        {},
+        optional={
+            n: st.floats(-6.0, 6.0).map(lambda k, d=getattr(defaults, n): (d or 1.0) * 10.0**k)
+            for n in names
+        },
+    )
+
+
+@pytest.mark.parametrize("cls", [HalfCarParams, FullCarParams])
+def test_any_car_across_twelve_decades_is_refused_or_analysed(cls):
+    # hypothesis: several fields changed at once, each over twelve decades;
+    # the same judgement as above, the modes against the matrix's eigenvalues
+    @settings(max_examples=60, deadline=None, derandomize=True)
+    @given(_decades(cls))
+    def check(values):
+        try:
+            params = cls(**values)
+        except ValueError as exc:
+            assert str(exc)
+            return
+        model = params.model()
+        eig = np.linalg.eigvals(model.system.A)
+        for mode in modal_analysis(model).modes:
+            assert np.min(np.abs(eig - mode.eigenvalue)) <= 1e-6 * abs(mode.eigenvalue)
+
+    check()
+
+
+def test_report_of_an_extreme_full_car_exits_2_before_computing(tmp_path):
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        status = run(["report", "--model", "full", "--a", "1e10", "--out", str(tmp_path / "r")])
+    assert status == 2 and "time scales span" in err.getvalue()
+    assert err.getvalue().count("\n") == 1
+    assert not (tmp_path / "r" / "report.md").exists()
