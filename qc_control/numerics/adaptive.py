@@ -64,6 +64,7 @@ __all__ = [
     "AdaptiveRun",
     "adaptive_solve",
     "check_tolerances",
+    "check_embedded",
     "initial_step",
     "slope_breakpoints",
     "MIN_RTOL",
@@ -178,6 +179,16 @@ SCIPY_CONTROLLER = StepController()
 def _rms(v: np.ndarray) -> float:
     """The root-mean-square norm (HNW I, §II.4, (4.11); scipy's ``norm``)."""
     return float(np.linalg.norm(v) / math.sqrt(v.size))
+
+
+def check_embedded(tab: ButcherTableau) -> None:
+    """Refuse ``rtol``/``atol`` with a tableau that has no error estimator."""
+    if not tab.embedded:
+        raise ValueError(
+            f"rtol/atol need an embedded pair (heun_euler, bogacki_shampine, dormand_prince "
+            f"or a tableau with b_hat); {tab.name!r} has no error estimator: drop rtol/atol "
+            "to step it at a fixed step"
+        )
 
 
 def check_tolerances(rtol, atol, n: int) -> tuple[float, np.ndarray | float]:
@@ -331,7 +342,7 @@ class _Loop:
         self.rtol, self.atol = tol
         self.plan = stage_plan(tab)
         self.error_weights = tab.b - tab.b_hat
-        self.exponent = -1.0 / (tab.error_order + 1)
+        self.exponent = -1.0 / (_error_order(tab) + 1)
         # FSAL: the last stage is f at the step's end (last row of a = b, c = 1)
         self.fsal = bool(tab.c[-1] == 1 and np.array_equal(tab.a[-1], tab.b))
         self.dense = _DENSE.get(tab)
@@ -422,6 +433,12 @@ class _Loop:
         )
 
 
+def _error_order(tab: ButcherTableau) -> int:
+    """The pair's error order q (`ButcherTableau.error_order`); a ValueError without ``b_hat``."""
+    check_embedded(tab)
+    return int(tab.error_order)  # type: ignore[arg-type]  # embedded: an int
+
+
 def _stops(t0: float, t_end: float, breakpoints) -> list[float]:
     """The times no step crosses: the breakpoints inside ``(t0, t_end)``, then ``t_end``."""
     b = np.unique(np.asarray(breakpoints, dtype=float).reshape(-1))
@@ -472,7 +489,7 @@ def adaptive_solve(
     loop = _Loop(f, t_out, x0, tab, tol, controller, max_step)
     stops = _stops(loop.t, float(t_out[-1]), breakpoints)
     if first_step is None:
-        h_abs = initial_step(f, loop.t, x0, loop.k1, stops[0], tab.error_order, *tol, max_step)
+        h_abs = initial_step(f, loop.t, x0, loop.k1, stops[0], _error_order(tab), *tol, max_step)
         loop.nfev += 1
     else:
         h_abs = _positive("first_step", first_step, allow_inf=False)

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from .adaptive import SCIPY_CONTROLLER, StepController, adaptive_solve
+from .adaptive import SCIPY_CONTROLLER, StepController, adaptive_solve, check_embedded
 from .limits import check_memory
 from .messages import show
 from .methods import ButcherTableau, get_method
@@ -454,12 +454,7 @@ def _integrate_adaptive(f, t, x, tab, tol, fixed, options, breakpoints) -> Solut
     """`integrate` with ``rtol``/``atol``: the arguments checked, the run handed
     to `qc_control.numerics.adaptive.adaptive_solve`, its result as a `Solution`."""
     substeps, events = fixed
-    if not tab.embedded:
-        raise ValueError(
-            f"rtol/atol need an embedded pair (a tableau with b_hat: heun_euler, "
-            f"bogacki_shampine, dormand_prince); {tab.name!r} has no error estimator: "
-            "drop rtol/atol to step it at a fixed step"
-        )
+    check_embedded(tab)
     if substeps != 1 or events is not None:
         raise ValueError(
             f"an adaptive run (rtol/atol) takes neither substeps (got {substeps}) nor events "
@@ -472,18 +467,11 @@ def _integrate_adaptive(f, t, x, tab, tol, fixed, options, breakpoints) -> Solut
     stops = np.empty(0) if breakpoints is None else _breakpoint_times(breakpoints)
     with np.errstate(over="ignore", invalid="ignore"):
         run = adaptive_solve(f, t, x, tab, *tol, breakpoints=stops, **options)
+    x = np.moveaxis(run.x, 0, -1)  # time last, as every Solution
     return Solution(
-        t=run.t,
-        x=np.moveaxis(run.x, 0, -1),
-        nfev=run.nfev,
-        steps=run.n_accepted,
-        method=tab,
-        status=run.status,
-        message=run.message,
-        accepted_times=run.accepted_times,
-        n_accepted=run.n_accepted,
-        n_rejected=run.n_rejected,
-    )
+        run.t, x, run.nfev, run.n_accepted, tab, run.status, run.message,
+        accepted_times=run.accepted_times, n_accepted=run.n_accepted, n_rejected=run.n_rejected,
+    )  # fmt: skip
 
 
 def _breakpoint_times(breakpoints) -> np.ndarray:

@@ -245,11 +245,7 @@ class ButcherTableau:
                 and np.array_equal(other.a, self.a)
                 and np.array_equal(other.b, self.b)
                 and np.array_equal(other.c, self.c)
-                and (
-                    np.array_equal(other.b_hat, self.b_hat)
-                    if self.embedded and other.embedded
-                    else self.b_hat is other.b_hat
-                )
+                and _same_weights(other.b_hat, self.b_hat)
             )
         return NotImplemented
 
@@ -258,6 +254,13 @@ class ButcherTableau:
 
     def __repr__(self) -> str:
         return f"ButcherTableau({self.name!r}, order={self.order}, stages={self.stages})"
+
+
+def _same_weights(x: np.ndarray | None, y: np.ndarray | None) -> bool:
+    """Equal error estimators: both absent, or equal arrays."""
+    if x is None or y is None:
+        return x is y
+    return np.array_equal(x, y)
 
 
 #: Forward Euler: x + h f(x) (seed, 4.2.1).
@@ -327,7 +330,7 @@ HEUN_EULER = ButcherTableau(
 #: 1989; scipy's RK23, whose E is b - b_hat).
 BOGACKI_SHAMPINE = ButcherTableau(
     "bogacki_shampine",
-    a=[[0, 0, 0, 0], [1 / 2, 0, 0, 0], [0, 3 / 4, 0, 0], [2 / 9, 1 / 3, 4 / 9, 0]],
+    a=np.array([[0, 0, 0, 0], [1 / 2, 0, 0, 0], [0, 3 / 4, 0, 0], [2 / 9, 1 / 3, 4 / 9, 0]]),
     b=[2 / 9, 1 / 3, 4 / 9, 0],
     c=[0, 1 / 2, 3 / 4, 1],
     order=3,
@@ -337,15 +340,17 @@ BOGACKI_SHAMPINE = ButcherTableau(
 #: 1980; HNW I, §II.5, Table 5.2; scipy's RK45 and MATLAB's ode45).
 DORMAND_PRINCE = ButcherTableau(
     "dormand_prince",
-    a=[
-        [0, 0, 0, 0, 0, 0, 0],
-        [1 / 5, 0, 0, 0, 0, 0, 0],
-        [3 / 40, 9 / 40, 0, 0, 0, 0, 0],
-        [44 / 45, -56 / 15, 32 / 9, 0, 0, 0, 0],
-        [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0, 0, 0],
-        [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0, 0],
-        [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0],
-    ],
+    a=np.array(
+        [
+            [0, 0, 0, 0, 0, 0, 0],
+            [1 / 5, 0, 0, 0, 0, 0, 0],
+            [3 / 40, 9 / 40, 0, 0, 0, 0, 0],
+            [44 / 45, -56 / 15, 32 / 9, 0, 0, 0, 0],
+            [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0, 0, 0],
+            [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0, 0],
+            [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0],
+        ]
+    ),
     b=[35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0],
     c=[0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1, 1],
     order=5,

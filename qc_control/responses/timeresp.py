@@ -47,7 +47,7 @@ from control.nlsys import input_output_response as _control_io_response
 from control.timeresp import forced_response as _control_forced_response
 
 from .. import compat
-from ..numerics.adaptive import slope_breakpoints
+from ..numerics.adaptive import check_embedded, slope_breakpoints
 from ..numerics.integrate import (
     STEP_BLOCK,
     DivergenceWarning,
@@ -398,12 +398,7 @@ class _Options:
 
 def _check_adaptive(opts: _Options) -> None:
     """rtol/atol need an embedded pair, one step per interval and the generic engine."""
-    if not opts.tab.embedded:
-        raise ValueError(
-            f"rtol/atol need an embedded pair (heun_euler, bogacki_shampine, dormand_prince "
-            f"or a tableau with b_hat); {opts.tab.name!r} has no error estimator: drop "
-            "rtol/atol to step it at a fixed step"
-        )
+    check_embedded(opts.tab)
     if opts.substeps != 1:
         raise ValueError(
             f"substeps = {opts.substeps} with rtol/atol: an adaptive run chooses its own steps"
@@ -470,7 +465,7 @@ class _Computed:
         self.h = float(np.diff(sol.accepted_times).max()) if sol.n_accepted else None
         self.step_rule = (
             f"adaptive: {sol.n_accepted} steps accepted and {sol.n_rejected} rejected "
-            f"at rtol {self.adaptive.rtol:g}, atol {_show_tolerance(self.adaptive.atol)}"
+            f"at rtol {self.adaptive.rtol}, atol {_show_tolerance(self.adaptive.atol)}"
         )
 
 
@@ -478,8 +473,8 @@ class _Computed:
 class _AdaptiveCounts:
     """What an adaptive run adds to `_Computed`."""
 
-    rtol: float
-    atol: float | np.ndarray
+    rtol: float | None
+    atol: float | np.ndarray | None
     accepted_times: np.ndarray
     n_accepted: int
     n_rejected: int
