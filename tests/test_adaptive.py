@@ -8,6 +8,7 @@ References: the published orders of each pair, scipy's ``solve_ivp``
 
 from __future__ import annotations
 
+import inspect
 import math
 
 import control
@@ -150,7 +151,12 @@ def test_initial_step_is_scipys(problem):
     for rtol, atol in ((1e-3, 1e-6), (1e-8, 1e-11)):
         f0 = f(0.0, x0)
         ours = initial_step(f, 0.0, x0, f0, t_end, 4, rtol, atol)
-        theirs = select_initial_step(f, 0.0, x0, t_end, np.inf, f0, 1, 4, rtol, atol)
+        if (
+            "t_bound" in inspect.signature(select_initial_step).parameters
+        ):  # newer scipy caps h at the interval
+            theirs = select_initial_step(f, 0.0, x0, t_end, np.inf, f0, 1, 4, rtol, atol)
+        else:  # the same rule without the cap at the interval (not reached here)
+            theirs = select_initial_step(f, 0.0, x0, f0, 1, 4, rtol, atol)
         # the same formula, the same operations: equal to rounding
         assert ours == pytest.approx(theirs, rel=1e-14)
 

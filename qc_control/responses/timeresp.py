@@ -1338,7 +1338,8 @@ def _check_fixed_step_method(method):
         raise ValueError(
             f"method={method!r} is a scipy.integrate.solve_ivp method, which "
             "control.input_output_response takes; qc_control steps at a fixed step: "
-            f"method must be one of {sorted(METHODS)} or a ButcherTableau"
+            f"method must be one of {sorted(METHODS)} or a ButcherTableau (RK45's pair is "
+            "method='dormand_prince' with rtol/atol, RK23's 'bogacki_shampine')"
         )
     return method
 
