@@ -63,7 +63,7 @@ from ..numerics.integrate import (
 from ..numerics.interconnect import CompiledInterconnect, FusedSteps, compile_interconnect
 from ..numerics.limits import check_memory
 from ..numerics.lti import array_key, is_nonlinear_system, lti_states, memo
-from ..numerics.methods import METHODS, ButcherTableau, get_method
+from ..numerics.methods import METHODS, TABLEAUS, ButcherTableau, get_method
 from ..numerics.sampled import linear_input
 from ..numerics.stability import max_stable_step, stability_coefficients, step_is_stable
 from ..numerics.stepper import substeps_for
@@ -364,7 +364,7 @@ def _not_a_method(value, name: str) -> None:
     positional is ``transpose``, where 'rk4' is silently true).
     """
     if isinstance(value, ButcherTableau) or (
-        isinstance(value, str) and value.strip().lower() in METHODS
+        isinstance(value, str) and value.strip().lower() in TABLEAUS
     ):
         raise TypeError(
             f"{name}={value!r} looks like a method: method is keyword-only "
