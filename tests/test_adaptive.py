@@ -330,3 +330,41 @@ def test_closed_form_decay_and_counts():
     # non-FSAL: s - 1 evaluations per attempt, one more per accepted step, two at the start
     assert run.nfev == 2 + (run.n_accepted + run.n_rejected) * 1 + run.n_accepted
     assert MIN_RTOL == 100 * np.finfo(float).eps
+
+
+def test_step_response_sums_the_traces():
+    # two inputs, two traces; each within 1e-6 m of python-control's exact
+    # step response at rtol 1e-6 (the run's global error is about 1e-8 m)
+    sys = control.ss(
+        np.asarray(qc.quarter_car().A), np.eye(4)[:, :2], np.eye(4)[2:], 0, name="two_inputs"
+    )
+    T = np.linspace(0, 5, 501)
+    exact = control.step_response(sys, T)
+    r = qc.step_response(sys, T, method="dormand_prince", rtol=1e-6, atol=1e-9)
+    assert r.success and np.abs(r.outputs - exact.outputs).max() < 1e-6
+    one = qc.step_response(sys, T, input=1, method="dormand_prince", rtol=1e-6, atol=1e-9)
+    zero = qc.step_response(sys, T, input=0, method="dormand_prince", rtol=1e-6, atol=1e-9)
+    assert r.n_accepted == one.n_accepted + zero.n_accepted
+    assert r.nfev == one.nfev + zero.nfev
+    np.testing.assert_array_equal(r.accepted_times, one.accepted_times)  # the last trace's
+
+
+def test_evaluation_times_and_max_step():
+    sys = control.nlsys(lambda t, x, u, p: van_der_pol(t, x), None, inputs=0, states=2, name="vdp")
+    T = np.linspace(0, 10, 11)
+    te = np.array([0.25, 2.5, 7.75])
+    r = qc.input_output_response(
+        sys, T, 0, [2.0, 0.0], method="dormand_prince", rtol=1e-8, atol=1e-10,
+        evaluation_times=te, solve_ivp_kwargs={"max_step": 0.05},
+    )  # fmt: skip
+    ref = solve_ivp(van_der_pol, (0, 10), [2.0, 0.0], method="RK45", rtol=1e-8, atol=1e-10,
+                    max_step=0.05, t_eval=te)  # fmt: skip
+    np.testing.assert_array_equal(r.t, te)
+    # the same steps and dense output as scipy's with the same max_step (rounding)
+    np.testing.assert_allclose(r.states, ref.y, rtol=0, atol=1e-9)
+    # each step at most max_step; differences of times up to 10 s round by ~2e-15 s
+    assert np.diff(r.accepted_times).max() <= 0.05 + 1e-14
+    with pytest.raises(ValueError, match="evaluation_times=None"):
+        qc.input_output_response(
+            sys, T, 0, [2.0, 0.0], method="dormand_prince", rtol=1e-6, evaluation_times=None
+        )
