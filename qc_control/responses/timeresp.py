@@ -1822,7 +1822,9 @@ def input_output_response(
         Accepted for python-control's signature. A fixed-step run cannot
         fail as ``solve_ivp`` can (a step-size underflow); a state that
         becomes NaN or inf ends the run, with a `DivergenceWarning` and
-        ``success`` False, whatever this says.
+        ``success`` False, whatever this says. An adaptive run (``rtol``/
+        ``atol``) whose step underflows ends there too, with ``success``
+        False and a message, rather than control's RuntimeError.
     transpose, squeeze : bool, optional
         As in python-control.
     return_states (or return_x) : bool, default False
