@@ -187,7 +187,11 @@ def test_signature_is_controls_plus_keyword_only_method(name):
         return [(p.name, p.default) for p in params if p.kind is p.POSITIONAL_OR_KEYWORD]
 
     assert positional(ours) == positional(theirs)
-    assert [p.name for p in ours if p.kind is p.KEYWORD_ONLY] == ["method", "substeps", "engine"]
+    # the keyword-only additions: the method, its steps, the engine, and the
+    # tolerances of an embedded pair's step-size control (issue 24)
+    assert [p.name for p in ours if p.kind is p.KEYWORD_ONLY] == [
+        "method", "substeps", "engine", "rtol", "atol",
+    ]  # fmt: skip
     assert [p.kind for p in ours][-1] is inspect.Parameter.VAR_KEYWORD  # control's aliases
 
 

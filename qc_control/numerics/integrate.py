@@ -1,10 +1,12 @@
-"""Fixed-step solutions of ``x' = f(t, x)`` with any explicit Butcher tableau.
+"""Solutions of ``x' = f(t, x)`` with any explicit Butcher tableau, at a fixed
+step or, for an embedded pair given ``rtol``/``atol``, with step-size control.
 
 `integrate` checks its arguments, steps the grid block by block with the
 stage loop of `qc_control.numerics.stepper` (the one place a tableau's
 stages are evaluated in Python), cuts a run that becomes non-finite and
 returns a `Solution`; with ``events`` it steps to each sign change of the
-switching functions. `integrate_stepper` gives the same checks and result
+switching functions; with ``rtol``/``atol`` it hands the run to
+`qc_control.numerics.adaptive`. `integrate_stepper` gives the same checks and result
 to a specialised stepper (`qc_control.numerics.interconnect.FusedSteps`,
 itself built on the stage loop). The time-grid rules live here too
 (`check_time_grid`, `uniform_step`, `stage_times`).
@@ -19,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
+from .adaptive import SCIPY_CONTROLLER, StepController, adaptive_solve, check_embedded
 from .limits import check_memory
 from .messages import show
 from .methods import ButcherTableau, get_method
@@ -73,7 +76,8 @@ class Solution:
         Steps taken (``substeps`` per interval of the grid).
     method : ButcherTableau
     status : str
-        ``'success'`` or ``'diverged'``.
+        ``'success'``, ``'diverged'``, or ``'failed'`` (an adaptive run
+        whose step fell below the smallest step the time's precision allows).
     message : str
     t_events : ndarray, shape (k,)
         With ``events``: the times at which an event function changed sign,
@@ -82,6 +86,13 @@ class Solution:
     i_events : ndarray of int, shape (k,)
         Which event function (its index in the vector ``events`` returns)
         changed sign at each of ``t_events``.
+    accepted_times : ndarray or None
+        An adaptive run's start and the end of each accepted step
+        (``n_accepted + 1`` times, as ``solve_ivp(...).t``); None at a
+        fixed step.
+    n_accepted, n_rejected : int
+        An adaptive run's accepted and rejected steps (``steps`` is
+        ``n_accepted``); 0 at a fixed step.
 
     Notes
     -----
@@ -98,10 +109,15 @@ class Solution:
     message: str
     t_events: np.ndarray = field(default_factory=lambda: np.empty(0))
     i_events: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=int))
+    accepted_times: np.ndarray | None = None
+    n_accepted: int = 0
+    n_rejected: int = 0
 
     def __post_init__(self):
-        if self.status not in ("success", "diverged"):
-            raise ValueError(f"status must be 'success' or 'diverged', got {self.status!r}")
+        if self.status not in ("success", "diverged", "failed"):
+            raise ValueError(
+                f"status must be 'success', 'diverged' or 'failed', got {self.status!r}"
+            )
         if self.status == "success" and not np.all(np.isfinite(self.x)):
             object.__setattr__(self, "status", "diverged")
             note = "the state holds non-finite values"
@@ -296,8 +312,12 @@ def check_substeps(substeps) -> int:
     return int(substeps)
 
 
-def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solution:
-    """Solve ``x' = f(t, x)`` with a fixed-step explicit Runge–Kutta method.
+def integrate(
+    f, t, x0, method="rk4", *, substeps: int = 1, events=None, rtol=None, atol=None,
+    first_step=None, max_step=np.inf, breakpoints=None, controller=SCIPY_CONTROLLER,
+) -> Solution:  # fmt: skip
+    """Solve ``x' = f(t, x)`` with an explicit Runge–Kutta method, at a fixed
+    step or with step-size control.
 
     Each interval ``[t[i], t[i+1]]`` of the grid is split into ``substeps``
     equal steps ``h``; on a grid that `uniform_step` finds uniform, every
@@ -338,6 +358,27 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
         discontinuous right-hand sides). The times go to
         ``Solution.t_events``. A single ``x0`` only (not a batch); a zero
         touched without a sign change (grazing) is not an event.
+    rtol, atol : float, optional
+        Step-size control for an embedded pair (a tableau with ``b_hat``:
+        ``'heun_euler'``, ``'bogacki_shampine'``, ``'dormand_prince'``):
+        either one given makes the run adaptive, the other taking scipy's
+        default (rtol 1e-3, atol 1e-6; atol may be one per state). The
+        steps are chosen by the standard controller
+        (`qc_control.numerics.adaptive`, HNW I, §II.4) and ``t`` is only
+        where the solution is reported: between step ends it is the pair's
+        continuous extension (dense output), so the output grid does not
+        hold the steps back. rtol must be at least 100 eps, both positive
+        and finite. A single ``x0`` only; no ``events``, ``substeps`` 1.
+    first_step, max_step : float, optional
+        An adaptive run's first step (default: HNW's starting-step rule,
+        as scipy's) and largest step (default inf) [s].
+    breakpoints : array_like, optional
+        Times at which ``f`` is not smooth in ``t`` (a sampled input's
+        kinks, `qc_control.numerics.adaptive.slope_breakpoints`): an
+        adaptive step never crosses one. Ignored at a fixed step, whose
+        steps end on the grid.
+    controller : StepController, optional
+        The controller's constants; default scipy's.
 
     Returns
     -------
@@ -345,12 +386,15 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
         If the state becomes non-finite, the run stops there: a
         `DivergenceWarning` is issued and the solution holds the samples
         up to the last finite one, with ``status='diverged'``. Every
-        sample is checked; a non-finite state is never a success.
+        sample is checked; a non-finite state is never a success. An
+        adaptive run whose step underflows stops with ``status='failed'``
+        and a message, holding the samples it reached.
 
     Raises
     ------
     ValueError
-        For a bad ``t``, ``x0`` or ``substeps``, naming it and its value.
+        For a bad ``t``, ``x0``, ``substeps`` or tolerance, naming it and
+        its value; for ``rtol``/``atol`` with a tableau without ``b_hat``.
     TypeError
         For an ``f`` that is not callable, or that returns complex values
         on a real state.
@@ -377,6 +421,12 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
     if not callable(f):
         raise TypeError(f"f must be callable as f(t, x), got {show(f)}")
     x = _initial_state(x0)
+    if rtol is not None or atol is not None:
+        return _integrate_adaptive(
+            f, t, x, tab, (rtol, atol), (substeps, events),
+            dict(first_step=first_step, max_step=max_step, controller=controller),
+            breakpoints,
+        )  # fmt: skip
     if events is not None:
         if not callable(events):
             raise TypeError(f"events must be callable as events(t, x), got {show(events)}")
@@ -398,6 +448,41 @@ def integrate(f, t, x0, method="rk4", *, substeps: int = 1, events=None) -> Solu
         return grid.run(f, x, out[start:], start, stop)
 
     return _blocks(run, t, x, tab, substeps, stacklevel=3)
+
+
+def _integrate_adaptive(f, t, x, tab, tol, fixed, options, breakpoints) -> Solution:
+    """`integrate` with ``rtol``/``atol``: the arguments checked, the run handed
+    to `qc_control.numerics.adaptive.adaptive_solve`, its result as a `Solution`."""
+    substeps, events = fixed
+    check_embedded(tab)
+    if substeps != 1 or events is not None:
+        raise ValueError(
+            f"an adaptive run (rtol/atol) takes neither substeps (got {substeps}) nor events "
+            f"(got {show(events)}): its steps are chosen by the error estimate"
+        )
+    if x.ndim != 1:
+        raise ValueError(f"an adaptive run needs a single initial state (n,), got {x.shape}")
+    if not isinstance(options["controller"], StepController):
+        raise TypeError(f"controller must be a StepController, got {show(options['controller'])}")
+    stops = np.empty(0) if breakpoints is None else _breakpoint_times(breakpoints)
+    with np.errstate(over="ignore", invalid="ignore"):
+        run = adaptive_solve(f, t, x, tab, *tol, breakpoints=stops, **options)
+    x = np.moveaxis(run.x, 0, -1)  # time last, as every Solution
+    return Solution(
+        run.t, x, run.nfev, run.n_accepted, tab, run.status, run.message,
+        accepted_times=run.accepted_times, n_accepted=run.n_accepted, n_rejected=run.n_rejected,
+    )  # fmt: skip
+
+
+def _breakpoint_times(breakpoints) -> np.ndarray:
+    """``breakpoints`` as a 1-D array of finite times, or a ValueError."""
+    try:
+        b = np.asarray(breakpoints, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"breakpoints must be times [s], got {show(breakpoints)}") from None
+    if not np.all(np.isfinite(b)):
+        raise ValueError(f"breakpoints must be finite times [s], got {show(breakpoints)}")
+    return b
 
 
 def integrate_stepper(stepper, t, x0, method="rk4", *, substeps: int = 1) -> Solution:

@@ -23,7 +23,19 @@ import numpy.typing as npt
 from .messages import show
 from .order_conditions import MAX_ORDER, check_order
 
-__all__ = ["ButcherTableau", "METHODS", "get_method", "EULER", "MIDPOINT", "HEUN", "RK4"]
+__all__ = [
+    "ButcherTableau",
+    "METHODS",
+    "TABLEAUS",
+    "get_method",
+    "EULER",
+    "MIDPOINT",
+    "HEUN",
+    "RK4",
+    "HEUN_EULER",
+    "BOGACKI_SHAMPINE",
+    "DORMAND_PRINCE",
+]
 
 _EPS = np.finfo(float).eps
 
@@ -59,12 +71,20 @@ class ButcherTableau:
     order : int, optional
         Classical order p. Computed from the tableau when left out; when
         given, it must be the computed order.
+    b_hat : array_like, shape (s,), optional
+        The weights of an embedded method ``x + h Σ b̂_i k_i`` of another
+        order on the same stages, summing to 1 and different from ``b``:
+        ``h Σ (b_i - b̂_i) k_i`` estimates the local error at no extra
+        evaluation (HNW I, §II.4), for step-size control
+        (`qc_control.numerics.adaptive`). The pair's `error_order` is the
+        lower of the two orders, each computed from the rooted trees.
 
     Raises
     ------
     ValueError
         When an entry is not a finite real number, the tableau is not
-        explicit or not consistent, or the stated order is not its order.
+        explicit or not consistent, the stated order is not its order, or
+        ``b_hat`` is not an embedded method of the same stages.
 
     Notes
     -----
@@ -99,6 +119,7 @@ class ButcherTableau:
     b: np.ndarray
     c: np.ndarray = None  # type: ignore[assignment]  # None: the row sums of a
     order: int = None  # type: ignore[assignment]  # None: computed
+    b_hat: np.ndarray | None = None  # None: no error estimator
 
     if TYPE_CHECKING:  # what the generated __init__ accepts; each field ends an array/int
 
@@ -109,6 +130,7 @@ class ButcherTableau:
             b: npt.ArrayLike,
             c: npt.ArrayLike | None = None,
             order: int | None = None,
+            b_hat: npt.ArrayLike | None = None,
         ) -> None: ...
 
     def __post_init__(self):
@@ -168,11 +190,50 @@ class ButcherTableau:
         object.__setattr__(self, "b", b)
         object.__setattr__(self, "c", c)
         object.__setattr__(self, "order", found.order)
+        self._set_embedded(where)
 
     @property
     def stages(self) -> int:
         """Number of stages s: right-hand-side evaluations per step."""
         return self.b.shape[0]
+
+    def _set_embedded(self, where: str) -> None:
+        """Check ``b_hat`` against ``b`` and keep the embedded method's order."""
+        if self.b_hat is None:
+            object.__setattr__(self, "_embedded_order", None)
+            return
+        b, s = self.b, self.stages
+        b_hat = _real_array(self.b_hat, "b_hat", where)
+        if b_hat.shape != b.shape:
+            raise ValueError(f"{where}: b_hat must have shape {b.shape} like b, got {b_hat.shape}")
+        if abs(b_hat.sum() - 1) > 64 * s * _EPS * max(1.0, np.abs(b_hat).sum()):
+            raise ValueError(f"{where}: b_hat sums to {b_hat.sum():.15g}, not 1")
+        if np.array_equal(b_hat, b):
+            raise ValueError(f"{where}: b_hat equals b, so it estimates no error")
+        b_hat.flags.writeable = False
+        object.__setattr__(self, "b_hat", b_hat)
+        found = check_order(self.a, b_hat, min(s, MAX_ORDER))
+        object.__setattr__(self, "_embedded_order", found.order)
+
+    @property
+    def embedded(self) -> bool:
+        """Whether the tableau carries an error estimator ``b_hat``."""
+        return self.b_hat is not None
+
+    @property
+    def embedded_order(self) -> int | None:
+        """The order of the embedded method ``b_hat`` (None without one)."""
+        return self._embedded_order  # type: ignore[attr-defined]
+
+    @property
+    def error_order(self) -> int | None:
+        """The order q of the error estimate: ``h Σ (b_i - b̂_i) k_i = O(h^{q+1})``.
+
+        ``q = min(p, p̂)`` of the two methods (HNW I, §II.4); the step-size
+        controller's exponent is ``-1/(q + 1)``. None without ``b_hat``.
+        """
+        p_hat = self.embedded_order
+        return None if p_hat is None else min(self.order, p_hat)
 
     def __eq__(self, other) -> bool:
         if isinstance(other, str):
@@ -184,6 +245,7 @@ class ButcherTableau:
                 and np.array_equal(other.a, self.a)
                 and np.array_equal(other.b, self.b)
                 and np.array_equal(other.c, self.c)
+                and _same_weights(other.b_hat, self.b_hat)
             )
         return NotImplemented
 
@@ -192,6 +254,13 @@ class ButcherTableau:
 
     def __repr__(self) -> str:
         return f"ButcherTableau({self.name!r}, order={self.order}, stages={self.stages})"
+
+
+def _same_weights(x: np.ndarray | None, y: np.ndarray | None) -> bool:
+    """Equal error estimators: both absent, or equal arrays."""
+    if x is None or y is None:
+        return x is y
+    return np.array_equal(x, y)
 
 
 #: Forward Euler: x + h f(x) (seed, 4.2.1).
@@ -214,9 +283,13 @@ RK4 = ButcherTableau(
 #: The seed's four methods by name.
 METHODS: dict[str, ButcherTableau] = {t.name: t for t in (EULER, MIDPOINT, HEUN, RK4)}
 
+#: Every named tableau, `get_method`'s catalogue: the seed's four and the
+#: methods added below.
+TABLEAUS: dict[str, ButcherTableau] = dict(METHODS)
+
 
 def get_method(method) -> ButcherTableau:
-    """A tableau from a name in `METHODS`, or the tableau itself.
+    """A tableau from a name in `TABLEAUS`, or the tableau itself.
 
     Raises
     ------
@@ -229,13 +302,59 @@ def get_method(method) -> ButcherTableau:
         return method
     if isinstance(method, str):
         try:
-            return METHODS[method.lower()]
+            return TABLEAUS[method.lower()]
         except KeyError:
             raise ValueError(
                 f"unknown method {method!r}; known methods are "
-                f"{', '.join(METHODS)} (or pass a ButcherTableau)"
+                f"{', '.join(TABLEAUS)} (or pass a ButcherTableau)"
             ) from None
     raise TypeError(
-        f"method must be a name in METHODS ({', '.join(METHODS)}) or a ButcherTableau, "
-        f"got {show(method)}"
+        f"method must be a name in METHODS or TABLEAUS ({', '.join(TABLEAUS)}) or a "
+        f"ButcherTableau, got {show(method)}"
     )
+
+
+# ---------------------------------------------------------------- embedded pairs
+# Each carries b_hat, an embedded method on the same stages whose difference
+# from b estimates the local error (HNW I, §II.4; step-size control in
+# qc_control.numerics.adaptive). The steps are taken with b, the higher order
+# ("local extrapolation"), as scipy does. Bogacki–Shampine and Dormand–Prince
+# are FSAL: their last stage is f at the step's end (last row of a = b,
+# c = 1), the next step's first stage.
+
+#: Heun–Euler 2(1): Heun's step, Euler's as the estimator (HNW I, §II.4).
+HEUN_EULER = ButcherTableau(
+    "heun_euler", a=[[0, 0], [1, 0]], b=[0.5, 0.5], c=[0, 1], order=2, b_hat=[1, 0]
+)
+#: Bogacki–Shampine 3(2), FSAL (Bogacki & Shampine, Appl. Math. Lett. 2(4),
+#: 1989; scipy's RK23, whose E is b - b_hat).
+BOGACKI_SHAMPINE = ButcherTableau(
+    "bogacki_shampine",
+    a=np.array([[0, 0, 0, 0], [1 / 2, 0, 0, 0], [0, 3 / 4, 0, 0], [2 / 9, 1 / 3, 4 / 9, 0]]),
+    b=[2 / 9, 1 / 3, 4 / 9, 0],
+    c=[0, 1 / 2, 3 / 4, 1],
+    order=3,
+    b_hat=[7 / 24, 1 / 4, 1 / 3, 1 / 8],
+)
+#: Dormand–Prince 5(4), FSAL (Dormand & Prince, J. Comput. Appl. Math. 6(1),
+#: 1980; HNW I, §II.5, Table 5.2; scipy's RK45 and MATLAB's ode45).
+DORMAND_PRINCE = ButcherTableau(
+    "dormand_prince",
+    a=np.array(
+        [
+            [0, 0, 0, 0, 0, 0, 0],
+            [1 / 5, 0, 0, 0, 0, 0, 0],
+            [3 / 40, 9 / 40, 0, 0, 0, 0, 0],
+            [44 / 45, -56 / 15, 32 / 9, 0, 0, 0, 0],
+            [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0, 0, 0],
+            [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0, 0],
+            [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0],
+        ]
+    ),
+    b=[35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0],
+    c=[0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1, 1],
+    order=5,
+    b_hat=[5179 / 57600, 0, 7571 / 16695, 393 / 640, -92097 / 339200, 187 / 2100, 1 / 40],
+)
+
+TABLEAUS.update({t.name: t for t in (HEUN_EULER, BOGACKI_SHAMPINE, DORMAND_PRINCE)})

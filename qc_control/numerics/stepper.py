@@ -46,6 +46,8 @@ __all__ = [
     "StagePlan",
     "stage_plan",
     "rk_steps",
+    "rk_stages",
+    "rk_end",
     "affine_rk_steps",
     "GridSteps",
     "sample_steps",
@@ -123,32 +125,49 @@ def stage_plan(tab: ButcherTableau) -> StagePlan:
     return StagePlan(np.array(coefficients), stages, weights[0], weights[1:])
 
 
+def rk_stages(f, t, v, x, stages, k: list) -> list:
+    """The stage derivatives of one step: ``k`` (holding ``k_1 = f(t, x)``) with ``k_2 .. k_s``.
+
+    ``v`` is the plan's coefficients times the step's ``h`` (`GridSteps`),
+    ``stages`` the plan's `StagePlan.stages`. The first stage is the
+    caller's, so that a step-size controller can reuse it across a rejected
+    step and take it from the previous step's last stage (FSAL).
+    """
+    for pc, terms in stages:
+        xi = x
+        for j, pa in terms:
+            xi = xi + v[pa] * k[j]
+        k.append(f(t + v[pc], xi))
+    return k
+
+
+def rk_end(x, v, k: list, plan: StagePlan):
+    """The step's end ``x + h Σ b_i k_i`` from its stage derivatives ``k`` (`rk_stages`)."""
+    pb, i0, rest = plan.first
+    ks = k[i0]
+    for i in rest:
+        ks = ks + k[i]
+    x = x + v[pb] * ks
+    for pb_, i0_, rest_ in plan.others:
+        ks = k[i0_]
+        for i in rest_:
+            ks = ks + k[i]
+        x = x + v[pb_] * ks
+    return x
+
+
 def rk_steps(f, ts, rows, x, out, plan: StagePlan):
     """One step from each time ``ts[k]`` with the row ``rows[k]``; ``out[k + 1]`` its end.
 
-    The stage loop for a callable right-hand side ``f(t, x)``. ``rows[k]``
-    is the plan's coefficients times the step's ``h`` (`GridSteps`); ``x``
-    is ``(n,)`` or a batch ``(n, m)`` (``f`` then returns ``(n, m)``).
-    Returns the last state.
+    The stage loop for a callable right-hand side ``f(t, x)``: `rk_stages`
+    then `rk_end`. ``rows[k]`` is the plan's coefficients times the step's
+    ``h`` (`GridSteps`); ``x`` is ``(n,)`` or a batch ``(n, m)`` (``f``
+    then returns ``(n, m)``). Returns the last state.
     """
-    stages, (pb, i0, rest), others = plan.stages, plan.first, plan.others
+    stages = plan.stages
     m = 0
     for t, v in zip(ts, rows):
-        k = [f(t, x)]
-        for pc, terms in stages:
-            xi = x
-            for j, pa in terms:
-                xi = xi + v[pa] * k[j]
-            k.append(f(t + v[pc], xi))
-        ks = k[i0]
-        for i in rest:
-            ks = ks + k[i]
-        x = x + v[pb] * ks
-        for pb_, i0_, rest_ in others:
-            ks = k[i0_]
-            for i in rest_:
-                ks = ks + k[i]
-            x = x + v[pb_] * ks
+        x = rk_end(x, v, rk_stages(f, t, v, x, stages, [f(t, x)]), plan)
         m += 1
         out[m] = x
     return x

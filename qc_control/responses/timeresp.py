@@ -8,7 +8,11 @@ the same `control.TimeResponseData` (labels, ``.plot()``, ``.to_pandas()``,
 tuple unpacking), or a `control.TimeResponseList` for a list of systems.
 The difference is the trajectory: for a continuous-time system it is the
 one the chosen fixed-step method computes. ``method``, ``substeps`` and
-``engine`` are keyword-only additions.
+``engine`` are keyword-only additions; so are ``rtol`` and ``atol``, with
+which an embedded pair (``'heun_euler'``, ``'bogacki_shampine'``,
+``'dormand_prince'``) chooses its own steps
+(`qc_control.numerics.adaptive`), never crossing a sample of the input
+where its slope changes.
 
 Which systems go where:
 
@@ -43,6 +47,7 @@ from control.nlsys import input_output_response as _control_io_response
 from control.timeresp import forced_response as _control_forced_response
 
 from .. import compat
+from ..numerics.adaptive import check_embedded, slope_breakpoints
 from ..numerics.integrate import (
     STEP_BLOCK,
     DivergenceWarning,
@@ -58,7 +63,7 @@ from ..numerics.integrate import (
 from ..numerics.interconnect import CompiledInterconnect, FusedSteps, compile_interconnect
 from ..numerics.limits import check_memory
 from ..numerics.lti import array_key, is_nonlinear_system, lti_states, memo
-from ..numerics.methods import METHODS, ButcherTableau, get_method
+from ..numerics.methods import METHODS, TABLEAUS, ButcherTableau, get_method
 from ..numerics.sampled import linear_input
 from ..numerics.stability import max_stable_step, stability_coefficients, step_is_stable
 from ..numerics.stepper import substeps_for
@@ -114,6 +119,17 @@ class FixedStepResponse(control.TimeResponseData):
         a switching function changed sign, each stepped to exactly.
     event_labels : tuple of str
         Which switching function changed sign at each of ``t_events``.
+    rtol, atol : float or None
+        The tolerances of an adaptive run (an embedded pair given
+        ``rtol``/``atol``); None at a fixed step.
+    accepted_times : ndarray or None
+        An adaptive run's start and the end of every accepted step [s]
+        (as ``solve_ivp(...).t``); with several traces (a step or impulse
+        response of several inputs), the last trace's. None at a fixed step.
+    n_accepted, n_rejected : int
+        An adaptive run's accepted and rejected steps, summed over traces
+        (``steps`` is ``n_accepted``; ``nfev`` counts every evaluation,
+        rejected steps' included).
     success, message
         As in python-control. ``success`` is False whenever the step
         exceeds the method's stability limit, the run diverged, or any
@@ -129,6 +145,11 @@ class FixedStepResponse(control.TimeResponseData):
     note: str | None = None
     t_events: np.ndarray = np.empty(0)
     event_labels: tuple[str, ...] = ()
+    rtol: float | None = None
+    atol: float | np.ndarray | None = None
+    accepted_times: np.ndarray | None = None
+    n_accepted: int = 0
+    n_rejected: int = 0
     _eigenvalues: np.ndarray | None = None
 
     @property
@@ -309,8 +330,8 @@ def auto_step(method, eigenvalues) -> tuple[float, str]:
 # ---------------------------------------------------------------- engines
 
 
-def _generic(A, B, T, u_samples, x0, tab, substeps, warn):
-    """The generic stepper on ``f(t, x) = A x + B u(t)``."""
+def _linear_rhs(A, B, T, u_samples):
+    """``f(t, x) = A x + B u(t)``, the input linear between its samples."""
     AT, BT = A.T.copy(), B.T.copy()
     if np.any(u_samples):
         u_of_t = linear_input(T, u_samples)
@@ -322,6 +343,12 @@ def _generic(A, B, T, u_samples, x0, tab, substeps, warn):
         def rhs(t, x):
             return x @ AT
 
+    return rhs
+
+
+def _generic(A, B, T, u_samples, x0, tab, substeps, warn):
+    """The generic stepper on ``f(t, x) = A x + B u(t)``."""
+    rhs = _linear_rhs(A, B, T, u_samples)
     with warnings.catch_warnings():
         if not warn:  # the step-size warning already told the user
             warnings.simplefilter("ignore", DivergenceWarning)
@@ -337,7 +364,7 @@ def _not_a_method(value, name: str) -> None:
     positional is ``transpose``, where 'rk4' is silently true).
     """
     if isinstance(value, ButcherTableau) or (
-        isinstance(value, str) and value.strip().lower() in METHODS
+        isinstance(value, str) and value.strip().lower() in TABLEAUS
     ):
         raise TypeError(
             f"{name}={value!r} looks like a method: method is keyword-only "
@@ -356,12 +383,31 @@ def _stacklevel() -> int:
 class _Options:
     """The keyword-only additions, checked once per call."""
 
-    def __init__(self, method, substeps, engine):
+    def __init__(self, method, substeps, engine, rtol=None, atol=None):
         self.tab = get_method(method)
         self.substeps = check_substeps(substeps)
         if engine not in _ENGINES:
             raise ValueError(f"engine must be 'auto', 'lti' or 'generic', got {engine!r}")
         self.engine = engine
+        self.rtol, self.atol = rtol, atol
+        #: an embedded pair given rtol/atol chooses its own steps
+        self.adaptive = rtol is not None or atol is not None
+        if self.adaptive:
+            _check_adaptive(self)
+
+
+def _check_adaptive(opts: _Options) -> None:
+    """rtol/atol need an embedded pair, one step per interval and the generic engine."""
+    check_embedded(opts.tab)
+    if opts.substeps != 1:
+        raise ValueError(
+            f"substeps = {opts.substeps} with rtol/atol: an adaptive run chooses its own steps"
+        )
+    if opts.engine == "lti":
+        raise ValueError(
+            "engine='lti' steps at a fixed step; rtol/atol need engine 'auto' or 'generic'"
+        )
+    # the tolerances themselves are checked once the states are known (integrate)
 
 
 @dataclass
@@ -376,21 +422,68 @@ class _Computed:
     steps: int = 0
     nfev: int = 0
     note: str | None = None
+    adaptive: _AdaptiveCounts | None = None
 
     def stamp(self, resp: FixedStepResponse) -> FixedStepResponse:
         """``resp`` with these attributes set."""
         resp.method, resp.h, resp.substeps = self.method, self.h, self.substeps
         resp.steps, resp.nfev = self.steps, self.nfev
         resp.step_rule, resp.note, resp._eigenvalues = self.step_rule, self.note, self.eigenvalues
+        if self.adaptive is not None:
+            a = self.adaptive
+            resp.rtol, resp.atol, resp.accepted_times = a.rtol, a.atol, a.accepted_times
+            resp.n_accepted, resp.n_rejected = a.n_accepted, a.n_rejected
         return resp
 
     @classmethod
     def of(cls, resp: FixedStepResponse) -> _Computed:
         """What ``resp`` says about how it was computed."""
+        adaptive = None
+        if resp.accepted_times is not None:
+            adaptive = _AdaptiveCounts(
+                resp.rtol, resp.atol, resp.accepted_times, resp.n_accepted, resp.n_rejected
+            )
         return cls(
             resp.method, resp.h, resp.substeps, resp.step_rule, resp._eigenvalues,
-            resp.steps, resp.nfev, resp.note,
+            resp.steps, resp.nfev, resp.note, adaptive,
         )  # fmt: skip
+
+    def record(self, sol, opts: _Options) -> None:
+        """The steps and evaluations of the run ``sol`` (a `Solution`); an adaptive
+        run's counts, accepted times and largest step besides."""
+        self.steps, self.nfev = sol.steps, sol.nfev
+        if sol.accepted_times is None:
+            return
+        self.adaptive = _AdaptiveCounts(
+            1e-3 if opts.rtol is None else opts.rtol,
+            1e-6 if opts.atol is None else opts.atol,
+            sol.accepted_times,
+            sol.n_accepted,
+            sol.n_rejected,
+        )
+        self.substeps = 1
+        self.h = float(np.diff(sol.accepted_times).max()) if sol.n_accepted else None
+        self.step_rule = (
+            f"adaptive: {sol.n_accepted} steps accepted and {sol.n_rejected} rejected "
+            f"at rtol {self.adaptive.rtol}, atol {_show_tolerance(self.adaptive.atol)}"
+        )
+
+
+@dataclass
+class _AdaptiveCounts:
+    """What an adaptive run adds to `_Computed`."""
+
+    rtol: float | None
+    atol: float | np.ndarray | None
+    accepted_times: np.ndarray
+    n_accepted: int
+    n_rejected: int
+
+
+def _show_tolerance(atol) -> str:
+    """``atol`` for a message: a number, or the range of one per state."""
+    a = np.asarray(atol, dtype=float)
+    return f"{float(a):g}" if a.ndim == 0 else f"{a.min():g}..{a.max():g} (one per state)"
 
 
 class _LinearRun(NamedTuple):
@@ -421,7 +514,7 @@ def _linear_step(tab: ButcherTableau, A: np.ndarray, H: float, opts: _Options, a
         else np.empty(0, complex)
     )
     substeps, step_rule = opts.substeps, None
-    if auto:
+    if auto and not opts.adaptive:  # an adaptive run sets its own step
         h_rule, step_rule = auto_step(tab, eig)
         if math.isfinite(h_rule):
             substeps = max(substeps, substeps_for(H, h_rule))
@@ -466,6 +559,8 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> _LinearRun:
         y = D @ u_samples if u_samples.size else np.zeros((C.shape[0], T.size))
         computed.note = "the system has no states: y = D u, nothing was integrated"
         return _LinearRun(T, np.zeros((0, T.size)), y, u_samples, computed, True, "")
+    if opts.adaptive:
+        return _simulate_adaptive(A, B, C, D, (T, u_samples, x0), opts, computed)
     message = _beyond_stability(tab, H / substeps, computed.eigenvalues, A, ss.name)
     success = not message
     uniform = dt is not None
@@ -489,6 +584,21 @@ def _simulate(ss, T, u_samples, x0, opts: _Options, auto: bool) -> _LinearRun:
         y = C @ x + D @ u if has_input else C @ x
     # lti_states cuts before the first non-finite sample: _finalise need not look again
     return _LinearRun(t, x, y, u, computed, success, message, states_finite=lti)
+
+
+def _simulate_adaptive(A, B, C, D, problem, opts: _Options, computed: _Computed) -> _LinearRun:
+    """An embedded pair with step-size control on ``x' = A x + B u(t)``: the
+    generic stepper, stopping at every sample where the input's slope changes."""
+    T, u_samples, x0 = problem
+    has_input = bool(u_samples.size) and bool(np.any(u_samples))
+    breaks = slope_breakpoints(T, u_samples) if has_input else None
+    rhs = _linear_rhs(A, B, T, u_samples)
+    sol = integrate(rhs, T, x0, opts.tab, rtol=opts.rtol, atol=opts.atol, breakpoints=breaks)
+    computed.record(sol, opts)
+    u = u_samples[:, : sol.t.size]
+    with np.errstate(over="ignore", invalid="ignore"):
+        y = C @ sol.x + D @ u if has_input else C @ sol.x
+    return _LinearRun(sol.t, sol.x, y, u, computed, sol.success, sol.message)
 
 
 def _all_finite(v: np.ndarray) -> bool:
@@ -736,6 +846,9 @@ def _combine(parts: list[FixedStepResponse]) -> tuple[_Computed, bool, str | Non
     computed = _Computed.of(parts[-1])
     computed.steps = sum(p.steps for p in parts)
     computed.nfev = sum(p.nfev for p in parts)
+    if computed.adaptive is not None:
+        computed.adaptive.n_accepted = sum(p.n_accepted for p in parts)
+        computed.adaptive.n_rejected = sum(p.n_rejected for p in parts)
     messages = []
     for p in parts:
         if p.message and p.message not in messages:
@@ -764,7 +877,7 @@ def _grid_arguments(sysdata, kwargs, grid, options, is_step: bool, positional: s
     python-control's keyword processing (`_with_aliases`) of ``grid =
     (timepts, timepts_num, return_states)`` and of ``named`` (each a value
     and its sentinel); no method in the positional ``positional``; the
-    keyword-only ``options = (method, substeps, engine)``; and the time
+    keyword-only ``options = (method, substeps, engine, rtol, atol)``; and the time
     grid, python-control's own when ``T`` is None or a final time.
 
     Returns
@@ -788,7 +901,7 @@ def _grid_arguments(sysdata, kwargs, grid, options, is_step: bool, positional: s
 def forced_response(
     sysdata, timepts=None, inputs=0.0, initial_state=0.0, transpose=False, params=None,
     interpolate=False, return_states=None, squeeze=None,
-    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+    *, method="rk4", substeps: int = 1, engine="auto", rtol=None, atol=None, **kwargs,
 ):  # fmt: skip
     """Forced response computed by a fixed-step method.
 
@@ -845,6 +958,19 @@ def forced_response(
         agree to rounding (1e-12 relative). ``'auto'`` uses ``'lti'`` on a
         uniform grid within the stability limit, ``'generic'`` otherwise
         (it stops a blow-up at its first non-finite sample).
+    rtol, atol : float, optional, keyword-only
+        With an embedded pair (``'heun_euler'``, ``'bogacki_shampine'``,
+        ``'dormand_prince'``), step adaptively to these tolerances (either
+        one given; the other takes scipy's default, rtol 1e-3 or atol 1e-6;
+        atol may be one per state) with the standard controller
+        (`qc_control.numerics.adaptive`, scipy's constants and first step).
+        No step crosses a sample of ``U`` where the input's slope changes,
+        so a short pulse on a long flat input is never stepped over; the
+        outputs at ``T`` between step ends are the pair's dense output.
+        The result then has ``accepted_times``, ``n_accepted``,
+        ``n_rejected`` and ``nfev``; ``engine`` must not be ``'lti'`` and
+        ``substeps`` must be 1. A tableau without ``b_hat`` raises a
+        ValueError.
 
     Returns
     -------
@@ -874,7 +1000,7 @@ def forced_response(
         return_states=(return_states, None),
     )
     _not_a_method(transpose, "transpose")
-    opts = _Options(method, substeps, engine)
+    opts = _Options(method, substeps, engine, rtol, atol)
     T, U, X0 = v["timepts"], v["inputs"], v["initial_state"]
     layout = _Layout(params, transpose, v["return_states"], squeeze)
     return _each(sysdata, lambda s: _forced(s, T, U, X0, layout, interpolate, opts))
@@ -883,7 +1009,7 @@ def forced_response(
 def initial_response(
     sysdata, timepts=None, initial_state=0, output_indices=None, timepts_num=None,
     params=None, transpose=False, return_states=False, squeeze=None,
-    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+    *, method="rk4", substeps: int = 1, engine="auto", rtol=None, atol=None, **kwargs,
 ):  # fmt: skip
     """Initial-condition response computed by a fixed-step method.
 
@@ -915,7 +1041,7 @@ def initial_response(
         As in python-control.
     return_states (or return_x) : bool, default False
         Whether the result unpacks to ``(t, y, x)``.
-    method, substeps, engine : keyword-only
+    method, substeps, engine, rtol, atol : keyword-only
         As in `forced_response`. With an automatic grid, ``substeps`` is a
         lower bound.
 
@@ -948,7 +1074,8 @@ def initial_response(
     True
     """
     v, opts, T, auto = _grid_arguments(
-        sysdata, kwargs, (timepts, timepts_num, return_states), (method, substeps, engine),
+        sysdata, kwargs, (timepts, timepts_num, return_states),
+        (method, substeps, engine, rtol, atol),
         False, "output_indices",
         initial_state=(initial_state, 0.0), output_indices=(output_indices, None),
     )  # fmt: skip
@@ -1039,7 +1166,7 @@ def _as_lti_statespace(sys):
 def step_response(
     sysdata, timepts=None, initial_state=0.0, input_indices=None, output_indices=None,
     timepts_num=None, transpose=False, return_states=False, squeeze=None, params=None,
-    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+    *, method="rk4", substeps: int = 1, engine="auto", rtol=None, atol=None, **kwargs,
 ):  # fmt: skip
     """Step response computed by a fixed-step method.
 
@@ -1059,7 +1186,7 @@ def step_response(
     timepts_num (or T_num) : int, optional
     transpose, return_states (or return_x), squeeze, params
         As in python-control.
-    method, substeps, engine : keyword-only
+    method, substeps, engine, rtol, atol : keyword-only
         As in `forced_response`.
 
     Returns
@@ -1074,7 +1201,8 @@ def step_response(
     (1.0, 'rk4', 2)
     """
     v, opts, T, auto = _grid_arguments(
-        sysdata, kwargs, (timepts, timepts_num, return_states), (method, substeps, engine),
+        sysdata, kwargs, (timepts, timepts_num, return_states),
+        (method, substeps, engine, rtol, atol),
         True, "input_indices", initial_state=(initial_state, 0.0),
         input_indices=(input_indices, None), output_indices=(output_indices, None),
     )  # fmt: skip
@@ -1125,7 +1253,7 @@ def _multi_trace(kind, sys, T, traces, inputs, output, layout: _Layout):
 def impulse_response(
     sysdata, timepts=None, input_indices=None, output_indices=None, timepts_num=None,
     transpose=False, return_states=False, squeeze=None,
-    *, method="rk4", substeps: int = 1, engine="auto", **kwargs,
+    *, method="rk4", substeps: int = 1, engine="auto", rtol=None, atol=None, **kwargs,
 ):  # fmt: skip
     """Impulse response computed by a fixed-step method.
 
@@ -1141,7 +1269,7 @@ def impulse_response(
         As in `step_response`; there is no initial state (the impulse sets it).
     timepts_num (or T_num), transpose, return_states (or return_x), squeeze
         As in `step_response`.
-    method, substeps, engine : keyword-only
+    method, substeps, engine, rtol, atol : keyword-only
         As in `forced_response`.
 
     Returns
@@ -1157,7 +1285,8 @@ def impulse_response(
     [1.0, 0.606531, 0.367879]
     """
     v, opts, T, auto = _grid_arguments(
-        sysdata, kwargs, (timepts, timepts_num, return_states), (method, substeps, engine),
+        sysdata, kwargs, (timepts, timepts_num, return_states),
+        (method, substeps, engine, rtol, atol),
         False, "input_indices",
         input_indices=(input_indices, None), output_indices=(output_indices, None),
     )  # fmt: skip
@@ -1209,7 +1338,8 @@ def _check_fixed_step_method(method):
         raise ValueError(
             f"method={method!r} is a scipy.integrate.solve_ivp method, which "
             "control.input_output_response takes; qc_control steps at a fixed step: "
-            f"method must be one of {sorted(METHODS)} or a ButcherTableau"
+            f"method must be one of {sorted(METHODS)} or a ButcherTableau (RK45's pair is "
+            "method='dormand_prince' with rtol/atol, RK23's 'bogacki_shampine')"
         )
     return method
 
@@ -1393,6 +1523,10 @@ def _io_step(sys, prob: _IOProblem, params, io: _IOOptions) -> _Computed:
     ``max_step``'s bound."""
     tab, substeps, step_rule, eig = io.opts.tab, io.opts.substeps, None, None
     H = float(np.diff(prob.T).max())
+    if io.opts.adaptive:  # the steps follow the error estimate; max_step goes to the controller
+        if io.max_step is not None:
+            _check_max_step(io.max_step)
+        return _Computed(tab, None, 1, None, None)
     if io.auto and prob.x0.size:
         eig, why = _linearised_eigenvalues(
             sys, float(prob.T[0]), prob.x0, prob.u_samples[:, 0], params
@@ -1407,13 +1541,17 @@ def _io_step(sys, prob: _IOProblem, params, io: _IOOptions) -> _Computed:
     max_step = io.max_step
     by_max_step = 0
     if max_step is not None:
-        if not (isinstance(max_step, (int, float, np.number)) and 0 < max_step < math.inf):
-            raise ValueError(f"max_step must be a positive number of seconds, got {max_step!r}")
+        _check_max_step(max_step)
         by_max_step = substeps_for(H, float(max_step))
         substeps = max(substeps, by_max_step)
     _check_io_steps(prob, io, substeps, by_max_step)
     compat.update_params(sys, params)  # linearize may have reset them
     return _Computed(tab, None, substeps, step_rule, eig)
+
+
+def _check_max_step(max_step) -> None:
+    if not (isinstance(max_step, (int, float, np.number)) and 0 < max_step < math.inf):
+        raise ValueError(f"max_step must be a positive number of seconds, got {max_step!r}")
 
 
 def _check_io_steps(prob: _IOProblem, io: _IOOptions, substeps: int, by_max_step: int) -> None:
@@ -1442,11 +1580,24 @@ def _check_io_steps(prob: _IOProblem, io: _IOOptions, substeps: int, by_max_step
     check_step_memory(intervals, substeps, per_step, what, cause)
 
 
-def _io_grid(T: np.ndarray, substeps: int, t_eval):
+def _io_grid(T: np.ndarray, substeps: int, t_eval, adaptive: bool = False):
     """``(grid, at, n_sub)``: the times stepped between, the indices of the output
-    times in it (None: all of them), and the steps per interval of ``grid``."""
+    times in it (None: all of them), and the steps per interval of ``grid``.
+
+    An adaptive run's grid is only where it reports (its dense output): ``T``,
+    or the evaluation times with ``T``'s ends."""
     if isinstance(t_eval, str) and t_eval == "T":
         return T, None, substeps
+    if adaptive:
+        if t_eval is None:
+            raise ValueError(
+                "evaluation_times=None (every step) is not available with rtol/atol: an "
+                "adaptive run reports at 'T' or at given times; its steps are in the "
+                "result's accepted_times"
+            )
+        te = _evaluation_times(t_eval, T)
+        grid = np.union1d(T[[0, -1]], te)
+        return grid, np.searchsorted(grid, te), 1
     grid = _step_grid(T, substeps)
     if t_eval is None:  # solve_ivp's own points: here, every step
         return grid, None, 1
@@ -1470,6 +1621,8 @@ def _io_integrate(sys, prob: _IOProblem, grid, at, n_sub, computed: _Computed, i
     """Step the states over ``grid``: the fused interconnection, the compiled
     right-hand side or ``sys._rhs``; with events, each kink stepped to exactly."""
     tab, T, u_samples, x0 = computed.method, prob.T, prob.u_samples, prob.x0
+    if io.opts.adaptive:
+        return _io_adaptive(sys, prob, grid, at, computed, io, u_of_t)
     t_events: np.ndarray = np.empty(0)
     event_labels: tuple[str, ...] = ()
     compiled = compile_interconnect(sys) if io.fast else None
@@ -1507,6 +1660,38 @@ def _io_integrate(sys, prob: _IOProblem, grid, at, n_sub, computed: _Computed, i
     t_out, x = (sol.t, sol.x) if at is None else (sol.t[keep], sol.x[:, keep])
     return _IOTrajectory(
         t_out, x, keep, computed, sol.success, sol.message, t_events, event_labels, fused, compiled
+    )
+
+
+def _io_adaptive(sys, prob: _IOProblem, grid, at, computed: _Computed, io, u_of_t):
+    """An embedded pair with step-size control on the system's right-hand side
+    (the interconnection solved once where it can be), stopping at every
+    sample where the input's slope changes; the outputs at ``grid`` by the
+    pair's dense output."""
+    if io.events is not None:
+        raise ValueError(
+            f"events={io.events!r} with rtol/atol: an adaptive run does not locate "
+            "events; use a fixed-step method for events"
+        )
+    compiled = compile_interconnect(sys) if io.fast else None
+    if compiled is not None:
+        f = compiled.make_rhs(u_of_t)
+    else:
+        rhs = compat.state_derivative(sys)
+
+        def f(t, x):
+            return rhs(t, x, u_of_t(t))
+
+    sol = integrate(
+        f, grid, prob.x0, computed.method, rtol=io.opts.rtol, atol=io.opts.atol,
+        max_step=math.inf if io.max_step is None else float(io.max_step),
+        breakpoints=slope_breakpoints(prob.T, prob.u_samples),
+    )  # fmt: skip
+    computed.record(sol, io.opts)
+    keep = np.arange(sol.t.size) if at is None else at[at < sol.t.size]
+    t_out, x = (sol.t, sol.x) if at is None else (sol.t[keep], sol.x[:, keep])
+    return _IOTrajectory(
+        t_out, x, keep, computed, sol.success, sol.message, np.empty(0), (), None, compiled
     )
 
 
@@ -1548,7 +1733,7 @@ def _io_response(sys, T, U, X0, layout: _Layout, io: _IOOptions):
     prob = _io_problem(sys, T, U, X0, layout.params)
     u_of_t = linear_input(prob.T, prob.u_samples)  # python-control's interpolation of the samples
     computed = _io_step(sys, prob, layout.params, io)
-    grid, at, n_sub = _io_grid(prob.T, computed.substeps, io.t_eval)
+    grid, at, n_sub = _io_grid(prob.T, computed.substeps, io.t_eval, io.opts.adaptive)
     computed.h = float(np.diff(grid).max()) * (1 if n_sub == 1 else 1 / n_sub)
     if prob.x0.size == 0:
         traj = _io_static(prob, grid, at, computed)
@@ -1567,11 +1752,33 @@ def _io_response(sys, T, U, X0, layout: _Layout, io: _IOOptions):
     return _finalise(traj.computed.stamp(resp))
 
 
+def _ivp_tolerances(ivp: dict, method, rtol, atol):
+    """``rtol``/``atol`` from ``solve_ivp_kwargs`` (popped from ``ivp``) for an
+    embedded pair, as python-control passes them to solve_ivp; given twice,
+    a ValueError. For other methods they stay in ``ivp`` (and are refused)."""
+    if "rtol" not in ivp and "atol" not in ivp:
+        return rtol, atol
+    try:
+        embedded = get_method(method).embedded
+    except (TypeError, ValueError):
+        return rtol, atol  # the method's own error comes later
+    if not embedded:
+        return rtol, atol
+    given = {"rtol": rtol, "atol": atol}
+    for name in ("rtol", "atol"):
+        if name in ivp:
+            if given[name] is not None:
+                raise ValueError(f"{name} specified more than once (keyword and solve_ivp_kwargs)")
+            given[name] = ivp.pop(name)
+    return given["rtol"], given["atol"]
+
+
 def input_output_response(
     sys, timepts=None, inputs=0.0, initial_state=0.0, params=None, ignore_errors=False,
     transpose=False, return_states=False, squeeze=None, solve_ivp_kwargs=None,
     evaluation_times="T",
-    *, method="rk4", substeps: int = 1, events=None, fast: bool = True, **kwargs,
+    *, method="rk4", substeps: int = 1, events=None, fast: bool = True, rtol=None, atol=None,
+    **kwargs,
 ):  # fmt: skip
     """Response of a nonlinear (or any) input/output system, at a fixed step.
 
@@ -1615,7 +1822,9 @@ def input_output_response(
         Accepted for python-control's signature. A fixed-step run cannot
         fail as ``solve_ivp`` can (a step-size underflow); a state that
         becomes NaN or inf ends the run, with a `DivergenceWarning` and
-        ``success`` False, whatever this says.
+        ``success`` False, whatever this says. An adaptive run (``rtol``/
+        ``atol``) whose step underflows ends there too, with ``success``
+        False and a message, rather than control's RuntimeError.
     transpose, squeeze : bool, optional
         As in python-control.
     return_states (or return_x) : bool, default False
@@ -1623,8 +1832,10 @@ def input_output_response(
     solve_ivp_kwargs : dict, optional
         Only the options that mean something at a fixed step: ``t_eval``
         (as ``evaluation_times``) and ``max_step`` (the step is at most
-        this: ``substeps`` is raised until it is). Any other (``rtol``,
-        ``atol``, ``method``, ``events``, ...) raises a ValueError naming it.
+        this: ``substeps`` is raised until it is); with an embedded pair
+        also ``rtol`` and ``atol`` (as the keywords), and ``max_step``
+        bounds the adaptive step. Any other (``method``, ``events``, ...)
+        raises a ValueError naming it.
     evaluation_times (or t_eval) : array_like, 'T' or None, default 'T'
         Output times. ``'T'``: the times of ``T``. An array (sorted, within
         ``[T[0], T[-1]]``): the steps are taken on the union of these times
@@ -1654,6 +1865,14 @@ def input_output_response(
         calling ``sys._rhs``, which re-solves it at every stage. The same
         trajectory to rounding. Falls back to ``sys._rhs`` by itself where
         the interconnection has an algebraic loop.
+    rtol, atol : float, optional, keyword-only
+        With an embedded pair, step adaptively to these tolerances, as in
+        `forced_response` (no step crosses a sample of ``U`` where its slope
+        changes; the outputs at ``T`` or ``evaluation_times`` are the pair's
+        dense output; no ``events``, ``substeps`` 1, ``evaluation_times``
+        not None). The result has ``accepted_times``, ``n_accepted``,
+        ``n_rejected`` and ``nfev``; a step that underflows ends the run
+        with ``success`` False and a message.
 
     Returns
     -------
@@ -1728,6 +1947,7 @@ def input_output_response(
         t_eval = ivp.pop("t_eval")
     ivp.pop("t_eval", None)
     max_step = ivp.pop("max_step", None)
+    rtol, atol = _ivp_tolerances(ivp, method, rtol, atol)
     if ivp:
         raise ValueError(
             f"solve_ivp_kwargs {sorted(ivp)} do not apply to a fixed-step method: "
@@ -1735,7 +1955,7 @@ def input_output_response(
             "step: substeps or max_step)"
         )
     _not_a_method(transpose, "transpose")
-    opts = _Options(_check_fixed_step_method(method), substeps, "generic")
+    opts = _Options(_check_fixed_step_method(method), substeps, "generic", rtol, atol)
     layout = _Layout(params, transpose, return_x, squeeze)
     io = _IOOptions(t_eval, max_step, opts, False, events, fast)
     return _each(sys, lambda s: _io_response(s, T, U, X0, layout, io))
