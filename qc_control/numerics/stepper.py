@@ -59,6 +59,7 @@ __all__ = [
     "NewtonFailure",
     "NEWTON_RTOL",
     "NEWTON_MAXITER",
+    "NEWTON_REFRESH_RATE",
 ]
 
 #: Relative slack of `substeps_for`: an interval that holds the step an integer
@@ -307,6 +308,12 @@ NEWTON_RTOL = 1e-12
 #: §IV.8, eq. 8.14); at θ = 0.5 from a correction of the state's size, 40 are needed.
 NEWTON_MAXITER = 50
 
+#: A step whose simplified Newton iteration contracts by less than this per
+#: iteration (each correction more than this times the last) has the Jacobian
+#: formed anew for the next step; a faster one keeps it (HW II, §IV.8, where
+#: RADAU5 keeps it below 1e-3 with an error-controlled tolerance).
+NEWTON_REFRESH_RATE = 0.1
+
 
 class NewtonFailure(ArithmeticError):
     """The stages of one implicit step could not be solved.
@@ -335,9 +342,10 @@ class ImplicitSteps:
     by the simplified Newton iteration of HW II, §IV.8 (eq. 8.2): from
     ``Z = 0``, each iteration solves
     ``(I - h\,a \otimes J)\,ΔZ = -(Z - h (a \otimes I) F(Z))`` with one LU
-    factorisation per step, ``J = ∂f/∂x`` at ``(t, x)``: from ``jac`` if
-    given, else by forward differences with increments
-    ``√ε · max(1, |x_k|)``. It has converged when ``‖ΔZ‖∞ <=``
+    factorisation per Jacobian and step size, ``J = ∂f/∂x`` at the start
+    of a step (kept for later steps while the iteration converges fast:
+    `step`): from ``jac`` if given, else by forward differences with
+    increments ``√ε · max(1, |x_k|)``. It has converged when ``‖ΔZ‖∞ <=``
     `NEWTON_RTOL` ``· max(‖x‖∞, ‖Z‖∞)``; a correction that does not shrink,
     a non-finite one, or `NEWTON_MAXITER` iterations without convergence
     raise `NewtonFailure`. The end of the step is
@@ -367,6 +375,8 @@ class ImplicitSteps:
     def __init__(self, tab: ButcherTableau, t, substeps: int = 1, dt=None, jac=None):
         self.tab, self.t, self.substeps, self.dt, self.jac = tab, t, substeps, dt, jac
         self.nfev = self.jacobians = self.iterations = 0
+        self._J: np.ndarray | None = None  # the Jacobian in use, and its factorisation at _lu_h
+        self._lu, self._lu_h = None, None
         self._c, self._b = tab.c.tolist(), tab.b
         # d = A^-T b when A is safely invertible: the step's end without s more calls of f
         cond = np.linalg.cond(tab.a)
@@ -388,19 +398,45 @@ class ImplicitSteps:
     def step(self, f, t: float, x, h: float, buf=None):
         """One step of length ``h`` from ``(t, x)``: the new state (``buf`` unused).
 
+        The Jacobian of an earlier step is used again while the iteration
+        converges fast with it (HW II, §IV.8: it need only be near ``∂f/∂x``);
+        it is formed anew at ``(t, x)`` for the first step, after a step whose
+        iteration contracted by less than `NEWTON_REFRESH_RATE` per iteration,
+        and before retrying a step that failed with an older one.
+
         Raises
         ------
         NewtonFailure
-            When the stage equations are not solved (class notes).
+            When the stage equations are not solved with a Jacobian formed
+            at the step's start (class notes).
         """
+        fresh = self._J is None
+        if fresh:
+            self._refresh(f, t, x)
+        try:
+            return self._newton(f, t, x, h)
+        except NewtonFailure:
+            if fresh:
+                raise
+            self._refresh(f, t, x)  # an older Jacobian: one more try with the current one
+            return self._newton(f, t, x, h)
+
+    def _refresh(self, f, t, x) -> None:
+        self._J = self._jacobian(f, t, x)
+        self._lu_h = None
+        self.jacobians += 1
+
+    def _newton(self, f, t: float, x, h: float):
+        """The simplified Newton iteration of one step with the kept Jacobian."""
         s, n = self.tab.stages, x.size
         times = [t + h * c for c in self._c]  # stage_times' operations: exact input look-ups
-        J = self._jacobian(f, t, x)
-        self.jacobians += 1
         ha = h * self.tab.a
-        lu = lu_factor(np.eye(s * n) - np.kron(ha, J))
-        Z = np.zeros((s, n), dtype=J.dtype)
-        scale, previous = float(np.max(np.abs(x), initial=0.0)), math.inf
+        if self._lu_h != h:  # one factorisation per Jacobian and step size
+            self._lu = lu_factor(np.eye(s * n) - np.kron(ha, self._J))
+            self._lu_h = h
+        lu = self._lu
+        Z = np.zeros((s, n), dtype=self._J.dtype)
+        scale, previous, slowest = float(np.max(np.abs(x), initial=0.0)), math.inf, 0.0
         for k in range(NEWTON_MAXITER):
             F = np.array([f(times[j], x + Z[j]) for j in range(s)])
             self.nfev += s
@@ -414,11 +450,14 @@ class ImplicitSteps:
             if size <= tol:
                 break
             self._check_rate(t, h, size, previous, k, tol)
+            slowest = max(slowest, size / previous if math.isfinite(previous) else 0.0)
             previous = size
         else:
             raise NewtonFailure(
                 t, h, f"not converged in {NEWTON_MAXITER} iterations (last correction {size:.3g})"
             )
+        if slowest > NEWTON_REFRESH_RATE:
+            self._J = None  # slow: a Jacobian at the next step's start
         if self._d is not None:
             return x + self._d @ Z
         F = np.array([f(times[j], x + Z[j]) for j in range(s)])
