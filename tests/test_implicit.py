@@ -398,3 +398,16 @@ def test_implicit_methods_with_events_on_the_nonlinear_car(name, tol, lift_off_r
     assert np.max(err) < tol, err
     # the contact times to the states' accuracy over the wheel's speed (~1 m/s)
     np.testing.assert_allclose(resp.t_events, ref.t_events, rtol=0, atol=10 * tol)
+
+
+def test_batched_nonlinear_runs_refuse_an_implicit_tableau():
+    from qc_control.models.nonlinear import NonlinearQuarterCarBatch
+    from qc_control.studies.nlsweep import simulate_batch
+
+    batch = NonlinearQuarterCarBatch([300.0, 310.0], [40.0] * 2, [2e4] * 2, [2e5] * 2, [1e3] * 2)
+    T = np.linspace(0, 0.1, 11)
+    # the batched loops evaluate stages one after another: never a silent wrong number
+    with pytest.raises(ValueError, match="'radau3' is implicit.*input_output_response"):
+        simulate_batch(batch, T, np.zeros(4), np.zeros((1, T.size)), "radau3")
+    with pytest.raises(ValueError, match="'gauss2' is implicit"):
+        qc.numerics.stepper.stage_plan(TABLEAUS["gauss2"])
