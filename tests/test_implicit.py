@@ -363,6 +363,22 @@ def test_a_stiff_system_at_a_step_far_beyond_explicit_stability():
     assert np.max(err[4:]) < 1e-7
 
 
+def test_a_stable_but_not_l_stable_keeps_the_stiff_mode_ringing():
+    # the same system under the trapezoidal rule: R(-500) = (1 - 250)/(1 + 250) ≈ -0.992
+    # (closed form), so the fast mode, decayed to nothing in the exact response,
+    # flips sign each step and is still at 0.992^k of its size
+    A = np.array([[-1.0, 0.0], [1.0, -1e4]])
+    T = np.linspace(0, 2, 41)
+    sys = control.ss(A, np.zeros((2, 1)), np.eye(2), 0)
+    exact = control.initial_response(sys, T, [1.0, 1.0]).states
+    resp = qc.initial_response(sys, T, [1.0, 1.0], method="trapezoidal", return_states=True)
+    assert resp.success  # stable, and wrong: why L-stability matters for stiff models
+    fast = (np.asarray(resp.states) - exact)[1]
+    k = np.arange(1, 11)
+    # the slow mode's own error (order 2 at h = 0.05) is below 1e-3 of the fast one
+    np.testing.assert_allclose(fast[k], (1 - 1 / 9999) * (-249 / 251) ** k, rtol=1e-3)
+
+
 # ---------------------------------------------------------------- events
 
 
