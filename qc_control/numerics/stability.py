@@ -1,11 +1,14 @@
 """Linear stability of the fixed-step methods on an LTI system.
 
-On ``x' = A x`` one step of an explicit Runge–Kutta method is
-``x_{n+1} = R(hA) x_n``, where ``R`` is the method's stability function.
-Along each eigenvector the step multiplies by ``R(hλ)``: the method is
-stable when ``|R(hλ)| <= 1`` for every eigenvalue, and it sees the mode
-with the eigenvalue ``λ_h = ln R(hλ) / h`` (Hairer & Wanner, *Solving
-ODEs II*, §IV.2).
+On ``x' = A x`` one step of a Runge–Kutta method is
+``x_{n+1} = R(hA) x_n``, where ``R`` is the method's stability function:
+a polynomial for an explicit method, a rational function for an implicit
+one. Along each eigenvector the step multiplies by ``R(hλ)``: the method
+is stable when ``|R(hλ)| <= 1`` for every eigenvalue, and it sees the
+mode with the eigenvalue ``λ_h = ln R(hλ) / h`` (Hairer & Wanner,
+*Solving ODEs II*, §IV.2-IV.3). An A-stable method (``|R| <= 1`` on the
+whole left half-plane) has no step limit on a stable system; an L-stable
+one also has ``R(∞) = 0`` and damps the stiffest modes out.
 
 Systems are given as a continuous-time `control.StateSpace` (a
 `control.TransferFunction` is converted with `control.ss`), as any object
@@ -491,7 +494,9 @@ def max_stable_step(method, sys_or_eigenvalues) -> float:
     float
         ``min over λ`` of the first positive ``h`` past which
         ``|R(hλ)| > 1``; the method is stable for every step below it.
-        ``inf`` if no eigenvalue limits the step; ``0.0`` if some
+        ``inf`` if no eigenvalue limits the step (every eigenvalue of a
+        stable system under an A-stable method: backward Euler, Gauss,
+        Radau IIA, the trapezoidal rule, SDIRK); ``0.0`` if some
         eigenvalue is amplified for every ``h > 0``: on the imaginary axis
         for a method whose stability region holds no stretch of it
         (Euler, Midpoint, Heun: ``|R(iy)|² = 1 + y⁴/4``), or in the right
@@ -629,6 +634,13 @@ def numerical_modes(method, h: float, modes) -> pd.DataFrame:
     imaginary axis) and removes a little from better-damped ones. When
     ``h Im λ`` nears π the logarithm aliases and the frequency error is
     meaningless; the column ``h*|lambda|`` shows how close that is.
+
+    Backward Euler, ``R = 1/(1 - z)``, adds damping: on an undamped mode
+    ``iω`` its decay rate is ``ln(1 + ω²h²)/(2h)`` and its frequency
+    ``atan(ωh)/h``. The trapezoidal rule and implicit midpoint,
+    ``R = (1 + z/2)/(1 - z/2)``, keep ``|R| = 1`` on the imaginary axis (no
+    damping added or removed) and warp the frequency to
+    ``(2/h) atan(ωh/2)``, the bilinear (Tustin) map's warping.
 
     Examples
     --------
