@@ -116,7 +116,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     )
     from .models.vehicle import Corner, SignalRoles, VehicleModel
     from .numerics.integrate import DivergenceWarning, Solution
-    from .numerics.methods import METHODS, ButcherTableau, get_method
+    from .numerics.methods import METHODS, TABLEAUS, ButcherTableau, get_method
     from .numerics.stability import max_stable_step, stability_function
     from .report import write_report
     from .report.plotting import plot_outputs
@@ -182,6 +182,7 @@ _LAZY: dict[str, str] = {
     "DivergenceWarning": "numerics.integrate",
     "Solution": "numerics.integrate",
     "METHODS": "numerics.methods",
+    "TABLEAUS": "numerics.methods",
     "ButcherTableau": "numerics.methods",
     "get_method": "numerics.methods",
     "ModalAnalysis": "models.modal",
@@ -277,6 +278,7 @@ __all__ = [
     "METRICS",
     "OUTPUTS",
     "STATES",
+    "TABLEAUS",
     "BatchResponse",
     "BumpStop",
     "ButcherTableau",

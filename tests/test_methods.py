@@ -91,7 +91,11 @@ def test_user_tableau_three_eighths_rule():
 @pytest.mark.parametrize(
     "kwargs, words",
     [
-        (dict(a=[[0, 1], [0, 0]], b=[0.5, 0.5], c=[1, 0], order=1), "strictly lower triangular"),
+        # an entry above the diagonal makes a valid implicit method, here of order 2
+        (
+            dict(a=[[0, 1], [0, 0]], b=[0.5, 0.5], c=[1, 0], order=1),
+            "meets every condition of order 2",
+        ),
         (dict(a=[[0, 0], [1, 0]], b=[0.5, 0.5], c=[0, 0.5], order=2), "row 1 of a sums to 1"),
         (dict(a=[[0, 0], [1, 0]], b=[0.5, 0.6], c=[0, 1], order=2), "b sums to 1.1"),
         (dict(a=[[0, 0], [1, 0]], b=[0.5, 0.5], c=[0, 1], order=3), "fails the order-3 conditions"),

@@ -1,14 +1,17 @@
-"""Solutions of ``x' = f(t, x)`` with any explicit Butcher tableau, at a fixed
-step or, for an embedded pair given ``rtol``/``atol``, with step-size control.
+"""Solutions of ``x' = f(t, x)`` with any Butcher tableau, explicit or implicit,
+at a fixed step or, for an embedded pair given ``rtol``/``atol``, with
+step-size control.
 
 `integrate` checks its arguments, steps the grid block by block with the
 stage loop of `qc_control.numerics.stepper` (the one place a tableau's
-stages are evaluated in Python), cuts a run that becomes non-finite and
-returns a `Solution`; with ``events`` it steps to each sign change of the
-switching functions; with ``rtol``/``atol`` it hands the run to
-`qc_control.numerics.adaptive`. `integrate_stepper` gives the same checks and result
-to a specialised stepper (`qc_control.numerics.interconnect.FusedSteps`,
-itself built on the stage loop). The time-grid rules live here too
+stages are evaluated in Python; for an implicit tableau its simplified
+Newton iteration), cuts a run that becomes non-finite or whose stage
+equations are not solved, and returns a `Solution`; with ``events`` it
+steps to each sign change of the switching functions; with
+``rtol``/``atol`` it hands the run to `qc_control.numerics.adaptive`.
+`integrate_stepper` gives the same checks and result to a specialised
+stepper (`qc_control.numerics.interconnect.FusedSteps`, itself built on the
+stage loop). The time-grid rules live here too
 (`check_time_grid`, `uniform_step`, `stage_times`).
 """
 
@@ -25,11 +28,12 @@ from .adaptive import SCIPY_CONTROLLER, StepController, adaptive_solve, check_em
 from .limits import check_memory
 from .messages import show
 from .methods import ButcherTableau, get_method
-from .stepper import GridSteps, stage_plan
+from .stepper import GridSteps, ImplicitSteps, NewtonFailure, stage_plan
 
 __all__ = [
     "Solution",
     "DivergenceWarning",
+    "ConvergenceWarning",
     "integrate",
     "integrate_stepper",
     "check_time_grid",
@@ -58,6 +62,10 @@ class DivergenceWarning(RuntimeWarning):
     """A fixed-step run became non-finite, or its step is beyond stability."""
 
 
+class ConvergenceWarning(RuntimeWarning):
+    """An implicit step's Newton iteration did not converge: the run stopped there."""
+
+
 @dataclass(frozen=True, eq=False)
 class Solution:
     """The result of `integrate` (and of the LTI engine, `qc_control.numerics.lti.lti_solve`).
@@ -76,8 +84,10 @@ class Solution:
         Steps taken (``substeps`` per interval of the grid).
     method : ButcherTableau
     status : str
-        ``'success'``, ``'diverged'``, or ``'failed'`` (an adaptive run
-        whose step fell below the smallest step the time's precision allows).
+        ``'success'``, ``'diverged'`` (the state became non-finite) or
+        ``'failed'`` (an implicit step's stage equations were not solved, or
+        an adaptive step fell below the smallest step the time's precision
+        allows).
     message : str
     t_events : ndarray, shape (k,)
         With ``events``: the times at which an event function changed sign,
@@ -239,7 +249,6 @@ def stage_times(t, method="rk4", *, substeps: int = 1) -> np.ndarray:
     tab = get_method(method)
     t = check_time_grid(t, "t")
     substeps = check_substeps(substeps)
-    plan = stage_plan(tab)
     check_step_memory(t.size - 1, substeps, stage_table_bytes(tab.stages), "the stage-times table")
     dt = uniform_step(t)
     tt = t.tolist()
@@ -248,9 +257,27 @@ def stage_times(t, method="rk4", *, substeps: int = 1) -> np.ndarray:
     else:
         hs = [(tt[i + 1] - tt[i]) / substeps for i in range(t.size - 1)]
     starts = np.array([tt[i] + sub * h for i, h in enumerate(hs) for sub in range(substeps)])
+    if tab.implicit:  # every stage at t + c_i h, as `ImplicitSteps.step` computes it
+        return starts[:, None] + np.repeat(hs, substeps)[:, None] * tab.c
+    plan = stage_plan(tab)
     v = np.repeat(hs, substeps)[:, None] * plan.coefficients
     pcs = plan.time_positions
     return np.column_stack([starts, starts[:, None] + v[:, pcs]]) if pcs else starts[:, None]
+
+
+def _failed_interval(t: np.ndarray, failure: NewtonFailure) -> int:
+    """The grid interval holding the failed step's start: its samples before are kept."""
+    return max(0, min(int(np.searchsorted(t, failure.t, side="right")) - 1, t.size - 2))
+
+
+def _newton_message(tab, t, n_last: int, failure: NewtonFailure) -> str:
+    """The one wording of a run stopped by an implicit step's Newton iteration."""
+    return (
+        f"{tab.name}: the simplified Newton iteration for the implicit stages did not "
+        f"converge in the step from t = {failure.t:.6g} s with h = {failure.h:.6g} s "
+        f"({failure.reason}); stopped after {n_last} of {t.size - 1} intervals; a smaller "
+        "step (more substeps, a smaller max_step) or an explicit method may get through"
+    )
 
 
 def _non_finite_message(tab, t, n_last: int) -> str:
@@ -313,11 +340,11 @@ def check_substeps(substeps) -> int:
 
 
 def integrate(
-    f, t, x0, method="rk4", *, substeps: int = 1, events=None, rtol=None, atol=None,
-    first_step=None, max_step=np.inf, breakpoints=None, controller=SCIPY_CONTROLLER,
+    f, t, x0, method="rk4", *, substeps: int = 1, events=None, jac=None, rtol=None,
+    atol=None, first_step=None, max_step=np.inf, breakpoints=None, controller=SCIPY_CONTROLLER,
 ) -> Solution:  # fmt: skip
-    """Solve ``x' = f(t, x)`` with an explicit Runge–Kutta method, at a fixed
-    step or with step-size control.
+    """Solve ``x' = f(t, x)`` with a Runge–Kutta method, explicit or implicit,
+    at a fixed step or (an embedded pair) with step-size control.
 
     Each interval ``[t[i], t[i+1]]`` of the grid is split into ``substeps``
     equal steps ``h``; on a grid that `uniform_step` finds uniform, every
@@ -328,6 +355,11 @@ def integrate(
 
         k_i = f\\big(t + c_i h,\\; x + h \\textstyle\\sum_{j<i} a_{ij} k_j\\big), \\qquad
         x \\leftarrow x + h \\textstyle\\sum_i b_i k_i .
+
+    With an implicit tableau the sum runs over every ``j`` and each step
+    solves its stage equations by a simplified Newton iteration
+    (`qc_control.numerics.stepper.ImplicitSteps`, tolerance
+    `qc_control.numerics.stepper.NEWTON_RTOL`).
 
     Parameters
     ----------
@@ -341,7 +373,8 @@ def integrate(
         scipy's `solve_ivp`, a complex ``x0`` makes the integration
         complex; with a real ``x0``, ``f`` must return real values.
     method : str or ButcherTableau, default ``'rk4'``
-        A name in `qc_control.METHODS` or any explicit tableau.
+        A name in `qc_control.numerics.methods.TABLEAUS` or any tableau.
+        An implicit tableau needs a single ``x0`` of shape (n,).
     substeps : int, default 1
         Steps per interval of ``t``.
     events : callable ``events(t, x) -> array_like``, optional
@@ -379,6 +412,9 @@ def integrate(
         steps end on the grid.
     controller : StepController, optional
         The controller's constants; default scipy's.
+    jac : callable ``jac(t, x) -> (n, n)``, optional
+        ``∂f/∂x``, for an implicit tableau's Newton iteration; by forward
+        differences (n + 1 calls of ``f`` per step) when left out.
 
     Returns
     -------
@@ -386,9 +422,13 @@ def integrate(
         If the state becomes non-finite, the run stops there: a
         `DivergenceWarning` is issued and the solution holds the samples
         up to the last finite one, with ``status='diverged'``. Every
-        sample is checked; a non-finite state is never a success. An
-        adaptive run whose step underflows stops with ``status='failed'``
-        and a message, holding the samples it reached.
+        sample is checked; a non-finite state is never a success. If an
+        implicit step's Newton iteration does not converge, the run stops
+        at the start of that step's interval: a `ConvergenceWarning` is
+        issued and the solution has ``status='failed'`` and a message
+        naming the step's time and length. An adaptive run whose step
+        underflows stops with ``status='failed'`` and a message, holding
+        the samples it reached.
 
     Raises
     ------
@@ -421,6 +461,13 @@ def integrate(
     if not callable(f):
         raise TypeError(f"f must be callable as f(t, x), got {show(f)}")
     x = _initial_state(x0)
+    if jac is not None and not callable(jac):
+        raise TypeError(f"jac must be callable as jac(t, x), got {show(jac)}")
+    if tab.implicit and x.ndim != 1:
+        raise ValueError(
+            f"the implicit tableau {tab.name!r} steps a single initial state of shape (n,), "
+            f"got x0 of shape {x.shape}"
+        )
     if rtol is not None or atol is not None:
         return _integrate_adaptive(
             f, t, x, tab, (rtol, atol), (substeps, events),
@@ -432,7 +479,14 @@ def integrate(
             raise TypeError(f"events must be callable as events(t, x), got {show(events)}")
         if x.ndim != 1:
             raise ValueError(f"events need a single initial state of shape (n,), got {x.shape}")
-        return _integrate_events(f, t, x, tab, substeps, events)
+        return _integrate_events(f, t, x, tab, substeps, events, jac)
+    if tab.implicit:
+        implicit = ImplicitSteps(tab, t.tolist(), substeps, uniform_step(t), jac)
+
+        def newton_run(x, out, start, stop):
+            return implicit.run(f, x, out[start:], start, stop)
+
+        return _blocks(newton_run, t, x, tab, substeps, stacklevel=3, nfev=lambda: implicit.nfev)
 
     # a uniform grid is stepped with its one step, like the LTI engine
     dt = uniform_step(t)
@@ -523,8 +577,13 @@ def integrate_stepper(stepper, t, x0, method="rk4", *, substeps: int = 1) -> Sol
     return _blocks(stepper, t, _initial_state(x0), tab, substeps, stacklevel=3)
 
 
-def _blocks(run, t, x, tab, substeps, stacklevel) -> Solution:
-    """Run ``run(x, out, start, stop)`` block by block, checking for a non-finite state."""
+def _blocks(run, t, x, tab, substeps, stacklevel, nfev=None) -> Solution:
+    """Run ``run(x, out, start, stop)`` block by block, checking for a non-finite state.
+
+    A `NewtonFailure` (an implicit step) stops the run at the start of the
+    interval it happened in, as ``status='failed'``. ``nfev()``, if given,
+    counts the evaluations made (else ``stages`` per step).
+    """
     out = np.empty((t.size,) + x.shape, dtype=x.dtype)
     out[0] = x
     n_last, n_computed, status, message = t.size - 1, t.size - 1, "success", ""
@@ -540,6 +599,11 @@ def _blocks(run, t, x, tab, substeps, stacklevel) -> Solution:
                     "f returned complex values for a real x0; pass a complex x0 (e.g. "
                     "x0 + 0j) to integrate in complex arithmetic, as scipy's solve_ivp does"
                 ) from None
+            except NewtonFailure as failure:
+                n_last = n_computed = _failed_interval(t, failure)
+                status, message = "failed", _newton_message(tab, t, n_last, failure)
+                warnings.warn(message, ConvergenceWarning, stacklevel=stacklevel)
+                break
             block = out[start + 1 : stop + 1]
             if np.isfinite(block).all():
                 continue
@@ -555,7 +619,7 @@ def _blocks(run, t, x, tab, substeps, stacklevel) -> Solution:
     return Solution(
         t=t[: n_last + 1],
         x=np.moveaxis(out[: n_last + 1], 0, -1),
-        nfev=tab.stages * steps,
+        nfev=tab.stages * steps if nfev is None else nfev(),
         steps=steps,
         method=tab,
         status=status,
@@ -583,21 +647,27 @@ def _initial_state(x0) -> np.ndarray:
 _MAX_EVENTS_PER_STEP = 16
 
 
-def _integrate_events(f, t, x, tab, substeps, events) -> Solution:
+def _integrate_events(f, t, x, tab, substeps, events, jac=None) -> Solution:
     """`integrate` with switching functions: step to each sign change exactly."""
     out = np.empty((t.size,) + x.shape, dtype=x.dtype)
     out[0] = x
     dt = uniform_step(t)
     tt = t.tolist()
-    run = _EventSteps(f, tab, x, events)
+    run = _EventSteps(f, tab, x, events, jac)
     sign = np.sign(run.switch(tt[0], x))
     n_last, status, message = t.size - 1, "success", ""
     with np.errstate(over="ignore", invalid="ignore"):
         for i in range(t.size - 1):
             h = ((tt[i + 1] - tt[i]) if dt is None else dt) / substeps
-            for sub in range(substeps):
-                ta = tt[i] + sub * h
-                x = run.across(ta, tt[i + 1] if sub == substeps - 1 else ta + h, x, sign)
+            try:
+                for sub in range(substeps):
+                    ta = tt[i] + sub * h
+                    x = run.across(ta, tt[i + 1] if sub == substeps - 1 else ta + h, x, sign)
+            except NewtonFailure as failure:
+                n_last, status = i, "failed"
+                message = _newton_message(tab, t, n_last, failure)
+                warnings.warn(message, ConvergenceWarning, stacklevel=3)
+                break
             out[i + 1] = x
             if not np.all(np.isfinite(x)):
                 n_last, status = i, "diverged"
@@ -625,9 +695,10 @@ class _EventSteps:
     located events (``t_events``, ``i_events``).
     """
 
-    def __init__(self, f, tab, x, events):
+    def __init__(self, f, tab, x, events, jac=None):
         self._f, self._events = f, events
-        self._grid = GridSteps(tab, [])
+        # an implicit tableau's step is its Newton iteration, same call shape
+        self._grid = ImplicitSteps(tab, [], jac=jac) if tab.implicit else GridSteps(tab, [])
         self._buf = np.empty((2,) + x.shape, dtype=x.dtype)
         self.calls = self.steps = 0
         self.t_events: list[float] = []

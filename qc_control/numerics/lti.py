@@ -121,10 +121,13 @@ def step_matrices(
     .. math:: z' = M z, \quad M = \begin{bmatrix} A & B & 0 \\
               0 & 0 & I/H \\ 0 & 0 & 0 \end{bmatrix}
 
-    is autonomous and linear, and an explicit Runge–Kutta method integrates
-    the linear ``u`` exactly at every stage (``u = u_k + c_i δ h/H``), so one
-    step is exactly ``R(hM)`` and the interval is ``R(hM)^s``. This is the
-    construction python-control's `forced_response` uses with ``exp``.
+    is autonomous and linear, and a Runge–Kutta method integrates the
+    linear ``u`` exactly at every stage (``u = u_k + c_i δ h/H``, as the
+    rows of ``a`` sum to ``c``), so one step is exactly ``R(hM)`` and the
+    interval is ``R(hM)^s``. This is the construction python-control's
+    `forced_response` uses with ``exp``. An explicit method's ``R`` is a
+    polynomial, evaluated by Horner's rule; an implicit method's comes from
+    one linear solve with ``I - a ⊗ hM`` (`_implicit_step_map`).
     """
     A, B = np.asarray(A, dtype=float), np.asarray(B, dtype=float)
     n, m = A.shape[-1], B.shape[-1]
@@ -134,16 +137,44 @@ def step_matrices(
     M[..., :n, :n] = A
     M[..., :n, n : n + m] = B
     M[..., n : n + m, n + m :] = np.eye(m) / H
-    coef = stability_coefficients(method)
     hM = h * M
-    step = np.broadcast_to(coef[-1] * np.eye(n + 2 * m), M.shape).copy()
-    for c in coef[-2::-1]:  # Horner: R(hM) = c0 I + hM (c1 I + hM (...))
-        step = hM @ step
-        step[..., np.arange(n + 2 * m), np.arange(n + 2 * m)] += c
+    tab = get_method(method)
+    if tab.implicit:
+        step = _implicit_step_map(tab, hM)
+    else:
+        coef = stability_coefficients(tab)
+        step = np.broadcast_to(coef[-1] * np.eye(n + 2 * m), M.shape).copy()
+        for c in coef[-2::-1]:  # Horner: R(hM) = c0 I + hM (c1 I + hM (...))
+            step = hM @ step
+            step[..., np.arange(n + 2 * m), np.arange(n + 2 * m)] += c
     interval = step if substeps == 1 else np.linalg.matrix_power(step, substeps)
     phi = interval[..., :n, :n]
     g_u, g_d = interval[..., :n, n : n + m], interval[..., :n, n + m :]
     return phi.copy(), g_u - g_d, g_d.copy()
+
+
+def _implicit_step_map(tab: ButcherTableau, hM: np.ndarray) -> np.ndarray:
+    r"""``R(hM)`` of an implicit tableau: one step on ``z' = Mz``, from one linear solve.
+
+    The stages ``Z_i = z + Σ_j a_ij hM Z_j`` of a step from ``z`` are, with
+    ``K_i = hM Z_i``, the solution of
+
+    .. math:: (I - a \otimes hM)\, K = (\mathbf{1} \otimes hM)\, z,
+              \qquad z_{+} = z + (b^T \otimes I)\, K
+
+    (HW II, §IV.5 and §IV.8), so ``R(hM) = I + (bᵀ ⊗ I)(I - a ⊗ hM)⁻¹(1 ⊗ hM)``:
+    the columns of ``1 ⊗ hM`` solved for at once, for every design of a batch.
+    """
+    a, b, s = tab.a, tab.b, tab.stages
+    N = hM.shape[-1]
+    batch = hM.shape[:-2]
+    big = np.eye(s * N) - np.einsum("ij,...pq->...ipjq", a, hM).reshape(batch + (s * N, s * N))
+    K = np.linalg.solve(big, np.concatenate([hM] * s, axis=-2))
+    step = np.broadcast_to(np.eye(N), hM.shape).copy()
+    for i in range(s):
+        if b[i] != 0:
+            step += b[i] * K[..., i * N : (i + 1) * N, :]
+    return step
 
 
 def _powers(phi: np.ndarray, L: int) -> np.ndarray:

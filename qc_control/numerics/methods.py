@@ -1,15 +1,19 @@
-"""Explicit Runge–Kutta methods as data: a Butcher tableau per method.
+"""Runge–Kutta methods as data: a Butcher tableau per method.
 
 A method with ``s`` stages advances ``x' = f(t, x)`` by one step ``h``:
 
 .. math::
 
-    k_i = f\\Big(t + c_i h,\\; x + h \\sum_{j<i} a_{ij} k_j\\Big), \\qquad
+    k_i = f\\Big(t + c_i h,\\; x + h \\sum_{j} a_{ij} k_j\\Big), \\qquad
     x_{n+1} = x_n + h \\sum_i b_i k_i
 
-(Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.1). One loop,
-`qc_control.numerics.integrate`, runs every tableau; the seed's four methods are
-four entries of `METHODS`.
+(Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.1). When ``a`` is
+strictly lower triangular the method is explicit and each stage follows
+from the earlier ones; otherwise it is implicit and the stages solve a
+system of equations (Hairer & Wanner, *Solving ODEs II*, §IV.5, §IV.8).
+`qc_control.numerics.integrate` runs every tableau; the seed's four
+methods are the four entries of `METHODS`, and `TABLEAUS` holds every
+named tableau.
 """
 
 from __future__ import annotations
@@ -32,6 +36,14 @@ __all__ = [
     "MIDPOINT",
     "HEUN",
     "RK4",
+    "BACKWARD_EULER",
+    "IMPLICIT_MIDPOINT",
+    "TRAPEZOIDAL",
+    "GAUSS2",
+    "GAUSS3",
+    "RADAU2",
+    "RADAU3",
+    "SDIRK2",
     "HEUN_EULER",
     "BOGACKI_SHAMPINE",
     "DORMAND_PRINCE",
@@ -56,14 +68,17 @@ def _real_array(value, what: str, where: str) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class ButcherTableau:
-    """An explicit Runge–Kutta method: coefficients ``a``, ``b``, ``c``.
+    """A Runge–Kutta method, explicit or implicit: coefficients ``a``, ``b``, ``c``.
 
     Parameters
     ----------
     name : str
         Short name, used in tables and figure legends.
     a : array_like, shape (s, s)
-        Stage coefficients, strictly lower triangular (explicit method).
+        Stage coefficients: strictly lower triangular for an explicit
+        method; any non-zero entry on or above the diagonal makes the
+        method implicit (diagonally implicit when only the diagonal is
+        non-zero above the lower triangle, fully implicit otherwise).
     b : array_like, shape (s,)
         Weights, summing to 1.
     c : array_like, shape (s,), optional
@@ -83,16 +98,19 @@ class ButcherTableau:
     ------
     ValueError
         When an entry is not a finite real number, the tableau is not
-        explicit or not consistent, the stated order is not its order, or
-        ``b_hat`` is not an embedded method of the same stages.
+        consistent, the stated order is not its order, or ``b_hat`` is not an
+        embedded method of the same stages.
 
     Notes
     -----
     The order is the largest ``p`` for which ``Φ(t) = 1/γ(t)`` holds on
     every rooted tree with at most ``p`` vertices (Butcher, *Numerical
     Methods for ODEs*, 3rd ed., §31-§32; HNW I, §II.2, Table 2.2), checked
-    up to ``min(s, MAX_ORDER)`` (an explicit ``s``-stage method has order at
-    most ``s``) by `qc_control.numerics.order_conditions.check_order`.
+    up to ``min(s, MAX_ORDER)`` for an explicit method (an explicit
+    ``s``-stage method has order at most ``s``) and ``min(2s, MAX_ORDER)``
+    for an implicit one (at most ``2s``, reached by Gauss–Legendre; HW II,
+    §IV.5) by `qc_control.numerics.order_conditions.check_order`. The
+    conditions are the same for implicit methods.
 
     A tableau equals another with the same name, coefficients and order,
     and equals the string of its name, so ``resp.method == "heun"`` reads
@@ -146,8 +164,6 @@ class ButcherTableau:
             raise ValueError(
                 f"{where}: need a (s, s), b (s,), c (s,); got a {a.shape}, b {b.shape}, c {c.shape}"
             )
-        if np.any(np.triu(a) != 0):
-            raise ValueError(f"{where}: a must be strictly lower triangular (explicit method)")
         for i in range(s):
             # rounding of the row sum: a few eps times the sum of magnitudes
             if abs(a[i].sum() - c[i]) > 64 * s * _EPS * max(1.0, np.abs(a[i]).sum()):
@@ -161,10 +177,12 @@ class ButcherTableau:
             isinstance(claimed, bool) or not isinstance(claimed, (int, np.integer)) or claimed < 1
         ):
             raise ValueError(f"{where}: order must be a positive integer, got {show(claimed)}")
-        top = min(s, MAX_ORDER)  # an explicit s-stage method has order <= s
+        # the highest order an s-stage method can have: s explicit, 2s implicit
+        bound = 2 * s if np.any(np.triu(a) != 0) else s
+        top = min(bound, MAX_ORDER)
         if claimed is not None:
-            # up to order s + 1 when more is claimed, to name the first failing tree
-            top = min(max(top, min(claimed, s + 1)), MAX_ORDER)
+            # one order beyond the bound when more is claimed, to name the first failing tree
+            top = min(max(top, min(claimed, bound + 1)), MAX_ORDER)
         found = check_order(a, b, top)
         if claimed is not None and claimed > found.order:
             if found.failing_tree is None:
@@ -172,12 +190,15 @@ class ButcherTableau:
                     f"{where}: claims order {claimed}; it meets every condition up to order "
                     f"{found.order}, and orders are verified only up to {MAX_ORDER}"
                 )
-            bound = (
-                f"; an explicit method with {s} stages has order at most {s}" if claimed > s else ""
+            kind = "an explicit" if bound == s else "an implicit"
+            limit = (
+                f"; {kind} method with {s} stages has order at most {bound}"
+                if claimed > bound
+                else ""
             )
             raise ValueError(
                 f"{where}: claims order {claimed} but fails the order-{found.order + 1} "
-                f"conditions ({found.failing}); its order is {found.order}{bound}"
+                f"conditions ({found.failing}); its order is {found.order}{limit}"
             )
         if claimed is not None and claimed < found.order:
             raise ValueError(
@@ -194,9 +215,14 @@ class ButcherTableau:
 
     @property
     def stages(self) -> int:
-        """Number of stages s: right-hand-side evaluations per step."""
+        """Number of stages s: right-hand-side evaluations per step (explicit)."""
         return self.b.shape[0]
 
+    @property
+    def implicit(self) -> bool:
+        """Whether any ``a_ij`` on or above the diagonal is non-zero: the stages
+        then solve equations (each step a Newton iteration on a nonlinear system)."""
+        return bool(np.any(np.triu(self.a) != 0))
     def _set_embedded(self, where: str) -> None:
         """Check ``b_hat`` against ``b`` and keep the embedded method's order."""
         if self.b_hat is None:
@@ -283,9 +309,96 @@ RK4 = ButcherTableau(
 #: The seed's four methods by name.
 METHODS: dict[str, ButcherTableau] = {t.name: t for t in (EULER, MIDPOINT, HEUN, RK4)}
 
-#: Every named tableau, `get_method`'s catalogue: the seed's four and the
-#: methods added below.
-TABLEAUS: dict[str, ButcherTableau] = dict(METHODS)
+# ---------------------------------------------------------------- implicit tableaus
+# Sources: Hairer & Wanner, *Solving ODEs II*, 2nd ed. (HW II), §IV.3 (Table 3.1
+# of Padé approximants), §IV.5 (Tables 5.1 and 5.2: Gauss and Radau IIA),
+# §IV.6 (SDIRK); Butcher, *Numerical Methods for ODEs*, 3rd ed., §34.
+
+_SQRT3, _SQRT6, _SQRT15 = np.sqrt(3.0), np.sqrt(6.0), np.sqrt(15.0)
+
+#: Backward Euler: x + h f(t + h, x_{n+1}); order 1, L-stable, R(z) = 1/(1 - z).
+BACKWARD_EULER = ButcherTableau("backward_euler", a=[[1.0]], b=[1.0], c=[1.0], order=1)
+#: Implicit midpoint, the one-stage Gauss method: order 2, A-stable and symplectic,
+#: R(z) = (1 + z/2)/(1 - z/2) (HW II, Table 5.1, s = 1).
+IMPLICIT_MIDPOINT = ButcherTableau("implicit_midpoint", a=[[0.5]], b=[1.0], c=[0.5], order=2)
+#: Trapezoidal rule (Crank–Nicolson), the two-stage Lobatto IIIA method: order 2,
+#: A-stable, R(z) = (1 + z/2)/(1 - z/2) (HW II, §IV.5, Table 5.7).
+TRAPEZOIDAL = ButcherTableau(
+    "trapezoidal", a=[[0.0, 0.0], [0.5, 0.5]], b=[0.5, 0.5], c=[0.0, 1.0], order=2
+)
+#: Gauss–Legendre, two stages: order 4, A-stable, R the (2, 2) Padé approximant
+#: of e^z (HW II, Table 5.1; Butcher §342).
+GAUSS2 = ButcherTableau(
+    "gauss2",
+    a=[[1 / 4, 1 / 4 - _SQRT3 / 6], [1 / 4 + _SQRT3 / 6, 1 / 4]],
+    b=[0.5, 0.5],
+    c=[1 / 2 - _SQRT3 / 6, 1 / 2 + _SQRT3 / 6],
+    order=4,
+)
+#: Gauss–Legendre, three stages: order 6, A-stable, R the (3, 3) Padé approximant
+#: (HW II, Table 5.2; Butcher §342).
+GAUSS3 = ButcherTableau(
+    "gauss3",
+    a=[
+        [5 / 36, 2 / 9 - _SQRT15 / 15, 5 / 36 - _SQRT15 / 30],
+        [5 / 36 + _SQRT15 / 24, 2 / 9, 5 / 36 - _SQRT15 / 24],
+        [5 / 36 + _SQRT15 / 30, 2 / 9 + _SQRT15 / 15, 5 / 36],
+    ],
+    b=[5 / 18, 4 / 9, 5 / 18],
+    c=[1 / 2 - _SQRT15 / 10, 1 / 2, 1 / 2 + _SQRT15 / 10],
+    order=6,
+)
+#: Radau IIA, two stages: order 3, L-stable, R the (1, 2) Padé approximant
+#: (HW II, Table 5.5).
+RADAU2 = ButcherTableau(
+    "radau2",
+    a=[[5 / 12, -1 / 12], [3 / 4, 1 / 4]],
+    b=[3 / 4, 1 / 4],
+    c=[1 / 3, 1.0],
+    order=3,
+)
+#: Radau IIA, three stages: order 5, L-stable, R the (2, 3) Padé approximant
+#: (HW II, Table 5.6); the method of scipy's ``solve_ivp(method='Radau')``.
+RADAU3 = ButcherTableau(
+    "radau3",
+    a=[
+        [(88 - 7 * _SQRT6) / 360, (296 - 169 * _SQRT6) / 1800, (-2 + 3 * _SQRT6) / 225],
+        [(296 + 169 * _SQRT6) / 1800, (88 + 7 * _SQRT6) / 360, (-2 - 3 * _SQRT6) / 225],
+        [(16 - _SQRT6) / 36, (16 + _SQRT6) / 36, 1 / 9],
+    ],
+    b=[(16 - _SQRT6) / 36, (16 + _SQRT6) / 36, 1 / 9],
+    c=[(4 - _SQRT6) / 10, (4 + _SQRT6) / 10, 1.0],
+    order=5,
+)
+_GAMMA = 1 - np.sqrt(2.0) / 2
+#: Two-stage SDIRK with γ = 1 - √2/2 (Alexander, SIAM J. Numer. Anal. 14, 1977;
+#: HW II, Table 6.1 with its L-stable γ): order 2, stiffly accurate, L-stable,
+#: R(z) = (1 + (1 - 2γ) z)/(1 - γz)².
+SDIRK2 = ButcherTableau(
+    "sdirk2",
+    a=[[_GAMMA, 0.0], [1 - _GAMMA, _GAMMA]],
+    b=[1 - _GAMMA, _GAMMA],
+    c=[_GAMMA, 1.0],
+    order=2,
+)
+
+#: Every named tableau: the seed's four, then the implicit ones.
+TABLEAUS: dict[str, ButcherTableau] = {
+    **METHODS,
+    **{
+        t.name: t
+        for t in (
+            BACKWARD_EULER,
+            IMPLICIT_MIDPOINT,
+            TRAPEZOIDAL,
+            GAUSS2,
+            GAUSS3,
+            RADAU2,
+            RADAU3,
+            SDIRK2,
+        )
+    },
+}
 
 
 def get_method(method) -> ButcherTableau:

@@ -1,4 +1,4 @@
-"""Order conditions of explicit Runge–Kutta methods, by rooted trees.
+"""Order conditions of Runge–Kutta methods, explicit or implicit, by rooted trees.
 
 A Runge–Kutta method with coefficients ``A``, ``b`` has order ``p`` when its
 step agrees with the Taylor series of the exact solution up to ``h^p`` for
@@ -27,6 +27,11 @@ the roots of the subtrees ``t_k``. Then
 ``Φ`` the *elementary weight*). The number of trees of order 1, 2, ...
 is 1, 1, 2, 4, 9, 20, 48, 115, 286, 719 (OEIS A000081).
 
+The conditions do not ask ``A`` to be lower triangular: they hold as
+written for implicit methods (Butcher §31; HNW I, §II.7, Theorem 7.4), so
+Gauss–Legendre with three stages is found to have order 6 from the same
+trees.
+
 Here a tree is a sorted tuple of its subtrees, so ``τ = ()``,
 ``[τ] = ((),)`` and ``[τ, τ] = ((), ())``; equal trees are equal tuples.
 """
@@ -54,8 +59,9 @@ __all__ = [
 #: A rooted tree: the sorted tuple of the subtrees at its root.
 Tree = tuple
 
-#: Highest order checked. An explicit method of order 9 or more is not in
-#: use here; the 1,842 trees up to order 10 take a few milliseconds.
+#: Highest order checked. A method of order 9 or more (explicit, or implicit
+#: with 5 stages or more) is not in use here; the 1,842 trees up to order 10
+#: take a few milliseconds.
 MAX_ORDER = 10
 
 
@@ -203,7 +209,7 @@ class OrderCheck:
 
 
 def check_order(a, b, max_order: int = MAX_ORDER) -> OrderCheck:
-    """The order of the explicit Runge–Kutta method ``(A, b)``.
+    """The order of the Runge–Kutta method ``(A, b)``, explicit or implicit.
 
     Each condition ``Φ(t) = 1/γ(t)`` is taken to hold when
     ``|Φ(t) - 1/γ(t)| <= 64·|t|·eps·Φ̄(t)``, where ``Φ̄(t)`` is the

@@ -1,11 +1,14 @@
 """Linear stability of the fixed-step methods on an LTI system.
 
-On ``x' = A x`` one step of an explicit Runge–Kutta method is
-``x_{n+1} = R(hA) x_n``, where ``R`` is the method's stability function.
-Along each eigenvector the step multiplies by ``R(hλ)``: the method is
-stable when ``|R(hλ)| <= 1`` for every eigenvalue, and it sees the mode
-with the eigenvalue ``λ_h = ln R(hλ) / h`` (Hairer & Wanner, *Solving
-ODEs II*, §IV.2).
+On ``x' = A x`` one step of a Runge–Kutta method is
+``x_{n+1} = R(hA) x_n``, where ``R`` is the method's stability function:
+a polynomial for an explicit method, a rational function for an implicit
+one. Along each eigenvector the step multiplies by ``R(hλ)``: the method
+is stable when ``|R(hλ)| <= 1`` for every eigenvalue, and it sees the
+mode with the eigenvalue ``λ_h = ln R(hλ) / h`` (Hairer & Wanner,
+*Solving ODEs II*, §IV.2-IV.3). An A-stable method (``|R| <= 1`` on the
+whole left half-plane) has no step limit on a stable system; an L-stable
+one also has ``R(∞) = 0`` and damps the stiffest modes out.
 
 Systems are given as a continuous-time `control.StateSpace` (a
 `control.TransferFunction` is converted with `control.ss`), as any object
@@ -26,6 +29,7 @@ from __future__ import annotations
 
 import functools
 import math
+from dataclasses import dataclass
 
 import control
 import numpy as np
@@ -36,6 +40,7 @@ from .messages import show
 from .methods import get_method
 
 __all__ = [
+    "StabilityFunction",
     "stability_function",
     "stability_coefficients",
     "amplification",
@@ -58,16 +63,154 @@ AMPLIFICATION_MARGIN = 1e-12
 _EPS = np.finfo(float).eps
 
 
-def stability_function(method) -> Polynomial:
-    """The stability function R(z) of an explicit Runge–Kutta method.
+@dataclass(frozen=True, eq=False)
+class StabilityFunction:
+    """The stability function ``R(z) = P(z) / Q(z)`` of a Runge–Kutta method.
+
+    One step on ``x' = λx`` multiplies ``x`` by ``R(hλ)``. For an
+    explicit method ``Q = 1`` and ``R`` is a polynomial; for an implicit
+    one ``R`` is rational (`stability_function`).
+
+    Attributes
+    ----------
+    numerator, denominator : numpy.polynomial.Polynomial
+        ``P`` and ``Q``, lowest power first, ``P(0) = Q(0) = 1``;
+        coefficients below their rounding are zero, so the degrees are
+        the true ones (``deg P < deg Q`` for an L-stable method).
+    """
+
+    numerator: Polynomial
+    denominator: Polynomial
+
+    def __call__(self, z):
+        """``R(z)``, element by element; ``inf`` at a pole."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return self.numerator(z) / self.denominator(z)
+
+    @property
+    def is_polynomial(self) -> bool:
+        """Whether ``Q = 1`` (every explicit method)."""
+        return self.denominator.degree() == 0
+
+    @property
+    def coef(self) -> np.ndarray:
+        """The polynomial's coefficients, lowest power first (explicit methods).
+
+        Raises
+        ------
+        ValueError
+            For a rational ``R``: use `numerator` and `denominator`.
+        """
+        if not self.is_polynomial:
+            raise ValueError(
+                "R(z) of an implicit method is rational: read .numerator and .denominator"
+            )
+        return self.numerator.coef
+
+    @property
+    def poles(self) -> np.ndarray:
+        """The roots of ``Q`` (none for an explicit method)."""
+        return self.denominator.roots()
+
+    @property
+    def at_infinity(self) -> float:
+        """``R(∞) = lim R(z)`` as ``|z| → ∞``: 0 when ``deg P < deg Q``, the
+        ratio of the leading coefficients when equal, ``inf`` when ``deg P > deg Q``."""
+        dp, dq = self.numerator.degree(), self.denominator.degree()
+        if dp < dq:
+            return 0.0
+        if dp > dq:
+            return math.inf
+        return float(self.numerator.coef[-1] / self.denominator.coef[-1])
+
+    @property
+    def a_stable(self) -> bool:
+        """``|R(z)| <= 1`` on the whole left half-plane.
+
+        By the maximum principle this holds if and only if ``R`` has no pole
+        with ``Re z <= 0`` and ``E(y) = |Q(iy)|² - |P(iy)|² >= 0`` for every
+        real ``y`` (HW II, §IV.3, Theorem 3.3, the E-polynomial). A
+        non-constant polynomial is unbounded, hence never A-stable.
+        """
+        if self.numerator.degree() > self.denominator.degree():
+            return False
+        if np.any(self.poles.real <= 0):
+            return False
+        return _e_polynomial_nonnegative(self.numerator.coef, self.denominator.coef)
+
+    @property
+    def l_stable(self) -> bool:
+        """A-stable with ``R(∞) = 0``: the stiffest modes are damped out in one step
+        (HW II, §IV.3, Definition 3.7)."""
+        return self.a_stable and self.at_infinity == 0.0
+
+
+def _e_polynomial_nonnegative(p: np.ndarray, q: np.ndarray) -> bool:
+    """``|Q(iy)|² - |P(iy)|² >= 0`` for every real ``y``, within rounding.
+
+    ``E`` is even in ``y``: with ``w = y²`` it is a real polynomial ``F(w)``,
+    whose sign is constant between its positive roots; it is checked at one
+    point in each stretch and beyond the last.
+    """
+    size = max(p.size, q.size)
+    i_pow = 1j ** np.arange(size)
+    pi, qi = np.zeros(size, complex), np.zeros(size, complex)
+    pi[: p.size], qi[: q.size] = p * i_pow[: p.size], q * i_pow[: q.size]
+    e = (np.convolve(qi, qi.conj()) - np.convolve(pi, pi.conj())).real
+    scale = np.convolve(np.abs(qi), np.abs(qi)) + np.convolve(np.abs(pi), np.abs(pi))
+    e[np.abs(e) <= 64 * size * _EPS * scale] = 0
+    f, f_scale = e[::2], scale[::2]  # the odd powers of y cancel
+    if not np.any(f):
+        return True  # |R| = 1 on the whole axis (Gauss, the trapezoidal rule)
+    roots = Polynomial(f).roots()
+    w = np.sort(roots.real[(np.abs(roots.imag) <= 1e-9 * np.abs(roots)) & (roots.real > 0)])
+    edges = np.concatenate([[0.0], w])
+    probes = np.concatenate([0.5 * (edges[:-1] + edges[1:]), [2 * edges[-1] + 1]])
+    values = np.polynomial.polynomial.polyval(probes, f)
+    bound = np.polynomial.polynomial.polyval(probes, f_scale)
+    return bool(np.all(values >= -64 * size * _EPS * bound))
+
+
+def _det_polynomial(M: np.ndarray) -> np.ndarray:
+    """Coefficients of ``det(I - zM)``, lowest power first (Faddeev–LeVerrier).
+
+    ``det(λI - M) = λ^s + c₁λ^{s-1} + ... + c_s`` gives ``det(I - zM) =
+    1 + c₁z + ... + c_s z^s``; the recursion ``M_k = M M_{k-1} + c_{k-1} I``,
+    ``c_k = -tr(M M_k)/k`` uses products and traces only, so a nilpotent
+    ``M`` gives exact zeros (Gantmacher, *Theory of Matrices* I, §IV.4).
+    Coefficients below the rounding of ``|M|^k`` are set to zero.
+    """
+    s = M.shape[0]
+    coef, Mk = [1.0], np.zeros_like(M)
+    norm = max(1.0, float(np.abs(M).sum(axis=1).max()))
+    for k in range(1, s + 1):
+        Mk = M @ Mk + coef[-1] * np.eye(s)
+        ck = -float(np.trace(M @ Mk)) / k
+        coef.append(0.0 if abs(ck) <= 64 * s * k * _EPS * norm**k else ck)
+    while len(coef) > 1 and coef[-1] == 0:
+        coef.pop()
+    return np.array(coef)
+
+
+def stability_function(method) -> StabilityFunction:
+    """The stability function R(z) of a Runge–Kutta method.
 
     .. math::
 
         R(z) = 1 + z\\, b^T (I - zA)^{-1} \\mathbf{1}
-             = 1 + \\sum_{k=0}^{s-1} z^{k+1}\\, b^T A^k \\mathbf{1}
+             = \\frac{\\det(I - zA + z \\mathbf{1} b^T)}{\\det(I - zA)}
 
-    The sum is exact because ``A`` is strictly lower triangular, hence
-    nilpotent (HW II, §IV.2, eq. 2.3).
+    (HW II, §IV.3, eq. 3.3). For an explicit method ``A`` is nilpotent,
+    ``det(I - zA) = 1`` and ``R`` is the polynomial
+    ``1 + Σ_{k<s} z^{k+1} bᵀA^k 1`` (HW II, §IV.2, eq. 2.3), summed exactly
+    that way. For an implicit method both determinants are polynomials of
+    degree at most ``s``, found without eigenvalues (`_det_polynomial`).
+
+    Returns
+    -------
+    StabilityFunction
+        Callable on ``z``, with its numerator and denominator, its poles,
+        ``R(∞)`` and whether the method is A- and L-stable.
 
     Examples
     --------
@@ -75,26 +218,80 @@ def stability_function(method) -> Polynomial:
     [1.0, 1.0, 0.5, 0.166667, 0.041667]
     >>> stability_function("euler").coef.tolist()
     [1.0, 1.0]
+    >>> R = stability_function("backward_euler")            # 1/(1 - z)
+    >>> R.numerator.coef.tolist(), R.denominator.coef.tolist(), R.l_stable
+    ([1.0], [1.0, -1.0], True)
+    >>> R = stability_function("trapezoidal")               # (1 + z/2)/(1 - z/2)
+    >>> R.a_stable, R.at_infinity
+    (True, -1.0)
     """
     tab = get_method(method)
+    if tab.implicit:
+        num = _det_polynomial(tab.a - np.outer(np.ones(tab.stages), tab.b))
+        return StabilityFunction(Polynomial(num), Polynomial(_det_polynomial(tab.a)))
     coef, v = [1.0], np.ones(tab.stages)
     for _ in range(tab.stages):
         coef.append(float(tab.b @ v))
         v = tab.a @ v
     while len(coef) > 1 and coef[-1] == 0:
         coef.pop()
-    return Polynomial(coef)
+    return StabilityFunction(Polynomial(coef), Polynomial([1.0]))
+
+
+@functools.lru_cache(maxsize=64)
+def _rational(method) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(P, Q, (P - Q)/z)``'s coefficients of R = P/Q, read-only (cached per tableau).
+
+    The third, ``R - 1 = z · ((P - Q)/z) / Q``, is R's departure from 1
+    without cancellation near ``z = 0`` (`_numerical_eigenvalue`).
+    """
+    R = stability_function(method)
+    p, q = R.numerator.coef.copy(), R.denominator.coef.copy()
+    diff = np.zeros(max(p.size, q.size))
+    diff[: p.size] += p
+    diff[: q.size] -= q
+    excess = diff[1:] if diff.size > 1 else np.zeros(1)
+    for arr in (p, q, excess):
+        arr.flags.writeable = False
+    return p, q, excess
+
+
+def _r_of(method, z):
+    """``R(z)`` of ``method`` from its cached coefficients (``inf`` at a pole)."""
+    p, q, _ = _rational(method)
+    num = np.polynomial.polynomial.polyval(z, p)
+    if q.size == 1:
+        return num
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return num / np.polynomial.polynomial.polyval(z, q)
 
 
 @functools.lru_cache(maxsize=64)
 def _coefficients(method) -> np.ndarray:
-    coef = stability_function(method).coef
+    tab = get_method(method)
+    if tab.implicit:
+        # R's Taylor series 1 + Σ z^{k+1} bᵀA^k 1 through z^{2s+1}: past the
+        # order (at most 2s) by one, enough for the error constant
+        coef, v = [1.0], np.ones(tab.stages)
+        for _ in range(2 * tab.stages + 1):
+            coef.append(float(tab.b @ v))
+            v = tab.a @ v
+        coef = np.array(coef)
+    else:
+        coef = stability_function(method).coef
     coef.flags.writeable = False
     return coef
 
 
 def stability_coefficients(method) -> np.ndarray:
-    """R(z)'s coefficients, lowest power first (cached per tableau; read-only)."""
+    """R(z)'s coefficients, lowest power first (cached per tableau; read-only).
+
+    For an explicit method, the polynomial itself. For an implicit method,
+    whose ``R`` is rational, the Taylor coefficients of ``R`` at 0 through
+    ``z^{2s+1}`` (one past the highest order an ``s``-stage method can
+    have), from which the order and the error constant are read; evaluate
+    ``R`` itself with `stability_function`.
+    """
     return _coefficients(get_method(method))
 
 
@@ -190,9 +387,8 @@ def amplification(method, h: float, eigenvalues):
     float for one system, an array for a batch. A system (see
     `eigenvalues_of`) is accepted too.
     """
-    coef = stability_coefficients(method)
     z = h * _batch_eigenvalues(eigenvalues)
-    radius = np.max(np.abs(np.polynomial.polynomial.polyval(z, coef)), axis=-1)
+    radius = np.max(np.abs(_r_of(get_method(method), z)), axis=-1)
     return float(radius) if radius.ndim == 0 else radius
 
 
@@ -227,36 +423,43 @@ def step_is_stable(method, h: float, eigenvalues):
     """
     if not (isinstance(h, (int, float, np.number)) and not isinstance(h, bool)) or not h >= 0:
         raise ValueError(f"h must be a step >= 0 s, got {show(h)}")
-    coef = stability_coefficients(method)
+    tab = get_method(method)
     lam = settle_marginal(_batch_eigenvalues(eigenvalues))
-    radius = np.abs(np.polynomial.polynomial.polyval(h * lam, coef))
+    radius = np.abs(_r_of(tab, h * lam))
     ok = (radius <= 1 + AMPLIFICATION_MARGIN) | (lam.real > 0)
     ok = np.all(ok, axis=-1)
     return bool(ok) if ok.ndim == 0 else ok
 
 
-def _step_limit(coef: np.ndarray, lam: complex) -> float:
+def _step_limit(tab, lam: complex) -> float:
     """The largest h with ``|R(hλ)| <= 1`` on ``(0, h]``, for one settled λ.
 
-    With ``y = h|λ|`` and ``u = λ/|λ|``, ``P(y) = |R(yu)|² - 1`` is a real
-    polynomial with ``P(0) = 0``. Coefficients below their rounding are
-    zeroed; if the lowest remaining one is positive, ``|R|`` exceeds 1 for
-    every small h (limit 0). Otherwise the limit is the first positive
-    root of ``P`` after which ``P > 0``, checked on ``|R|`` itself.
+    With ``y = h|λ|``, ``u = λ/|λ|`` and ``R = N/D``,
+    ``P(y) = |N(yu)|² - |D(yu)|²`` (``|R|² - 1`` for an explicit method,
+    ``D = 1``) is a real polynomial with ``P(0) = 0`` and the sign of
+    ``|R(yu)| - 1``. Coefficients below their rounding are zeroed; if the
+    lowest remaining one is positive, ``|R|`` exceeds 1 for every small h
+    (limit 0). Otherwise the limit is the first positive root of ``P``
+    after which ``P > 0``, checked on ``|R|`` itself.
     """
     size = abs(lam)
     if size == 0:
         return math.inf
     if lam.real > 0:
         return 0.0
+    num, den, _ = _rational(tab)
+    width = max(num.size, den.size)
     u = lam / size  # exactly 1j on the axis, so odd powers stay purely imaginary
     powers = [1.0 + 0j]
-    for _ in range(coef.size - 1):
+    for _ in range(width - 1):
         powers.append(powers[-1] * u)
-    r = coef * np.array(powers)
-    p = np.convolve(r, np.conj(r)).real
-    bound = np.convolve(np.abs(coef), np.abs(coef))
-    p[np.abs(p) <= 64 * coef.size * _EPS * bound] = 0
+    powers = np.array(powers)
+    p, bound = np.zeros(2 * width - 1), np.zeros(2 * width - 1)
+    for poly, sign in ((num, 1.0), (den, -1.0)):
+        r = poly * powers[: poly.size]
+        p[: 2 * poly.size - 1] += sign * np.convolve(r, np.conj(r)).real
+        bound[: 2 * poly.size - 1] += np.convolve(np.abs(poly), np.abs(poly))
+    p[np.abs(p) <= 64 * width * _EPS * bound] = 0
     p[0] = 0.0
     nz = np.flatnonzero(p)
     if nz.size == 0:
@@ -268,7 +471,7 @@ def _step_limit(coef: np.ndarray, lam: complex) -> float:
     real = np.sort(roots.real[(np.abs(roots.imag) <= 1e-6 * np.abs(roots)) & (roots.real > 0)])
 
     def grows(y):
-        return abs(np.polynomial.polynomial.polyval(y * u, coef)) > 1
+        return abs(_r_of(tab, y * u)) > 1
 
     for i, y in enumerate(real):
         after = real[i + 1] if i + 1 < real.size else 2 * y
@@ -291,7 +494,9 @@ def max_stable_step(method, sys_or_eigenvalues) -> float:
     float
         ``min over λ`` of the first positive ``h`` past which
         ``|R(hλ)| > 1``; the method is stable for every step below it.
-        ``inf`` if no eigenvalue limits the step; ``0.0`` if some
+        ``inf`` if no eigenvalue limits the step (every eigenvalue of a
+        stable system under an A-stable method: backward Euler, Gauss,
+        Radau IIA, the trapezoidal rule, SDIRK); ``0.0`` if some
         eigenvalue is amplified for every ``h > 0``: on the imaginary axis
         for a method whose stability region holds no stretch of it
         (Euler, Midpoint, Heun: ``|R(iy)|² = 1 + y⁴/4``), or in the right
@@ -320,10 +525,10 @@ def max_stable_step(method, sys_or_eigenvalues) -> float:
     0.282843
     """
     _check_order_of_arguments("max_stable_step", method, sys_or_eigenvalues)
-    coef = stability_coefficients(method)
+    tab = get_method(method)
     lam = settle_marginal(eigenvalues_of(sys_or_eigenvalues))
     lam = np.unique(np.where(lam.imag < 0, lam.conj(), lam))  # a conjugate has the same limit
-    return min((_step_limit(coef, complex(x)) for x in lam), default=math.inf)
+    return min((_step_limit(tab, complex(x)) for x in lam), default=math.inf)
 
 
 def _check_order_of_arguments(fname: str, method, system) -> None:
@@ -353,15 +558,19 @@ def _mode_rows(modes_or_system):
     return [(f"mode {i + 1}", x, None) for i, x in enumerate(ordered)]
 
 
-def _numerical_eigenvalue(coef: np.ndarray, h: float, lam: complex) -> tuple[complex, float]:
+def _numerical_eigenvalue(tab, h: float, lam: complex) -> tuple[complex, float]:
     """``λ_h = ln R(hλ) / h`` and ``|R(hλ)|``, accurate when ``R(hλ)`` is near 1.
 
-    With ``R - 1 = w = x + iy`` formed from ``z·(c₁ + c₂z + ...)`` (no
-    cancellation), ``ln R = ½ log1p(2x + x² + y²) + i atan2(y, 1 + x)``.
-    A plain ``log(R)`` loses ``eps/|hλ|`` relative: 1e-11 at ``h|λ| = 1e-5``.
+    With ``R - 1 = w = x + iy`` formed from ``z·(c₁ + c₂z + ...) / D(z)``
+    (``R = N/D``, ``N - D = z (c₁ + c₂z + ...)``: no cancellation),
+    ``ln R = ½ log1p(2x + x² + y²) + i atan2(y, 1 + x)``. A plain
+    ``log(R)`` loses ``eps/|hλ|`` relative: 1e-11 at ``h|λ| = 1e-5``.
     """
+    _, den, excess = _rational(tab)
     z = h * lam
-    w = complex(z * np.polynomial.polynomial.polyval(z, coef[1:]))
+    w = complex(z * np.polynomial.polynomial.polyval(z, excess))
+    if den.size > 1:
+        w = w / complex(np.polynomial.polynomial.polyval(z, den))
     x, y = w.real, w.imag + 0.0
     g = 2 * x + x * x + y * y  # |R|² - 1
     if g <= -1:
@@ -426,6 +635,13 @@ def numerical_modes(method, h: float, modes) -> pd.DataFrame:
     ``h Im λ`` nears π the logarithm aliases and the frequency error is
     meaningless; the column ``h*|lambda|`` shows how close that is.
 
+    Backward Euler, ``R = 1/(1 - z)``, adds damping: on an undamped mode
+    ``iω`` its decay rate is ``ln(1 + ω²h²)/(2h)`` and its frequency
+    ``atan(ωh)/h``. The trapezoidal rule and implicit midpoint,
+    ``R = (1 + z/2)/(1 - z/2)``, keep ``|R| = 1`` on the imaginary axis (no
+    damping added or removed) and warp the frequency to
+    ``(2/h) atan(ωh/2)``, the bilinear (Tustin) map's warping.
+
     Examples
     --------
     Euler at h = 10 ms on the seed's body mode and on a real eigenvalue:
@@ -445,10 +661,10 @@ def numerical_modes(method, h: float, modes) -> pd.DataFrame:
         or h <= 0
     ):
         raise ValueError(f"h must be a finite step > 0 s, got {show(h)}")
-    coef = stability_coefficients(method)
+    tab = get_method(method)
     rows = {}
     for name, lam, mode_zeta in _mode_rows(modes):
-        lam_h, mu = _numerical_eigenvalue(coef, h, lam)
+        lam_h, mu = _numerical_eigenvalue(tab, h, lam)
         wn, wn_h = abs(lam), abs(lam_h)
         real = lam.imag == 0
         zeta = mode_zeta if mode_zeta is not None else (-lam.real / wn if wn > 0 else math.nan)

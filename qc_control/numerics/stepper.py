@@ -30,6 +30,10 @@ Compiled right-hand sides take the same loop compiled
 (`qc_control.numerics.compiled_stepper`). `GridSteps.run` takes whole
 intervals of an output grid (``substeps`` steps each, every
 ``substeps``-th state kept) for both Python kinds.
+
+An implicit tableau's stages depend on each other and on themselves:
+`ImplicitSteps` solves them at each step by a simplified Newton iteration
+(Hairer & Wanner, *Solving ODEs II*, §IV.8), over the same intervals.
 """
 
 from __future__ import annotations
@@ -39,6 +43,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.linalg import lu_factor, lu_solve
 
 from .methods import ButcherTableau
 
@@ -52,6 +57,11 @@ __all__ = [
     "GridSteps",
     "sample_steps",
     "substeps_for",
+    "ImplicitSteps",
+    "NewtonFailure",
+    "NEWTON_RTOL",
+    "NEWTON_MAXITER",
+    "NEWTON_REFRESH_RATE",
 ]
 
 #: Relative slack of `substeps_for`: an interval that holds the step an integer
@@ -105,7 +115,20 @@ class StagePlan:
 
 @functools.lru_cache(maxsize=64)
 def stage_plan(tab: ButcherTableau) -> StagePlan:
-    """The `StagePlan` of ``tab`` (computed once per tableau)."""
+    """The `StagePlan` of ``tab`` (computed once per tableau).
+
+    Raises
+    ------
+    ValueError
+        For an implicit tableau, whose stages this loop cannot evaluate one
+        after another (`ImplicitSteps` steps it).
+    """
+    if tab.implicit:
+        raise ValueError(
+            f"tableau {tab.name!r} is implicit: its stages solve equations, and this stage "
+            "loop (and the batched and compiled steppers built on it) takes explicit "
+            "tableaus only; qc_control.integrate and the responses step implicit ones"
+        )
     a, b, c = tab.a.tolist(), tab.b.tolist(), tab.c.tolist()
     coefficients: list[float] = [0.0]
 
@@ -289,3 +312,208 @@ def sample_steps(advance, x, out, intervals: int, substeps: int):
     x = advance(x, buf)
     out[1 : intervals + 1] = buf[substeps::substeps]
     return x
+
+
+#: The simplified Newton iteration has converged when its last correction is at
+#: most this times the size of the state or of the stage increments, whichever is
+#: larger (max-norm): 1e4 times the rounding of double precision, far below the
+#: local error of any step worth taking.
+NEWTON_RTOL = 1e-12
+
+#: Iterations of one step's simplified Newton iteration before it is declared
+#: not converged. Converging at the rate θ (each correction θ times the last),
+#: the iteration is also given up as soon as ``θ^k/(1 - θ)`` times the last
+#: correction, for the ``k`` iterations left, cannot reach the tolerance (HW II,
+#: §IV.8, eq. 8.14); at θ = 0.5 from a correction of the state's size, 40 are needed.
+NEWTON_MAXITER = 50
+
+#: A step whose simplified Newton iteration contracts by less than this per
+#: iteration (each correction more than this times the last) has the Jacobian
+#: formed anew for the next step; a faster one keeps it (HW II, §IV.8, where
+#: RADAU5 keeps it below 1e-3 with an error-controlled tolerance).
+NEWTON_REFRESH_RATE = 0.1
+
+
+class NewtonFailure(ArithmeticError):
+    """The stages of one implicit step could not be solved.
+
+    Attributes
+    ----------
+    t, h : float
+        The step's start [s] and length [s].
+    reason : str
+        Why, in words.
+    """
+
+    def __init__(self, t: float, h: float, reason: str):
+        super().__init__(f"Newton iteration failed at t = {t:.6g} s, h = {h:.6g} s: {reason}")
+        self.t, self.h, self.reason = t, h, reason
+
+
+class ImplicitSteps:
+    r"""An implicit tableau's steps over the intervals of an output grid.
+
+    One step from ``(t, x)`` solves for the stage increments
+    ``Z_i = X_i - x``,
+
+    .. math:: Z_i = h \sum_j a_{ij}\, f(t + c_j h,\; x + Z_j),
+
+    by the simplified Newton iteration of HW II, §IV.8 (eq. 8.2): from
+    ``Z = 0``, each iteration solves
+    ``(I - h\,a \otimes J)\,ΔZ = -(Z - h (a \otimes I) F(Z))`` with one LU
+    factorisation per Jacobian and step size, ``J = ∂f/∂x`` at the start
+    of a step (kept for later steps while the iteration converges fast:
+    `step`): from ``jac`` if given, else by forward differences with
+    increments ``√ε · max(1, |x_k|)``. It has converged when ``‖ΔZ‖∞ <=``
+    `NEWTON_RTOL` ``· max(‖x‖∞, ‖Z‖∞)``; a correction that does not shrink,
+    a non-finite one, or `NEWTON_MAXITER` iterations without convergence
+    raise `NewtonFailure`. The end of the step is
+    ``x + Σ d_i Z_i`` with ``dᵀ = bᵀA⁻¹`` when ``A`` is invertible (HW II,
+    eq. 8.2b), else ``x + h Σ b_i f(t + c_i h, x + Z_i)``.
+
+    Parameters
+    ----------
+    tab : ButcherTableau
+        An implicit tableau.
+    t : list of float
+        The grid.
+    substeps : int, default 1
+    dt : float or None
+        The grid's step if uniform (`qc_control.numerics.integrate.uniform_step`).
+    jac : callable ``jac(t, x) -> (n, n)``, optional
+        The Jacobian of ``f``.
+
+    Attributes
+    ----------
+    nfev : int
+        Calls of ``f`` made, the Jacobian's differences included.
+    jacobians, iterations : int
+        Jacobians formed and Newton iterations taken.
+    """
+
+    def __init__(self, tab: ButcherTableau, t, substeps: int = 1, dt=None, jac=None):
+        self.tab, self.t, self.substeps, self.dt, self.jac = tab, t, substeps, dt, jac
+        self.nfev = self.jacobians = self.iterations = 0
+        self._J: np.ndarray | None = None  # the Jacobian in use, and its factorisation at _lu_h
+        self._lu, self._lu_h = None, None
+        self._c, self._b = tab.c.tolist(), tab.b
+        # d = A^-T b when A is safely invertible: the step's end without s more calls of f
+        cond = np.linalg.cond(tab.a)
+        self._d = np.linalg.solve(tab.a.T, tab.b) if cond < 1e8 else None
+
+    def _jacobian(self, f, t, x) -> np.ndarray:
+        if self.jac is not None:
+            return np.asarray(self.jac(t, x), dtype=x.dtype).reshape(x.size, x.size)
+        f0 = np.asarray(f(t, x))
+        delta = np.sqrt(np.finfo(float).eps) * np.maximum(1.0, np.abs(x))
+        J = np.empty((x.size, x.size), dtype=np.result_type(x, f0))
+        for k in range(x.size):
+            xk = x.copy()
+            xk[k] += delta[k]
+            J[:, k] = (np.asarray(f(t, xk)) - f0) / delta[k]
+        self.nfev += x.size + 1
+        return J
+
+    def step(self, f, t: float, x, h: float, buf=None):
+        """One step of length ``h`` from ``(t, x)``: the new state (``buf`` unused).
+
+        The Jacobian of an earlier step is used again while the iteration
+        converges fast with it (HW II, §IV.8: it need only be near ``∂f/∂x``);
+        it is formed anew at ``(t, x)`` for the first step, after a step whose
+        iteration contracted by less than `NEWTON_REFRESH_RATE` per iteration,
+        and before retrying a step that failed with an older one.
+
+        Raises
+        ------
+        NewtonFailure
+            When the stage equations are not solved with a Jacobian formed
+            at the step's start (class notes).
+        """
+        fresh = self._J is None
+        if fresh:
+            self._refresh(f, t, x)
+        try:
+            return self._newton(f, t, x, h)
+        except NewtonFailure:
+            if fresh:
+                raise
+            self._refresh(f, t, x)  # an older Jacobian: one more try with the current one
+            return self._newton(f, t, x, h)
+
+    def _refresh(self, f, t, x) -> None:
+        self._J = self._jacobian(f, t, x)
+        self._lu_h = None
+        self.jacobians += 1
+
+    def _newton(self, f, t: float, x, h: float):
+        """The simplified Newton iteration of one step with the kept Jacobian."""
+        s, n = self.tab.stages, x.size
+        times = [t + h * c for c in self._c]  # stage_times' operations: exact input look-ups
+        ha = h * self.tab.a
+        if self._lu_h != h:  # one factorisation per Jacobian and step size
+            self._lu = lu_factor(np.eye(s * n) - np.kron(ha, self._J))
+            self._lu_h = h
+        lu = self._lu
+        Z = np.zeros((s, n), dtype=self._J.dtype)
+        scale, previous, slowest = float(np.max(np.abs(x), initial=0.0)), math.inf, 0.0
+        for k in range(NEWTON_MAXITER):
+            F = np.array([f(times[j], x + Z[j]) for j in range(s)])
+            self.nfev += s
+            self.iterations += 1
+            dZ = lu_solve(lu, -(Z - ha @ F).reshape(-1)).reshape(s, n)
+            Z += dZ
+            size = float(np.max(np.abs(dZ)))
+            if not math.isfinite(size):
+                raise NewtonFailure(t, h, "a correction became non-finite")
+            tol = NEWTON_RTOL * max(scale, float(np.max(np.abs(Z))))
+            if size <= tol:
+                break
+            self._check_rate(t, h, size, previous, k, tol)
+            slowest = max(slowest, size / previous if math.isfinite(previous) else 0.0)
+            previous = size
+        else:
+            raise NewtonFailure(
+                t, h, f"not converged in {NEWTON_MAXITER} iterations (last correction {size:.3g})"
+            )
+        if slowest > NEWTON_REFRESH_RATE:
+            self._J = None  # slow: a Jacobian at the next step's start
+        if self._d is not None:
+            return x + self._d @ Z
+        F = np.array([f(times[j], x + Z[j]) for j in range(s)])
+        self.nfev += s
+        return x + h * (self._b @ F)
+
+    @staticmethod
+    def _check_rate(t, h, size, previous, k, tol) -> None:
+        """Raise `NewtonFailure` if the iteration diverges, or converges too slowly
+        to reach ``tol`` in the iterations left (HW II, §IV.8, eq. 8.14)."""
+        if not math.isfinite(previous):
+            return
+        rate = size / previous if previous > 0 else 0.0
+        if rate >= 1:
+            raise NewtonFailure(
+                t, h, f"the correction grew from {previous:.3g} to {size:.3g} (diverging)"
+            )
+        left = NEWTON_MAXITER - 1 - k
+        if rate**left / (1 - rate) * size > tol:
+            raise NewtonFailure(
+                t,
+                h,
+                f"converging too slowly (rate {rate:.3g}) to reach the tolerance in "
+                f"{NEWTON_MAXITER} iterations",
+            )
+
+    def run(self, f, x, out, start: int, stop: int):
+        """Step ``f`` from ``t[start]`` to ``t[stop]``; ``out[l + 1]`` at ``t[start + l + 1]``.
+
+        Each interval's end is written as soon as it is reached, so a
+        `NewtonFailure` leaves every sample before the failing interval in
+        ``out``. Returns the last state.
+        """
+        tt, ns = self.t, self.substeps
+        for l, i in enumerate(range(start, stop)):
+            h = (self.dt if self.dt is not None else tt[i + 1] - tt[i]) / ns
+            for sub in range(ns):
+                x = self.step(f, tt[i] + sub * h if ns > 1 else tt[i], x, h)
+            out[l + 1] = x
+        return x

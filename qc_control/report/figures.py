@@ -356,7 +356,8 @@ def _regions(ax, cmp, x, y, colors, rank):
         ax.contour(
             x,
             y,
-            np.abs(stability_function(tab)(Z)),
+            # a pole of an implicit method's R is inf: any value above 1 draws the same line
+            np.minimum(np.abs(stability_function(tab)(Z)), 1e6),
             levels=[1.0],
             colors=[colors[tab.name]],
             linewidths=1.5,
@@ -373,7 +374,8 @@ def _modes(ax, cmp, size=6):
 def stability_figure(cmp) -> Figure:
     """Stability regions ``|R(z)| <= 1`` with hλ of each mode, and a zoom on hλ.
 
-    Left: the regions in full. Right: the square around the origin that
+    Left: the regions in full (an implicit method's region is the outside
+    of its curve, in the right half-plane). Right: the square around the origin that
     holds every hλ (outlined on the left), with the regions redrawn there,
     so that modes near the boundary can be told inside from outside.
     """
@@ -383,7 +385,10 @@ def stability_figure(cmp) -> Figure:
     hl = cmp.h * np.array([m.eigenvalue for m in cmp.modes.modes])
     reach = float(np.max(np.abs(hl))) if hl.size else 0.1
     lim = max(3.2, 1.1 * reach)
-    x, y = np.linspace(-lim - 0.3, 1.0, 500), np.linspace(-lim, lim, 500)
+    # an implicit method is unstable only on a bounded set of the right half-plane:
+    # show that half-plane as far as the left one
+    right = lim if any(tab.implicit for tab in cmp.methods) else 1.0
+    x, y = np.linspace(-lim - 0.3, right, 500), np.linspace(-lim, lim, 500)
     _regions(full, cmp, x, y, colors, rank)
     _modes(full, cmp)
     # the zoom: a square around the origin that holds every hλ with a margin
@@ -411,7 +416,7 @@ def stability_figure(cmp) -> Figure:
             color=colors[tab.name],
             ls=_OVERLAY_STYLES[rank[tab.name] % len(_OVERLAY_STYLES)],
             lw=1.5,
-            label=f"{tab.name}: |R(z)| = 1",
+            label=f"{tab.name}: |R(z)| = 1" + (" (stable outside)" if tab.implicit else ""),
         )
         for tab in cmp.methods
     ]

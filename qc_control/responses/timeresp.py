@@ -63,7 +63,7 @@ from ..numerics.integrate import (
 from ..numerics.interconnect import CompiledInterconnect, FusedSteps, compile_interconnect
 from ..numerics.limits import check_memory
 from ..numerics.lti import array_key, is_nonlinear_system, lti_states, memo
-from ..numerics.methods import METHODS, TABLEAUS, ButcherTableau, get_method
+from ..numerics.methods import TABLEAUS, ButcherTableau, get_method
 from ..numerics.sampled import linear_input
 from ..numerics.stability import max_stable_step, stability_coefficients, step_is_stable
 from ..numerics.stepper import substeps_for
@@ -349,10 +349,12 @@ def _linear_rhs(A, B, T, u_samples):
 def _generic(A, B, T, u_samples, x0, tab, substeps, warn):
     """The generic stepper on ``f(t, x) = A x + B u(t)``."""
     rhs = _linear_rhs(A, B, T, u_samples)
+    # an implicit tableau's Newton iteration gets the exact Jacobian, A itself
+    jac = (lambda t, x: A) if tab.implicit else None
     with warnings.catch_warnings():
         if not warn:  # the step-size warning already told the user
             warnings.simplefilter("ignore", DivergenceWarning)
-        return integrate(rhs, T, x0, tab, substeps=substeps)
+        return integrate(rhs, T, x0, tab, substeps=substeps, jac=jac)
 
 
 def _not_a_method(value, name: str) -> None:
@@ -1338,7 +1340,7 @@ def _check_fixed_step_method(method):
         raise ValueError(
             f"method={method!r} is a scipy.integrate.solve_ivp method, which "
             "control.input_output_response takes; qc_control steps at a fixed step: "
-            f"method must be one of {sorted(METHODS)} or a ButcherTableau (RK45's pair is "
+            f"method must be one of {sorted(TABLEAUS)} or a ButcherTableau (RK45's pair is "
             "method='dormand_prince' with rtol/atol, RK23's 'bogacki_shampine')"
         )
     return method
@@ -1636,7 +1638,7 @@ def _io_integrate(sys, prob: _IOProblem, grid, at, n_sub, computed: _Computed, i
     if compiled is not None:  # the interconnection solved once (qc_control.numerics.interconnect)
         stages = stage_times(grid, tab, substeps=n_sub)
         dt = uniform_step(grid)
-        if g is None and dt is not None:
+        if g is None and dt is not None and not tab.implicit:  # fused: explicit stages only
             fused = compiled.fused(tab, dt / n_sub, stages, (T, u_samples), n_sub)
         if fused is None:
             f = compiled.make_rhs(u_of_t, (T, u_samples), stages)
@@ -1929,7 +1931,7 @@ def input_output_response(
         value = kwargs.pop("solve_ivp_method")
         raise ValueError(
             f"solve_ivp_method={value!r}: qc_control does not call solve_ivp; "
-            f"choose the fixed-step method with method= (one of {sorted(METHODS)} "
+            f"choose the fixed-step method with method= (one of {sorted(TABLEAUS)} "
             "or a ButcherTableau)"
         )
     if kwargs:

@@ -118,6 +118,11 @@ def _march(dynamics, T, X0, U, tab, substeps, events, t_events, block=BLOCK):
     """Step every design; yield ``(start, states (n, m, L))`` for the samples
     ``start .. start + L - 1`` of ``T`` (sample 0 is ``X0``)."""
     m, n = dynamics.size, len(dynamics.state_labels)
+    if tab.implicit:  # the batched and compiled loops evaluate stages one after another
+        raise ValueError(
+            f"method {tab.name!r} is implicit; batched nonlinear runs step explicit tableaus "
+            f"only: step a design with qc.input_output_response(..., method={tab.name!r})"
+        )
     dt = uniform_step(T)
     if dt is None:
         raise ValueError("T must be uniformly spaced for a batched nonlinear run")
