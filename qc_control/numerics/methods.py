@@ -223,6 +223,7 @@ class ButcherTableau:
         """Whether any ``a_ij`` on or above the diagonal is non-zero: the stages
         then solve equations (each step a Newton iteration on a nonlinear system)."""
         return bool(np.any(np.triu(self.a) != 0))
+
     def _set_embedded(self, where: str) -> None:
         """Check ``b_hat`` against ``b`` and keep the embedded method's order."""
         if self.b_hat is None:
