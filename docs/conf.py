@@ -1,14 +1,19 @@
-"""Sphinx configuration of the qc_control docs: API reference (numpydoc),
-the examples as a gallery (sphinx-gallery) and the course notebook (myst-nb).
+"""Sphinx configuration of the qc_control docs: the user guide (MyST pages
+executed by myst-nb), the API reference (numpydoc), the examples as a gallery
+(sphinx-gallery) and the course notebook (myst-nb).
 
-Build with ``make docs`` (warnings are errors). Everything builds offline:
-the examples and the notebook run on this machine, nothing is fetched.
+Build with ``make docs`` (warnings are errors, numpydoc's included). Everything
+builds and reads offline: the guide's code, the examples and the notebook run
+on this machine, and the formulas are typeset by a copy of MathJax served from
+the site itself (``sphinx-mathjax-offline``), so nothing is fetched.
 """
 
 from __future__ import annotations
 
+import os
 import shutil
 import sys
+import warnings
 from pathlib import Path
 
 HERE = Path(__file__).parent
@@ -26,6 +31,9 @@ release = version = qc_control.__version__
 extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.mathjax",
+    # MathJax 3 from the package, copied into _static/mathjax: formulas render with no
+    # network (a course machine, a train), where the default loads it from a CDN
+    "sphinx-mathjax-offline",
     "numpydoc",
     "sphinx_gallery.gen_gallery",
     "myst_nb",
@@ -45,6 +53,10 @@ exclude_patterns = [
 ]
 
 # --- API reference --------------------------------------------------------------
+# numpydoc reports a malformed docstring (an unknown section heading, say) with a
+# Python warning, which Sphinx's -W does not see: make it an error, so the build
+# fails on it as on any Sphinx warning.
+warnings.filterwarnings("error", category=UserWarning, module=r"numpydoc(\..*)?$")
 autodoc_default_options = {"members": True, "member-order": "bysource"}
 autodoc_typehints = "none"  # numpydoc's Parameters sections say it, once
 numpydoc_show_class_members = False
@@ -66,6 +78,15 @@ sphinx_gallery_conf = {
 }
 
 # --- the notebook: executed during the build, by a local kernel ----------------
+# qc_control's sweeps import tqdm.auto, which warns in a kernel without ipywidgets
+# (the docs extra installs none); the warning would print this machine's paths
+# into the pages. The kernels inherit this filter from the environment.
+os.environ["PYTHONWARNINGS"] = ",".join(
+    filter(None, [os.environ.get("PYTHONWARNINGS"), "ignore:IProgress not found"])
+)
+
+# The guide's pages are MyST notebooks too: every code cell runs in the build, so a
+# page that drifts from the code fails it (nb_execution_raise_on_error).
 nb_execution_mode = "force"
 nb_execution_timeout = 300
 nb_execution_raise_on_error = True

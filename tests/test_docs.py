@@ -1,5 +1,7 @@
-"""The docs site: API reference, example gallery and course notebook, built with
-Sphinx with warnings as errors (what ``make docs`` runs)."""
+"""The docs site: the user guide, API reference, example gallery and course
+notebook, built with Sphinx with warnings as errors (what ``make docs`` runs),
+then read offline in headless Chromium: the formulas typeset with nothing
+fetched, no raw TeX left on the page."""
 
 import pkgutil
 import re
@@ -9,6 +11,10 @@ import sys
 from pathlib import Path
 
 import pytest
+
+# the browser fixture and the network rule of the report's check (Debian's Chromium,
+# installed in the fixture where the tests run as root, as in CI)
+from test_html_browser import _local, browser  # noqa: F401
 
 import qc_control
 
@@ -27,35 +33,114 @@ def test_every_public_module_is_in_the_api_reference():
     assert not missing, f"add {missing} to docs/api.rst"
 
 
-@pytest.mark.slow
-def test_docs_build_with_warnings_as_errors(tmp_path):
+@pytest.fixture(scope="module")
+def site(tmp_path_factory):
+    """The docs built once, from a copy of the sources, so that the build's
+    generated files stay out of the tree: the HTML folder."""
     for name in ("sphinx", "numpydoc", "sphinx_gallery", "myst_nb"):
         pytest.importorskip(name, reason="the docs extra is not installed: `make docs` installs it")
-    # a copy of the sources, so that the build's generated files stay out of the tree
+    tmp_path = tmp_path_factory.mktemp("site")
     ignore = shutil.ignore_patterns(
         "_build", "auto_examples", "notebooks", "sg_execution_times.rst", "*_output"
     )
     shutil.copytree(DOCS, tmp_path / "docs", ignore=ignore)
     shutil.copytree(ROOT / "examples", tmp_path / "examples", ignore=ignore)
+    shutil.copytree(ROOT / "benchmarks", tmp_path / "benchmarks", ignore=ignore)  # Performance
     html = tmp_path / "docs" / "_build" / "html"
     run = subprocess.run(
         [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html"]
         + [str(tmp_path / "docs"), str(html)],
         capture_output=True,
         text=True,
-        timeout=1200,
+        timeout=1800,
         env={"MPLBACKEND": "Agg", "PATH": str(Path(sys.executable).parent)},
     )
     assert run.returncode == 0, run.stderr[-5000:]
+    return html
+
+
+@pytest.mark.slow
+def test_docs_build_with_warnings_as_errors(site):
+    html = site
     api = (html / "api.html").read_text(encoding="utf-8")
     for name in (
         "qc_control.models.quarter.quarter_car",
         "qc_control.report.plotting.plot_outputs",
     ):
         assert f'id="{name}"' in api, name
+    # numpydoc read FixedStepResponse's attribute section (a malformed heading dropped it)
+    fixed_step = api.split('id="qc_control.responses.timeresp.FixedStepResponse"')[1]
+    fixed_step = fixed_step.split('id="qc_control.responses.timeresp.', 1)[0]  # to the next name
+    assert "Attributes" in fixed_step
+    for attribute in ("max_stable_step", "step_rule", "event_labels", "success, message"):
+        assert attribute in fixed_step, attribute
     for script in (ROOT / "examples").glob("*.py"):  # each example ran and drew
         page = (html / "auto_examples" / f"{script.stem}.html").read_text(encoding="utf-8")
         assert re.search(r'<img [^>]*src="\.\./_images/sphx_glr_' + script.stem, page), script
     course = (html / "notebooks" / "course.html").read_text(encoding="utf-8")
     assert "Exercise 5: not answered yet" in course  # executed during the build
     assert course.count("<img") >= 5
+
+
+@pytest.mark.slow
+def test_every_guide_page_ran_its_code(site):
+    """Each guide page is in the site with its cells' outputs: the build ran them."""
+    for page in (DOCS / "guide").glob("*.md"):
+        if page.stem == "index":
+            continue
+        built = (site / "guide" / f"{page.stem}.html").read_text(encoding="utf-8")
+        assert "cell_output" in built, f"{page.name}: no cell output in the built page"
+    # a number the reader is told to expect, computed in the build
+    start = (site / "guide" / "getting-started.html").read_text(encoding="utf-8")
+    assert "max |xs error| = 0.000192 m with 2000 RHS evaluations" in start
+
+
+#: Pages with formulas: a guide page with display and inline math ($$ and $),
+#: one whose math is in its own paragraph, and the notebook's (dollarmath).
+MATH_PAGES = ("guide/responses.html", "guide/roads.html", "notebooks/course.html")
+
+#: After MathJax: how many formulas the page marks for typesetting, how many it
+#: typeset, and the text a reader sees outside code (code and its output may
+#: hold TeX on purpose, a matplotlib label say).
+TYPESET = """async () => {
+  const prose = () => {
+    const clone = document.body.cloneNode(true);
+    clone.querySelectorAll("pre, code, script, style, mjx-container").forEach(e => e.remove());
+    return clone.textContent;
+  };
+  if (window.MathJax && MathJax.startup && MathJax.startup.promise) {
+    await MathJax.startup.promise;
+  }
+  return {
+    marked: document.querySelectorAll(".math").length,
+    typeset: document.querySelectorAll("mjx-container").length,
+    errors: document.querySelectorAll("mjx-merror").length,
+    text: prose(),
+    mathjax: Boolean(window.MathJax && MathJax.version),
+  };
+}"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", MATH_PAGES)
+def test_formulas_render_offline(site, browser, name):  # noqa: F811
+    """The page opened from disk with the browser offline: MathJax (served
+    from the site) typesets every formula, and no raw TeX is left in the text
+    a reader sees."""
+    context = browser.new_context(viewport={"width": 1280, "height": 900}, offline=True)
+    requested: list[str] = []
+    context.on("request", lambda request: requested.append(request.url))
+    try:
+        tab = context.new_page()
+        tab.goto((site / name).as_uri(), wait_until="load")
+        verdict = tab.evaluate(TYPESET)
+    finally:
+        context.close()
+    remote = [url for url in requested if not _local(url)]
+    assert remote == [], remote  # nothing reached for the network
+    assert verdict["mathjax"], "MathJax did not load from the site"
+    assert verdict["marked"] > 0, "no formula on the page: choose a page with math"
+    assert verdict["typeset"] >= verdict["marked"], verdict["typeset"]
+    assert verdict["errors"] == 0
+    for raw in ("\\frac", "$$", "\\(", "\\[", "\\lambda", "\\sqrt"):
+        assert raw not in verdict["text"], f"raw TeX {raw!r} on {name}"

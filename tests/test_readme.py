@@ -1,23 +1,25 @@
 """The README's Python blocks run, in order, as a reader would paste them,
-and what they leave behind is checked against independent values."""
+and what they leave behind is checked against independent values.
 
-import itertools
+The guide's examples (an ISO 8608 road, a sweep of 1,000 designs) moved to the
+docs site with the text around them; ``tests/test_docs_guide.py`` checks them
+there."""
+
 import re
 from pathlib import Path
 
-import control
 import numpy as np
 import pytest
 
 README = Path(__file__).parent.parent / "README.md"
 
-pytestmark = pytest.mark.slow  # a sweep of 1,000 designs and a 60 s road: about 9 s
+pytestmark = pytest.mark.slow  # imports control and qc_control, a modal analysis: about 3 s
 
 
 @pytest.fixture(scope="module")
 def namespace():
     blocks = re.findall(r"```python\n(.*?)```", README.read_text(encoding="utf-8"), re.S)
-    assert len(blocks) >= 5
+    assert blocks, "the README has no Python block left to run"
     namespace: dict = {}
     for i, block in enumerate(blocks):
         try:
@@ -61,33 +63,17 @@ def test_the_damped_frequencies_are_those_of_the_seed_matrix(namespace):
     assert p.zeta == 0.3  # the README's "firmer damper"
 
 
-def test_the_road_response_is_rk4_on_the_exact_response(namespace):
-    """The last ``resp`` is RK4 at h = 5 ms on the ISO 8608 class C road
-    ``zr``; python-control's exact response to the same samples is the
-    reference."""
-    T = _readme_value(namespace, "T")
-    zr = _readme_value(namespace, "zr")
-    resp = _readme_value(namespace, "resp")
-    p = _readme_value(namespace, "params")
-    qc = namespace["qc"]
-    assert resp.method.name == "rk4"
-    exact = control.forced_response(qc.quarter_car(p, road=True), T, zr)
-    for label in ("xs", "body_acc", "susp_travel"):
-        got = resp.outputs[list(resp.output_labels).index(label)]
-        ref = exact.outputs[list(exact.output_labels).index(label)]
-        gap = np.max(np.abs(got - ref)) / np.max(np.abs(ref))
-        # Measured: 1.1e-6 of the peak for body_acc (the worst), 1.2e-7 for xs.
-        # 1e-5 holds that with margin, and is far below a second-order
-        # method's gap on the same road (Heun: 2e-3), so it tells RK4 apart.
-        assert gap < 1e-5, (label, gap)
-
-
-def test_the_sweep_covers_its_grid_without_rejections(namespace):
-    """``result`` is the README's sweep over 40 ks by 25 zeta."""
-    result = _readme_value(namespace, "result")
-    assert result.errors.empty
-    assert len(result.metrics) == 40 * 25
-    grid = set(itertools.product(np.linspace(15e3, 45e3, 40), np.linspace(0.1, 0.6, 25)))
-    got = set(zip(result.metrics["ks"], result.metrics["zeta"]))
-    assert got == grid
-    assert result.metrics["stable"].all()  # RK4 at h = 1 ms is far inside every limit
+def test_the_fixed_step_response_is_heun_on_the_exact_response(namespace):
+    """``heun`` is Heun's method at h = 10 ms on the 5 cm road step; ``exact``
+    is python-control's response to the same samples."""
+    heun = _readme_value(namespace, "heun")
+    exact = _readme_value(namespace, "exact")
+    assert heun.method.name == "heun"
+    assert heun.h == pytest.approx(0.01)
+    got = heun.outputs[list(heun.output_labels).index("xs")]
+    ref = exact.outputs[list(exact.output_labels).index("xs")]
+    gap = np.max(np.abs(got - ref)) / np.max(np.abs(ref))
+    # A second-order method at h|lambda|max = 0.25 on this car: the global
+    # error is a few 1e-3 of the peak (measured 2.2e-3). Between 1e-4 and 2e-2:
+    # far from RK4's 1e-6 and from Euler's 1e-1, so it is Heun's and no other.
+    assert 1e-4 < gap < 2e-2, gap

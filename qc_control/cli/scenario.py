@@ -49,6 +49,7 @@ import functools
 import inspect
 import json
 import math
+import re
 import shlex
 import sys
 from collections.abc import Callable, Mapping
@@ -1022,8 +1023,10 @@ def _cli_text(value) -> str:
     return value if isinstance(value, str) else repr(value)
 
 
-def command_line(words: list[str], options: list[tuple[str, str | None]]) -> str:
-    """``qc-control WORDS --option value ...`` as one shell-quoted line.
+def command_line(
+    words: list[str], options: list[tuple[str, str | None]], *, windows: bool | None = None
+) -> str:
+    """``qc-control WORDS --option value ...`` as one line quoted for this platform's shell.
 
     Parameters
     ----------
@@ -1031,11 +1034,36 @@ def command_line(words: list[str], options: list[tuple[str, str | None]]) -> str
         The subcommand, e.g. ``['report']``.
     options : list of (option, value)
         Each option with its value as text, or None for a flag.
+    windows : bool, optional
+        Quote for Windows' ``cmd.exe`` (double quotes) rather than a POSIX shell
+        (single quotes). By default, for the platform the line is written on, which
+        is where a report's reader reruns it.
     """
     args = ["qc-control", *words]
     for name, value in options:
         args += [name] if value is None else _option(name, value)
-    return shlex.join(args)
+    if windows is None:
+        windows = sys.platform == "win32"
+    return " ".join(map(_cmd_quote, args)) if windows else shlex.join(args)
+
+
+#: Characters that cmd.exe or the C runtime's argument splitting read as more than
+#: text outside double quotes: blanks split, the rest redirect, chain or escape.
+_CMD_SPECIAL = frozenset(" \t&|<>^()%!\"',;=")
+
+
+def _cmd_quote(arg: str) -> str:
+    """``arg`` as one argument on a ``cmd.exe`` line, read back by the C runtime intact.
+
+    Inside double quotes cmd.exe passes ``&|<>^()`` through; the C runtime then
+    reads ``\\"`` as a quote and doubles backslashes only before a quote
+    (`subprocess.list2cmdline` follows the same rules).
+    """
+    if arg and not _CMD_SPECIAL.intersection(arg):
+        return arg
+    escaped = re.sub(r'(\\*)"', r'\1\1\\"', arg)  # backslashes before a quote doubled
+    escaped = re.sub(r"(\\+)$", r"\1\1", escaped)  # and before the closing quote
+    return f'"{escaped}"'
 
 
 def _road_at(road: Road, t: float) -> float:

@@ -93,8 +93,10 @@ _ENGINES = ("auto", "lti", "generic")
 class FixedStepResponse(control.TimeResponseData):
     """A `control.TimeResponseData` that also says how it was computed.
 
-    Attributes (besides those of `control.TimeResponseData`)
-    ----------------------------------------------------------
+    It has every attribute of `control.TimeResponseData`, and these besides.
+
+    Attributes
+    ----------
     method : ButcherTableau or None
         The method that computed the response; None when no method was
         applied (a discrete-time or ``dt=None`` system).
