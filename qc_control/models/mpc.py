@@ -301,10 +301,9 @@ class _CondensedQP:
         first = scipy.linalg.cho_solve(self._chol, self._GO)[0]
         self.Kx, self.Kw = first @ F, first @ L
         self.N, self.n = N, n
-        self._travel = None
-        if travel_row is not None:
-            Ct = np.kron(np.eye(N), travel_row)  # travel at ticks 1 … N
-            self._travel = (Ct @ Phi[n:], Ct @ Gam[n:], Ct @ Lam[n:])
+        # the travel at ticks 1 … N: (from x0, from U, from w); zero rows without a limit
+        Ct = np.kron(np.eye(N), np.zeros((1, n)) if travel_row is None else travel_row)
+        self._travel = (Ct @ Phi[n:], Ct @ Gam[n:], Ct @ Lam[n:])
         self.limits, self.penalty = limits, penalty
         self._osqp = None if not limits else self._setup_osqp()
 
@@ -383,6 +382,8 @@ class _CondensedQP:
                 [np.clip(-scipy.linalg.cho_solve(self._chol, f) / us, -1, 1), np.zeros(ns)]
             )
         U, sigma = v[:N] * us, v[N:] * ss
+        if "fa" in self.limits:  # the box to the bit: OSQP meets it to its tolerance
+            U = np.clip(U, -self.limits["fa"], self.limits["fa"])
         cost = float(U @ self.H @ U + 2 * f @ U + r)
         if ns:
             cost += self.penalty[0] * sigma.sum() + self.penalty[1] * sigma @ sigma

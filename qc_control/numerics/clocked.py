@@ -300,9 +300,9 @@ def _road_within(gw: np.ndarray, Phi: np.ndarray, m: int, intervals: int) -> np.
     """``R[k, j]``: the road's part of the state ``j`` steps into tick interval ``k``,
     from 0 at the tick (all intervals at once, one step of each per pass)."""
     n = Phi.shape[0]
-    G = np.zeros((intervals * m, n))
-    G[: gw.shape[0]] = gw
-    G = G.reshape(intervals, m, n)
+    flat = np.zeros((intervals * m, n))
+    flat[: gw.shape[0]] = gw
+    G = flat.reshape(intervals, m, n)
     R = np.zeros((intervals, m + 1, n))
     for j in range(m):
         R[:, j + 1] = R[:, j] @ Phi.T + G[:, j]

@@ -301,10 +301,10 @@ def _measure(
     row["road: rms actuator force [N]"], row["road: mean actuator power [W]"] = _actuator(road_resp)
     failed = [r for r in (bump_resp, road_resp) if not r.success]
     note = f"the fixed-step run did not succeed ({failed[0].message})" if failed else ""
-    if bump_ecu is not None:
-        row.update(bump_ecu[0])
-        row.update(road_ecu[0])
-        note = "; ".join(filter(None, [note, bump_ecu[1], road_ecu[1]]))
+    for ecu in (bump_ecu, road_ecu):
+        if ecu is not None:
+            row.update(ecu[0])
+            note = "; ".join(filter(None, [note, ecu[1]]))
     return row, note
 
 
