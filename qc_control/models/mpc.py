@@ -359,11 +359,29 @@ class _CondensedQP:
     def solve(self, x, w) -> MPCSolution:
         start = time.perf_counter()
         f, r = self._terms(x, w)
-        if self._osqp is None:
-            U = -scipy.linalg.cho_solve(self._chol, f)
-            cost = float(U @ self.H @ U + 2 * f @ U + r)
-            elapsed = time.perf_counter() - start
-            return MPCSolution(U, cost, elapsed, np.zeros(0), "unconstrained")
+        free = -scipy.linalg.cho_solve(self._chol, f)
+        travel = self._travel[0] @ x + self._travel[2] @ w + self._travel[1] @ free
+        if self._osqp is None or self._within_limits(free, travel):
+            # the unconstrained optimum is feasible, so it is the QP's (convex) optimum
+            # with no slack: exact, and no iteration needed
+            cost = float(free @ self.H @ free + 2 * f @ free + r)
+            status = "unconstrained" if self._osqp is None else "solved"
+            slack = np.zeros(self.N if "susp_travel" in self.limits else 0)
+            return MPCSolution(free, cost, time.perf_counter() - start, slack, status)
+        U, sigma, status = self._solve_qp(x, w, f, free)
+        cost = float(U @ self.H @ U + 2 * f @ U + r)
+        if sigma.size:
+            cost += self.penalty[0] * sigma.sum() + self.penalty[1] * sigma @ sigma
+        return MPCSolution(U, cost, time.perf_counter() - start, sigma, status)
+
+    def _within_limits(self, U, travel) -> bool:
+        F, s = self.limits.get("fa"), self.limits.get("susp_travel")
+        return (F is None or bool(np.all(np.abs(U) <= F))) and (
+            s is None or bool(np.all(np.abs(travel) <= s))
+        )
+
+    def _solve_qp(self, x, w, f, free):
+        """``(U, σ, status)`` from OSQP, warm-started, its linear term and bounds updated."""
         N, ns, us, ss = self.N, self._ns, self._us, self._ss
         q = np.concatenate([2 * self._scale * us * f, self._q_slack])
         lo, hi = self._lo.copy(), self._hi.copy()
@@ -376,19 +394,12 @@ class _CondensedQP:
         self._osqp.update(q=q, l=lo, u=hi)
         res = self._osqp.solve(raise_error=False)
         v = np.asarray(res.x, dtype=float)
-        status = str(res.info.status)
         if not np.all(np.isfinite(v)):  # no solution: the clipped unconstrained plan
-            v = np.concatenate(
-                [np.clip(-scipy.linalg.cho_solve(self._chol, f) / us, -1, 1), np.zeros(ns)]
-            )
-        U, sigma = v[:N] * us, v[N:] * ss
+            v = np.concatenate([np.clip(free / us, -1, 1), np.zeros(ns)])
+        U, sigma = v[:N] * us, np.maximum(v[N:] * ss, 0.0)
         if "fa" in self.limits:  # the box to the bit: OSQP meets it to its tolerance
             U = np.clip(U, -self.limits["fa"], self.limits["fa"])
-        cost = float(U @ self.H @ U + 2 * f @ U + r)
-        if ns:
-            cost += self.penalty[0] * sigma.sum() + self.penalty[1] * sigma @ sigma
-        elapsed = time.perf_counter() - start
-        return MPCSolution(U, cost, elapsed, sigma, status)
+        return U, sigma, str(res.info.status)
 
 
 def _check_limits(limits) -> dict:
