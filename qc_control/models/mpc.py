@@ -84,7 +84,7 @@ __all__ = [
 TRAVEL_PENALTY = (1e6, 1e8)
 #: OSQP's tolerances: with its solution polishing the active set's equality
 #: solve makes the optimum good to far better than these.
-_OSQP_SETTINGS = dict(eps_abs=1e-7, eps_rel=1e-7, polishing=True, verbose=False, max_iter=20000)
+_OSQP_SETTINGS = dict(eps_abs=1e-5, eps_rel=1e-5, polishing=True, verbose=False, max_iter=20000)
 #: A slack [m] above this counts as the travel penalty being active.
 _SLACK_TOL = 1e-7
 
@@ -298,7 +298,9 @@ class _CondensedQP:
         self.H = (self.H + self.H.T) / 2
         self._GO, self._F, self._L, self._Om = G.T @ Om, F, L, Om
         self._chol = scipy.linalg.cho_factor(self.H)
-        first = scipy.linalg.cho_solve(self._chol, self._GO)[0]
+        # the unconstrained plan U = -H⁻¹ G^T Ω (F x0 + L w): one product per tick
+        self._free = scipy.linalg.cho_solve(self._chol, self._GO)
+        first = self._free[0]
         self.Kx, self.Kw = first @ F, first @ L
         self.N, self.n = N, n
         # the travel at ticks 1 … N: (from x0, from U, from w); zero rows without a limit
@@ -352,14 +354,11 @@ class _CondensedQP:
         if self._osqp is not None:
             self._osqp.warm_start(x=np.zeros(self.N + self._ns), y=np.zeros(self._lo.size))
 
-    def _terms(self, x, w):
-        o = self._F @ x + self._L @ w
-        return self._GO @ o, float(o @ self._Om @ o)
-
     def solve(self, x, w) -> MPCSolution:
         start = time.perf_counter()
-        f, r = self._terms(x, w)
-        free = -scipy.linalg.cho_solve(self._chol, f)
+        o = self._F @ x + self._L @ w  # the weighted signals with no move
+        f, r = self._GO @ o, float(o @ self._Om @ o)
+        free = -(self._free @ o)
         travel = self._travel[0] @ x + self._travel[2] @ w + self._travel[1] @ free
         if self._osqp is None or self._within_limits(free, travel):
             # the unconstrained optimum is feasible, so it is the QP's (convex) optimum
@@ -367,6 +366,11 @@ class _CondensedQP:
             cost = float(free @ self.H @ free + 2 * f @ free + r)
             status = "unconstrained" if self._osqp is None else "solved"
             slack = np.zeros(self.N if "susp_travel" in self.limits else 0)
+            if self._osqp is not None:  # the next QP starts here: no constraint active
+                self._osqp.warm_start(
+                    x=np.concatenate([free / self._us, slack / self._ss]),
+                    y=np.zeros(self._lo.size),
+                )
             return MPCSolution(free, cost, time.perf_counter() - start, slack, status)
         U, sigma, status = self._solve_qp(x, w, f, free)
         cost = float(U @ self.H @ U + 2 * f @ U + r)
@@ -391,8 +395,10 @@ class _CondensedQP:
             k = lo.size - 3 * N
             hi[k : k + N] = s_lim - t0
             lo[k + N : k + 2 * N] = -s_lim - t0
-        self._osqp.update(q=q, l=lo, u=hi)
-        res = self._osqp.solve(raise_error=False)
+        solver = self._osqp
+        assert solver is not None  # only called with limits, which set it up
+        solver.update(q=q, l=lo, u=hi)
+        res = solver.solve(raise_error=False)
         v = np.asarray(res.x, dtype=float)
         if not np.all(np.isfinite(v)):  # no solution: the clipped unconstrained plan
             v = np.concatenate([np.clip(free / us, -1, 1), np.zeros(ns)])
