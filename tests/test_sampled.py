@@ -211,3 +211,11 @@ def test_a_rebuilt_loop_closes_the_same_controller_with_its_delay(car):
     other = loop.rebuild(qc.QuarterCarParams(ks=3e4))
     assert isinstance(other.system, ClockedLoop) and other.system.delay == 2
     assert other.params.ks == 3e4
+
+
+def test_compare_methods_refuses_a_sampled_loop_saying_why(car):
+    """Its references know no ticks: a comparison against them would be wrong, not slow."""
+    law, _ = _dlqr_law(car)
+    loop = qc.closed_loop(car, law)
+    with pytest.raises(ValueError, match="sampled-data loop: the comparison's references"):
+        qc.compare_methods(loop, T=np.arange(0, 101) * DT, X0=[*X0, 0.0], timing=False)
