@@ -62,7 +62,9 @@ from dataclasses import dataclass, field
 
 import control
 import numpy as np
+import osqp
 import scipy.linalg
+import scipy.sparse as sp
 
 from .controllers import DEFAULT_LQR_WEIGHTS, lqr_weights, relative_coordinates
 from .vehicle import VehicleModel
@@ -310,9 +312,6 @@ class _CondensedQP:
         self._osqp = None if not limits else self._setup_osqp()
 
     def _setup_osqp(self):
-        import osqp  # the QP solver, needed only with limits
-        import scipy.sparse as sp
-
         N = self.N
         F_lim, s_lim = self.limits.get("fa"), self.limits.get("susp_travel")
         us = F_lim if F_lim else 1e3  # forces in units of the limit: a well-scaled QP
