@@ -38,7 +38,9 @@ feedforward). With limits, OSQP (Stellato et al., "OSQP: an operator
 splitting solver for quadratic programs", Math. Prog. Comp. 12, 2020) is
 set up once with the constant ``H`` and constraint matrix, its KKT matrix
 factored once; each tick updates the linear term and the bounds and is
-warm-started from the previous solution.
+warm-started from the previous solution. A tick whose unconstrained plan
+already keeps every limit needs no QP: that plan is the convex QP's
+optimum (with no slack), exactly, and the solver is warm-started from it.
 
 **Constraints.** ``|u_k| <= F`` is hard. The suspension travel at the
 predicted ticks ``1 … N`` is soft: ``|travel_k| <= s + σ_k``, ``σ_k >= 0``,
@@ -107,7 +109,9 @@ class MPCSolution:
         The travel excess ``σ_k`` [m] at the predicted ticks 1 … N (zeros
         without a travel limit).
     status : str
-        ``'unconstrained'`` (the linear law), or OSQP's status.
+        ``'unconstrained'`` (no limits: the linear law), ``'solved'`` (the
+        unconstrained plan keeps the limits, or OSQP solved the QP), or
+        OSQP's status otherwise.
     """
 
     moves: np.ndarray
