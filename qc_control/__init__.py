@@ -92,6 +92,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         half_car_model,
     )
     from .models.modal import ModalAnalysis, Mode, modal_analysis, numerical_modes
+    from .models.mpc import MPCController, MPCSolution, mpc_controller, sampled_lqr
     from .models.nonlinear import (
         BumpStop,
         NonlinearQuarterCarBatch,
@@ -251,6 +252,11 @@ _LAZY: dict[str, str] = {
     "NonlinearQuarterCarBatch": "models.nonlinear",
     "simulate_batch": "studies.nlsweep",
     "BatchResponse": "studies.nlsweep",
+    # sampled-data and predictive control
+    "mpc_controller": "models.mpc",
+    "sampled_lqr": "models.mpc",
+    "MPCController": "models.mpc",
+    "MPCSolution": "models.mpc",
 }
 
 
@@ -361,4 +367,9 @@ __all__ = [
     "wk_filter",
     "wk_weighted",
     "write_report",
+    # sampled-data and predictive control
+    "MPCController",
+    "MPCSolution",
+    "mpc_controller",
+    "sampled_lqr",
 ]

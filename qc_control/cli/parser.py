@@ -308,7 +308,8 @@ def _add_control_report(sub, shown: str) -> None:
     ctl.add_argument(
         "--designs",
         metavar="A,B,...",
-        help=f"designs to compare (default all: {', '.join(DESIGNS)}; 'hinf' for H∞)",
+        help=f"designs to compare (default all: {', '.join(DESIGNS)}; 'hinf' for H∞, "
+        "'lqr-sampled', 'mpc-preview-0.2' and 'mpc-preview-0.5' for the names with commas)",
     )
     for name, kind, default, metavar, help in _CONTROL_OPTIONS:
         ctl.add_argument(option_name(name), type=kind, default=default, metavar=metavar, help=help)
@@ -498,10 +499,21 @@ def _report(args, scenario: Scenario, out: Path) -> int:
     return 0
 
 
+#: Short names on the command line: '--designs' splits on commas, which some names hold.
+_DESIGN_ALIASES = {
+    "hinf": "H∞",
+    "h∞": "H∞",
+    "lqr-sampled": "LQR, sampled",
+    "mpc-preview-0.2": "MPC, preview 0.2 s",
+    "mpc-preview-0.5": "MPC, preview 0.5 s",
+}
+_DESIGN_SHORT = {"H∞": "hinf", **{v: k for k, v in _DESIGN_ALIASES.items() if "," in v}}
+
+
 def _designs(text: str | None) -> list[str]:
     if text is None:
         return [d for d in DESIGNS if d != "H∞" or HINF_AVAILABLE]
-    names = [("H∞" if n.strip().lower() in ("hinf", "h∞") else n.strip()) for n in text.split(",")]
+    names = [_DESIGN_ALIASES.get(n.strip().lower(), n.strip()) for n in text.split(",")]
     unknown = [n for n in names if n not in DESIGNS]
     if unknown:
         raise UsageError(f"--designs: unknown design {unknown[0]!r}; choose from {list(DESIGNS)}")
@@ -518,7 +530,7 @@ def _control_command(args, designs: list[str]) -> str:
     for f in fields(QuarterCarParams):
         if getattr(args, f.name, None) is not None:
             options.append((option_name(f.name), repr(getattr(args, f.name))))
-    options.append(("--designs", ",".join("hinf" if d == "H∞" else d for d in designs)))
+    options.append(("--designs", ",".join(_DESIGN_SHORT.get(d, d) for d in designs)))
     options += [(option_name(name), str(getattr(args, name))) for name, *_ in _CONTROL_OPTIONS]
     return command_line(["control-report"], [*options, ("--out", str(args.out))])
 

@@ -55,6 +55,7 @@ from typing import Any
 import control
 import numpy as np
 
+from .sampled_loop import sampled_loop
 from .vehicle import VehicleModel
 
 try:  # optional: qc-control[robust], for hinf_controller
@@ -732,7 +733,9 @@ def _measured_plant(car: VehicleModel, measured: Sequence[str]) -> control.State
     )
 
 
-def closed_loop(car: VehicleModel, controller, *, name: str | None = None) -> VehicleModel:
+def closed_loop(
+    car: VehicleModel, controller, *, name: str | None = None, delay: int = 0
+) -> VehicleModel:
     """The car with a controller driving its actuator force ``fa``.
 
     ``control.interconnect`` joins the car (its outputs and, where the
@@ -749,6 +752,10 @@ def closed_loop(car: VehicleModel, controller, *, name: str | None = None) -> Ve
         are outputs or states of the car.
     name : str, optional
         Default ``'<car> + <controller>'``.
+    delay : int, default 0
+        For a discrete controller: whole samples of computation delay (the
+        move computed at tick ``k`` is applied from tick ``k + delay``; the
+        moves before the first are 0). A continuous controller has none.
 
     Returns
     -------
@@ -762,6 +769,16 @@ def closed_loop(car: VehicleModel, controller, *, name: str | None = None) -> Ve
         semi-active one (through `qc_control.input_output_response`). Roles,
         units and parameters are the car's; ``rebuild(params)`` closes the
         same controller around the rebuilt car.
+
+        A **discrete** controller (``dt > 0``: a ``control.StateSpace`` or
+        ``control.NonlinearIOSystem``, or `qc_control.mpc_controller`) runs
+        on a clock beside the continuous car
+        (`qc_control.models.sampled_loop`): its move is held between ticks
+        (zero-order hold) and the loop's ``system`` is a
+        `qc_control.numerics.clocked.ClockedLoop` whose states end with the
+        held move ``fa_held`` (and the queued ones ``fa_queued<i>``); the
+        responses step it with steps landing on every tick, and the
+        controller's period must be a whole multiple of the car's step.
     """
     if not isinstance(car, VehicleModel):
         raise TypeError(f"car must be a VehicleModel, got {type(car).__name__}")
@@ -777,6 +794,14 @@ def closed_loop(car: VehicleModel, controller, *, name: str | None = None) -> Ve
         )
     measured = list(controller.input_labels)
     plant = _measured_plant(car, measured)
+    rebuild = functools.partial(_rebuild, car.rebuild, controller, name, delay=delay)
+    if control.isdtime(controller, strict=True):
+        return sampled_loop(car, controller, plant, delay, name, rebuild)
+    if delay != 0:
+        raise ValueError(
+            f"delay={delay!r} needs a discrete controller (dt > 0); controller "
+            f"{controller.name!r} is continuous"
+        )
     inputs = [label for label in car.system.input_labels if label != "fa"]
     outputs = [*car.system.output_labels, "fa"]
     ctrl_states = [f"{controller.name}_{s}" for s in controller.state_labels]
@@ -807,9 +832,9 @@ def closed_loop(car: VehicleModel, controller, *, name: str | None = None) -> Ve
         car.params,
         units,
         car.roles,
-        functools.partial(_rebuild, car.rebuild, controller, name),
+        rebuild,
     )
 
 
-def _rebuild(car_rebuild, controller, name, params) -> VehicleModel:
-    return closed_loop(car_rebuild(params), controller, name=name)
+def _rebuild(car_rebuild, controller, name, params, delay=0) -> VehicleModel:
+    return closed_loop(car_rebuild(params), controller, name=name, delay=delay)

@@ -85,6 +85,28 @@ def _design_table(cmp) -> pd.DataFrame:
     )
 
 
+def _ecu_blocks(cmp, table: pd.DataFrame) -> list:
+    """The controllers on a clock: force and travel at every tick, solve times, penalty."""
+    cols = [c for c in table.columns if c.startswith("ecu: ")]
+    if not cols:
+        return []
+    rows = table[cols].dropna(how="all")
+    if rows.empty:
+        return []
+    return [
+        Heading("Controllers on a clock"),
+        Table(
+            rows.rename(columns=lambda c: c[len("ecu: ") :]),
+            "Sampled-data designs: the largest force commanded at any tick and the largest "
+            "suspension travel over each run (the force limit is hard: no tick exceeds it), "
+            "the QP's solve time per tick (median and worst, wall time on this machine) and "
+            "the ticks on which the soft travel limit's penalty was active (listed in the "
+            "notes when any).",
+            "Table 2b",
+        ),
+    ]
+
+
 def control_blocks(cmp, command: str | None = None) -> list:
     """The report as document blocks (see `qc_control.report.document`)."""
     p, bump, road = cmp.params, cmp.bump, cmp.road
@@ -121,6 +143,7 @@ def control_blocks(cmp, command: str | None = None) -> list:
             "only dissipates).",
             "Table 3",
         ),
+        *_ecu_blocks(cmp, table),
         Heading("Transmissibility"),
     ]
     specs = control_figures(cmp)

@@ -48,6 +48,7 @@ from control.timeresp import forced_response as _control_forced_response
 
 from .. import compat
 from ..numerics.adaptive import check_embedded, slope_breakpoints
+from ..numerics.clocked import ClockedLoop, step_clocked
 from ..numerics.integrate import (
     STEP_BLOCK,
     DivergenceWarning,
@@ -1734,6 +1735,8 @@ def _io_response(sys, T, U, X0, layout: _Layout, io: _IOOptions):
             _control_io_response, sys, T, U, X0, layout,
             return_x=layout.return_x, evaluation_times=io.t_eval,
         )  # fmt: skip
+    if isinstance(sys, ClockedLoop):  # a controller on a clock: steps land on every tick
+        return _clocked_response(sys, T, U, X0, layout, io)
     prob = _io_problem(sys, T, U, X0, layout.params)
     u_of_t = linear_input(prob.T, prob.u_samples)  # python-control's interpolation of the samples
     computed = _io_step(sys, prob, layout.params, io)
@@ -1775,6 +1778,48 @@ def _ivp_tolerances(ivp: dict, method, rtol, atol):
                 raise ValueError(f"{name} specified more than once (keyword and solve_ivp_kwargs)")
             given[name] = ivp.pop(name)
     return given["rtol"], given["atol"]
+
+
+def _clocked_response(sys: ClockedLoop, T, U, X0, layout: _Layout, io: _IOOptions):
+    """A sampled-data loop (`qc_control.numerics.clocked`): the car stepped at
+    ``h = ΔT / substeps``, the controller updated at its ticks, its move held.
+
+    The result also carries ``tick_times`` [s] and ``moves`` (the move
+    computed at each tick, before any delay).
+    """
+    if not (isinstance(io.t_eval, str) and io.t_eval == "T"):
+        raise ValueError(
+            f"evaluation_times={io.t_eval!r}: a sampled-data loop is output at the times of T"
+        )
+    if io.events is not None:
+        raise ValueError("events= does not apply to a sampled-data loop (a linear car)")
+    if io.opts.adaptive:
+        raise ValueError(
+            "rtol/atol: a sampled-data loop is stepped at a fixed step that lands on every "
+            "clock tick; give method and substeps instead"
+        )
+    prob = _io_problem(sys, T, U, X0, layout.params)
+    computed = _io_step(sys, prob, layout.params, io)
+    computed.h = float(np.diff(prob.T).max()) / computed.substeps
+    run = step_clocked(sys, computed.method, prob.T, prob.u_samples, prob.x0, computed.substeps)
+    computed.steps, computed.nfev = run.steps, run.nfev
+    x = np.vstack([run.x, run.xc, run.held])
+    y = sys.outputs_of(x, prob.u_samples)
+    computed.note = (
+        f"sampled-data loop: controller every {sys.period:g} s (zero-order hold, delay "
+        f"{sys.delay} samples), car stepped at h = {computed.h:.6g} s"
+    )
+    resp = _response(
+        sys,
+        (prob.T, y, x, prob.u_samples),
+        layout,
+        "Input/output response for " + sys.name,
+        True,
+        None,
+    )
+    resp.tick_times, resp.moves = run.tick_times, run.moves
+    resp.t_events, resp.event_labels = np.empty(0), ()
+    return _finalise(computed.stamp(resp))
 
 
 def input_output_response(

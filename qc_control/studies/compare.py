@@ -760,6 +760,13 @@ def _checked_problem(
             "(e.g. qc.quarter_car_model(params, road=True)) so that the "
             "comparison knows which output is which"
         )
+    if hasattr(sys, "law") and hasattr(sys, "period"):  # a ClockedLoop (numerics.clocked)
+        raise ValueError(
+            f"system {sys.name!r} is a sampled-data loop: the comparison's references "
+            "(the matrix exponential, solve_ivp) know no clock ticks. Compare its ticks with "
+            "the exact discrete equivalent, control.c2d(car, dt, 'zoh') closed with the "
+            "controller, as tests/test_sampled.py does"
+        )
     T = check_time_grid(np.linspace(0, DEFAULT_T_END, 1001) if T is None else T, "T")
     h, substeps = _grid(T, h)
     tabs = _tableaus(methods)

@@ -29,7 +29,7 @@ import control
 import numpy as np
 import pandas as pd
 
-from ..models import controllers
+from ..models import controllers, mpc
 from ..models.controllers import closed_loop
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
 from ..models.vehicle import VehicleModel
@@ -58,11 +58,19 @@ DESIGNS = (
     "ADD",
     "LQR",
     "H∞",
+    "LQR, sampled",
+    "MPC",
+    "MPC, preview 0.2 s",
+    "MPC, preview 0.5 s",
 )
 #: Metrics of the bump run (names of `qc_control.ride.metrics`).
 BUMP_METRICS = ("peak_body_acc", "peak_susp_travel", "settling_time")
 #: Metrics of the road run.
 ROAD_METRICS = ("rms_body_acc", "rms_body_acc_wk", "rms_susp_travel", "rms_tire_load / static")
+#: The sampled-data designs: the ECU's period [s], the MPC's horizon (ticks: 0.5 s, the
+#: longest preview), the actuator's force limit [N] (hard) and the travel limit [m]
+#: (soft, `qc_control.models.mpc.TRAVEL_PENALTY`).
+ECU_PERIOD, MPC_HORIZON, FORCE_LIMIT, TRAVEL_LIMIT = 0.01, 50, 1000.0, 0.08
 #: The time steps of the road and bump runs [s] (the road's is within
 #: `qc_control.ride.road.largest_step` up to 35 m/s).
 DT_ROAD, DT_BUMP = 0.005, 0.002
@@ -153,6 +161,7 @@ def _design_set(p: QuarterCarParams, road_class, speed, cmax, which, hinf_beta):
         "passive optimum": lambda: _passive_optimum(p, road_class, speed),
         **{name: _closed(car, laws[name], what[name]) for name in laws},
         "H∞": lambda: _hinf(car, hinf_beta),
+        **_sampled_designs(car),
     }
     unknown = [w for w in which if w not in makers]
     if unknown:
@@ -163,6 +172,32 @@ def _design_set(p: QuarterCarParams, road_class, speed, cmax, which, hinf_beta):
 def _closed(car: VehicleModel, law: Callable, what: str) -> Callable[[], tuple[VehicleModel, str]]:
     """The design that closes ``law()`` around ``car``, built when asked."""
     return lambda: (closed_loop(car, law()), what)
+
+
+def _sampled_designs(car: VehicleModel) -> dict[str, Callable[[], tuple[VehicleModel, str]]]:
+    """The controllers on a clock: the sampled LQR and MPC without and with preview."""
+    clock = f"{ECU_PERIOD * 1e3:g} ms ZOH, |fa| ≤ {FORCE_LIMIT:g} N"
+
+    def lqr():
+        law = mpc.sampled_lqr(car, ECU_PERIOD, limit=FORCE_LIMIT)
+        return closed_loop(car, law), f"LQR's weights, control.dlqr, {clock} (clipped)"
+
+    def predictive(preview):
+        law = mpc.mpc_controller(
+            car,
+            ECU_PERIOD,
+            MPC_HORIZON,
+            limits={"fa": FORCE_LIMIT, "susp_travel": TRAVEL_LIMIT},
+            preview=preview,
+        )
+        return closed_loop(car, law), f"LQR's weights, OSQP, {law.description}"
+
+    return {
+        "LQR, sampled": lqr,
+        "MPC": lambda: predictive(None),
+        "MPC, preview 0.2 s": lambda: predictive(0.2),
+        "MPC, preview 0.5 s": lambda: predictive(0.5),
+    }
 
 
 def _passive_optimum(p, road_class, speed):
@@ -258,12 +293,50 @@ def _measure(
 ) -> tuple[dict, str]:
     """One design's row of metrics over the bump and road runs, and a note if a run failed."""
     bump_resp = _run(model, *runs["bump"], method)
+    bump_ecu = _ecu(model, bump_resp, "bump")
     road_resp = _run(model, *runs["road"], method)
+    road_ecu = _ecu(model, road_resp, "road")
     row = {f"bump: {k}": v for k, v in ride_metrics(bump_resp, model, BUMP_METRICS).items()}
     row.update({f"road: {k}": v for k, v in ride_metrics(road_resp, model, ROAD_METRICS).items()})
     row["road: rms actuator force [N]"], row["road: mean actuator power [W]"] = _actuator(road_resp)
     failed = [r for r in (bump_resp, road_resp) if not r.success]
     note = f"the fixed-step run did not succeed ({failed[0].message})" if failed else ""
+    for ecu in (bump_ecu, road_ecu):
+        if ecu is not None:
+            row.update(ecu[0])
+            note = "; ".join(filter(None, [note, ecu[1]]))
+    return row, note
+
+
+def _ecu(model: VehicleModel, resp, run: str) -> tuple[dict, str] | None:
+    """A sampled design's largest force and travel at every tick and its solve times.
+
+    The force is read at the ticks (the move held from each), the travel at
+    every sample; the solve times are the controller's own log (an MPC's
+    QP solves), None for a law without one. None for a continuous design.
+    """
+    law = getattr(model.system, "law", None)
+    if law is None:
+        return None
+    travel = np.asarray(resp.outputs)[list(resp.output_labels).index("susp_travel")]
+    row = {
+        f"ecu: {run} max |fa| [N]": float(np.max(np.abs(resp.moves))),
+        f"ecu: {run} max |susp_travel| [m]": float(np.max(np.abs(travel))),
+    }
+    log = getattr(law, "log", None)
+    times = np.asarray(log.solve_times if log is not None else [np.nan]) * 1e3
+    row[f"ecu: {run} solve median [ms]"] = float(np.median(times))
+    row[f"ecu: {run} solve worst [ms]"] = float(np.max(times))
+    penalty = list(log.penalty_ticks) if log is not None else []
+    row[f"ecu: {run} travel penalty ticks"] = float(len(penalty))
+    note = ""
+    if penalty:
+        note = (
+            f"{run}: the soft travel limit's penalty was active on {len(penalty)} ticks, "
+            f"from t = {penalty[0]:.2f} s to {penalty[-1]:.2f} s"
+        )
+    if log is not None and log.failures:
+        note = "; ".join(filter(None, [note, f"{run}: {len(log.failures)} QPs not solved"]))
     return row, note
 
 
@@ -368,7 +441,13 @@ def compare_controllers(
     )
     table = pd.DataFrame.from_dict(rows, orient="index").astype(float)
     table.index.name = "design"
-    semi = [n for n in built if n not in linear]
+    sampled = [n for n, (m, _) in built.items() if hasattr(m.system, "law")]
+    semi = [n for n in built if n not in linear and n not in sampled]
+    if sampled:
+        notes.append(
+            "sampled-data designs run on a clock beside the continuous car and have no "
+            "transmissibility: " + ", ".join(sampled) + " appear in the tables only"
+        )
     if semi:
         notes.append(
             "semi-active designs are nonlinear and have no transmissibility: "
