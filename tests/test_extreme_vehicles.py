@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from qc_control.cli.parser import run
 from qc_control.models.halfcar import FullCarParams, HalfCarParams
 from qc_control.models.modal import modal_analysis
-from qc_control.models.vehicle import MAX_RATE_SPAN
+from qc_control.models.quarter import MAX_RATE_SPAN
 
 EXTREMES = (1e-300, 1e-12, 1e10, 1e300, -1e300)
 

@@ -58,15 +58,8 @@ from typing import Any, ClassVar
 import control
 import numpy as np
 
-from .vehicle import (
-    MAX_RATE_SPAN,
-    STANDARD_GRAVITY,
-    BatchedModel,
-    Corner,
-    SignalRoles,
-    VehicleModel,
-    params_as,
-)
+from .quarter import MAX_RATE_SPAN
+from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel, params_as
 
 __all__ = [
     "HalfCarParams",

@@ -27,15 +27,7 @@ from typing import Any
 import control
 import numpy as np
 
-from .vehicle import (
-    MAX_RATE_SPAN,
-    STANDARD_GRAVITY,
-    BatchedModel,
-    Corner,
-    SignalRoles,
-    VehicleModel,
-    params_as,
-)
+from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel, params_as
 
 __all__ = [
     "QuarterCarParams",
@@ -54,6 +46,10 @@ __all__ = [
 STATES = ("vs", "vu", "xs", "xu")
 #: Output names, in order.
 OUTPUTS = ("xs", "xu", "susp_travel", "tire_defl", "body_acc")
+#: The largest ratio of the fastest to the slowest of a vehicle's rates
+#: (sqrt(k/m), c/m) that the parameter classes (this car's, the half and full
+#: car's) accept; see `QuarterCarParams`'s validation.
+MAX_RATE_SPAN = 1e7
 #: The seed's initial state: the body released from 5 cm, at rest [m/s, m/s, m, m].
 SEED_X0 = (0.0, 0.0, 0.05, 0.0)
 #: The SI unit of every signal of the quarter car.

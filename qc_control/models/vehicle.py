@@ -40,11 +40,6 @@ __all__ = [
 
 #: Standard gravity [m/s²] (ISO 80000-3), for static wheel loads.
 STANDARD_GRAVITY = 9.80665
-#: The largest ratio of the fastest to the slowest of a vehicle's rates
-#: (sqrt(k/m), c/m) that the parameter classes accept: eigenvalues come out of
-#: double precision with a relative error of about eps·(fastest/slowest)², so
-#: beyond it the slow mode loses its digits.
-MAX_RATE_SPAN = 1e7
 
 
 @dataclass(frozen=True)
