@@ -119,6 +119,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from .numerics.methods import METHODS, ButcherTableau, get_method
     from .numerics.stability import max_stable_step, stability_function
     from .report import write_report
+    from .report.identification import MeasurementComparison, compare_to_measurement
     from .report.plotting import plot_outputs
     from .responses.timeresp import (
         FixedStepResponse,
@@ -147,6 +148,8 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from .studies.compare import MethodComparison, compare_methods
     from .studies.control_study import ControlComparison, compare_controllers
     from .studies.damping import DampingOptimum, ParetoFront, optimal_damping, pareto_front
+    from .studies.identify import Identification, identify
+    from .studies.measurement import Measurement
     from .studies.nlsweep import BatchResponse, simulate_batch
     from .studies.sweeps import (
         DEFAULT_METRICS,
@@ -250,6 +253,12 @@ _LAZY: dict[str, str] = {
     "NonlinearQuarterCarBatch": "models.nonlinear",
     "simulate_batch": "studies.nlsweep",
     "BatchResponse": "studies.nlsweep",
+    # measured data: identification and simulation against measurement
+    "Measurement": "studies.measurement",
+    "identify": "studies.identify",
+    "Identification": "studies.identify",
+    "compare_to_measurement": "report.identification",
+    "MeasurementComparison": "report.identification",
 }
 
 
@@ -359,4 +368,9 @@ __all__ = [
     "wk_filter",
     "wk_weighted",
     "write_report",
+    "Measurement",
+    "identify",
+    "Identification",
+    "compare_to_measurement",
+    "MeasurementComparison",
 ]

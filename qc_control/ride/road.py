@@ -6,6 +6,9 @@ meet the front wheels' road a wheelbase later (`delay`, `axle_inputs`,
 `corner_inputs`), and the left and right tracks of a random road are partly
 correlated (`isotropic_coherence`, `iso8608_tracks`).
 
+A measured profile's International Roughness Index is `iri` (ASTM E1926,
+in `qc_control.ride.roughness`).
+
 Every function returns ``zr`` on a given time grid ``T`` [s]; the random
 road is deterministic for a given seed. A road is an input linear between
 samples (python-control's assumption), so ``control.forced_response``
@@ -21,6 +24,7 @@ import scipy.special
 
 from ..numerics.integrate import check_time_grid, uniform_step
 from ..numerics.limits import check_memory
+from .roughness import IRISegments, iri
 
 __all__ = [
     "step",
@@ -43,6 +47,8 @@ __all__ = [
     "isotropic_coherence",
     "iso8608_profiles",
     "iso8608_tracks",
+    "iri",
+    "IRISegments",
 ]
 
 #: Reference spatial frequency n0 [cycles/m] of ISO 8608.
