@@ -148,7 +148,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from .studies.compare import MethodComparison, compare_methods
     from .studies.control_study import ControlComparison, compare_controllers
     from .studies.damping import DampingOptimum, ParetoFront, optimal_damping, pareto_front
-    from .studies.identify import Identification, identify
+    from .studies.identification import Identification, identify
     from .studies.measurement import Measurement
     from .studies.nlsweep import BatchResponse, simulate_batch
     from .studies.sweeps import (
@@ -255,8 +255,8 @@ _LAZY: dict[str, str] = {
     "BatchResponse": "studies.nlsweep",
     # measured data: identification and simulation against measurement
     "Measurement": "studies.measurement",
-    "identify": "studies.identify",
-    "Identification": "studies.identify",
+    "identify": "studies.identification",
+    "Identification": "studies.identification",
     "compare_to_measurement": "report.identification",
     "MeasurementComparison": "report.identification",
 }

@@ -26,7 +26,7 @@ import scipy.signal
 
 from ..models.quarter import QuarterCarParams
 from ..models.vehicle import VehicleModel
-from ..studies.identify import OUTPUT_LABELS, Identification, nrmse_fit, simulate_quarter
+from ..studies.identification import OUTPUT_LABELS, Identification, nrmse_fit, simulate_quarter
 from ..studies.measurement import SIGNAL_UNITS, Measurement
 from . import FORMATS, FigureSpec, write_document
 from .document import Code, Heading, Image, Paragraph, Table
