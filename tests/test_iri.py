@@ -80,7 +80,7 @@ def test_iso8608_classes_rise_by_a_factor_two():
     "x, z, match",
     [
         (np.arange(0, 5, 0.1), np.zeros(50), "needs more than its 11 m"),
-        (np.r_[0.0, 0.1, 0.1, *np.arange(0.3, 20, 0.1)], None, "x must increase"),
+        (np.concatenate([[0.0, 0.1, 0.1], np.arange(0.3, 20, 0.1)]), None, "x must increase"),
         (np.r_[np.arange(0, 10, 0.1), np.arange(10.2, 30, 0.1)], None, "uniform sample interval"),
         (np.arange(0, 20, 0.1), np.r_[np.zeros(10), np.nan, np.zeros(189)], "profile is not "),
     ],
