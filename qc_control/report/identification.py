@@ -237,10 +237,16 @@ def _blocks(ident: Identification, fitted, held, specs, command) -> list:
     ]
     if ident.ratios is not None:
         blocks.append(Table(ident.ratios, "The ratios the records determine.", "Table 2"))
+    n = 2 + (ident.ratios is not None)
     blocks += [
         Heading("Fit"),
-        Table(fit_table, "NRMSE fit [%] per output (100: perfect).", "Table 3"),
-        Table(white, "Whiteness of the residuals (autocorrelation, lags 1-25).", "Table 4"),
+        Table(fit_table, "NRMSE fit [%] per output (100: perfect).", f"Table {n}"),
+        Table(
+            white,
+            "Whiteness of the residuals: the fraction of autocorrelation lags 1-25 outside "
+            "the 95 % band (white: no more than 4 of 25, the binomial's 99th percentile).",
+            f"Table {n + 1}",
+        ),
     ]
     blocks += [Image(s.name, s.caption, s.label) for s in specs]
     if ident.notes:

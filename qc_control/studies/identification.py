@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import scipy.optimize
+import scipy.stats
 
 from ..models.quarter import QuarterCarParams, quarter_car_abcd, quarter_car_model
 from ..models.vehicle import VehicleModel
@@ -95,16 +96,22 @@ def nrmse_fit(measured: np.ndarray, simulated: np.ndarray) -> float:
 
 def whiteness(residual: np.ndarray, lags: int = WHITENESS_LAGS) -> tuple[float, bool]:
     """The fraction of autocorrelation lags 1..``lags`` outside ±1.96/√N, and whether
-    the residual passes as white (at most 10 % of them outside: 5 % are expected
-    outside by chance, and a model error shows as a run of many)."""
+    the residual passes as white.
+
+    Each lag of a white residual falls outside the band with probability 5 %,
+    so a count of lags outside is binomial: the residual passes unless the
+    count is beyond that binomial's 99th percentile (4 of 25 lags), which a
+    white residual exceeds once in a hundred records; a model error shows as
+    a run of many lags outside.
+    """
     e = np.asarray(residual, dtype=float) - np.mean(residual)
     n = e.size
     denom = float(e @ e)
     if denom == 0 or n <= lags:
         return 0.0, True
     r = np.array([e[:-k] @ e[k:] / denom for k in range(1, lags + 1)])
-    outside = float(np.mean(np.abs(r) > Z95 / math.sqrt(n)))
-    return outside, outside <= 0.1
+    outside = int(np.sum(np.abs(r) > Z95 / math.sqrt(n)))
+    return outside / lags, outside <= scipy.stats.binom.ppf(0.99, lags, 0.05)
 
 
 def _quarter_matrices(values: Mapping[str, float]):

@@ -21,7 +21,14 @@ import pandas as pd
 
 from ..models.quarter import UNITS as QUARTER_UNITS
 
-__all__ = ["Measurement", "SIGNAL_UNITS", "INPUT_LABELS", "UNIT_FACTORS"]
+__all__ = [
+    "Measurement",
+    "SIGNAL_UNITS",
+    "INPUT_LABELS",
+    "UNIT_FACTORS",
+    "rig_record",
+    "RIG_COLUMNS",
+]
 
 #: The labels a measurement may hold and their SI units: the quarter car's
 #: signals and the wheel's acceleration (an accelerometer on the hub).
@@ -296,6 +303,42 @@ class Measurement:
             f"Measurement({self.t.size} samples at {1 / self.dt:.6g} Hz, "
             f"{self.t[-1] - self.t[0]:.6g} s; {', '.join(self.labels)})"
         )
+
+
+#: The shipped rig records' columns by label (``examples/make_rig_dataset.py``).
+RIG_COLUMNS = {
+    "zr": "base_mm",
+    "fa": "force_N",
+    "susp_travel": "travel_mm",
+    "body_acc": "body_acc_ms2",
+    "wheel_acc": "wheel_acc_ms2",
+    "xs": "body_disp_mm",
+}
+
+
+def rig_record(part: str = "identification") -> Measurement:
+    """The shipped rig test, a SIMULATED record (see ``examples/make_rig_dataset.py``).
+
+    A quarter car with a damped tire on a rig, its base plate moving
+    randomly and an actuator sweeping a force chirp; 1 % sensor noise, a
+    drifting body displacement sensor and a force channel of the opposite
+    sign to the model's ``fa``, as a real rig's records have.
+
+    Parameters
+    ----------
+    part : {'identification', 'validation'}
+        The 15 s record to fit, or the 8 s held-out one (200 Hz both).
+
+    Examples
+    --------
+    >>> rig_record()
+    Measurement(3001 samples at 200 Hz, 15 s; zr, fa, susp_travel, body_acc, wheel_acc, xs)
+    """
+    if part not in ("identification", "validation"):
+        raise ValueError(f"part must be 'identification' or 'validation', got {part!r}")
+    path = Path(__file__).parent.parent / "data" / f"rig_{part}.csv"
+    units = {k: "mm" for k in ("zr", "susp_travel", "xs")}
+    return Measurement.from_csv(path, time="time_s", columns=RIG_COLUMNS, units=units)
 
 
 def _leading_comments(path: Path) -> int:
