@@ -423,7 +423,7 @@ def identify(
     )
     if not solution.success:
         notes.append(f"the optimiser stopped: {solution.message}")
-    return _result(problem, solution, free_names, pinned_for_scale, notes)
+    return _result(problem, solution, pinned_for_scale, notes)
 
 
 def _rest_state(problem: _Problem, theta: np.ndarray) -> np.ndarray:
@@ -434,15 +434,16 @@ def _rest_state(problem: _Problem, theta: np.ndarray) -> np.ndarray:
     return -np.linalg.solve(A, B @ np.array(u0))
 
 
-def _covariance(problem: _Problem, J: np.ndarray, residual: np.ndarray):
-    """The sandwich covariance (module note) and the directions not determined."""
+def _covariance(n_out: int, J: np.ndarray, residual: np.ndarray):
+    """The sandwich covariance (module note) and the directions not determined;
+    the residual holds ``n_out`` outputs' blocks of equal length."""
     p = J.shape[1]
     norms = np.linalg.norm(J, axis=0)
     norms[norms == 0] = 1.0
     Js = J / norms  # column scaling: the rank test then sees directions, not units
     _, s, Vt = np.linalg.svd(Js, full_matrices=False)
     null = s < RANK_TOLERANCE * s[0]
-    n_out, N = len(problem.outputs), len(problem.measurement)
+    N = residual.size // n_out
     Jo = Js.reshape(n_out, N, p)
     eo = residual.reshape(n_out, N)
     sigma2 = np.sum(eo**2, axis=1) / max(N - p / n_out, 1.0)
@@ -485,10 +486,14 @@ def _ratios(table: pd.DataFrame, ms: float) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=columns).set_index("ratio")
 
 
-def _result(problem: _Problem, solution, free_names, pinned_for_scale, notes) -> Identification:
+def _result(problem: _Problem, solution, pinned_for_scale, notes, covariance=None):
+    """The `Identification` of a solved problem; ``covariance`` is ``(cov,
+    undetermined)`` when the fit was not this problem's (the frequency domain)."""
     names = problem.names()
     theta = solution.x
-    cov, undetermined = _covariance(problem, solution.jac, solution.fun)
+    if covariance is None:
+        covariance = _covariance(len(problem.outputs), solution.jac, solution.fun)
+    cov, undetermined = covariance
     table = _table(names, theta, cov, undetermined, len(problem.free))
     sd = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
     correlation = pd.DataFrame(cov / np.outer(sd, sd), index=names, columns=names)
