@@ -95,3 +95,14 @@ def test_bad_segment():
     x = np.arange(0, 20, 0.1)
     with pytest.raises(ValueError, match="segment must be"):
         qc.road.iri(x, np.zeros_like(x), segment=0.0)
+
+
+@pytest.mark.parametrize("road_class", ["A", "C"])
+def test_iso8608_class_iri_is_the_profiles_mean(road_class):
+    # the spectral expectation (Gaussian stroke velocity: E|v| = σ√(2/π)) against the IRI
+    # of simulated 3 km profiles of the class: 3 km spans ~100 of the body mode's
+    # correlation lengths, so each profile's IRI scatters by about 1 %; 3 % is 3 SDs
+    expected = qc.road.iso8608_iri(road_class)
+    for seed in range(3):
+        x, z = qc.road.iso8608_profile(3000.0, 0.05, road_class, seed=seed)
+        assert qc.road.iri(x, z) == pytest.approx(expected, rel=0.03)
