@@ -196,7 +196,7 @@ def compare_to_measurement(
 
 
 def _figures(fitted: MeasurementComparison, held: MeasurementComparison | None):
-    specs = []
+    specs: list[FigureSpec] = []
     runs = [("identification record", fitted, "fit")]
     if held is not None:
         runs.append(("held-out record", held, "validation"))
