@@ -109,7 +109,7 @@ def _overlay(ax, t, measured, simulated) -> None:
 
 
 def _panels(cmp: MeasurementComparison, draw, xlabel: str = "t [s]", psd: bool = False):
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure  # heavy and optional: only when plotting
 
     labels = list(cmp.measured)
     fig = Figure(figsize=(8, 2.2 * len(labels) + 0.6), layout="constrained")
@@ -249,12 +249,9 @@ def _blocks(ident: Identification, fitted, held, specs, command) -> list:
         ),
     ]
     blocks += [Image(s.name, s.caption, s.label) for s in specs]
-    if ident.notes:
-        blocks.append(Heading("Notes"))
-        blocks += [Paragraph(note) for note in ident.notes]
-    if command:
-        blocks += [Heading("Reproduce"), Code(command)]
-    return blocks
+    notes = [Heading("Notes"), *map(Paragraph, ident.notes)] if ident.notes else []
+    reproduce = [Heading("Reproduce"), Code(command)] if command else []
+    return blocks + notes + reproduce
 
 
 def write_identification_report(
