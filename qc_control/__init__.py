@@ -120,6 +120,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from .numerics.methods import METHODS, TABLEAUS, ButcherTableau, get_method
     from .numerics.stability import max_stable_step, stability_function
     from .report import write_report
+    from .report.identification import MeasurementComparison, compare_to_measurement
     from .report.plotting import plot_outputs
     from .responses.timeresp import (
         FixedStepResponse,
@@ -148,6 +149,8 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from .studies.compare import MethodComparison, compare_methods
     from .studies.control_study import ControlComparison, compare_controllers
     from .studies.damping import DampingOptimum, ParetoFront, optimal_damping, pareto_front
+    from .studies.identification import Identification, identify
+    from .studies.measurement import Measurement
     from .studies.nlsweep import BatchResponse, simulate_batch
     from .studies.sweeps import (
         DEFAULT_METRICS,
@@ -257,6 +260,12 @@ _LAZY: dict[str, str] = {
     "sampled_lqr": "models.mpc",
     "MPCController": "models.mpc",
     "MPCSolution": "models.mpc",
+    # measured data: identification and simulation against measurement
+    "Measurement": "studies.measurement",
+    "identify": "studies.identification",
+    "Identification": "studies.identification",
+    "compare_to_measurement": "report.identification",
+    "MeasurementComparison": "report.identification",
 }
 
 
@@ -372,4 +381,9 @@ __all__ = [
     "MPCSolution",
     "mpc_controller",
     "sampled_lqr",
+    "Measurement",
+    "identify",
+    "Identification",
+    "compare_to_measurement",
+    "MeasurementComparison",
 ]

@@ -31,6 +31,8 @@ from ..report import ReportError, check_target, report_lock, write_report
 from ..report.control import write_control_report
 from ..studies.compare import ReferenceBudgetError
 from ..studies.control_study import DESIGNS, compare_controllers
+from .measured import CommandTools as _CommandTools
+from .measured import add_measured_commands
 from .scenario import (
     DEFAULT_MODEL,
     ROADS,
@@ -236,6 +238,7 @@ def build_parser(model: str | None = None) -> argparse.ArgumentParser:
     modes.set_defaults(run=_cmd_modes)
     _add_report(sub, shown)
     _add_control_report(sub, shown)
+    add_measured_commands(sub, _CommandTools(UsageError, _check_out, _claimed))
     return parser
 
 

@@ -447,6 +447,8 @@ def nonlinear_quarter_car(
     3934.4
     """
     p = as_params(params)
+    if p.cu:  # its tire is a spring that may lift off; a tire damper is the linear car's
+        raise ValueError(f"the nonlinear car has no tire damping: cu must be 0, got {p.cu!r}")
     zr_at, inputs, ia = _road_height(road, actuator)
     forces = dict(tire=tire, bump_stop=bump_stop, damper=damper, gravity=gravity, zr_at=zr_at)
     elements = _force_elements(p, spring=spring, **forces)

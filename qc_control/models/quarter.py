@@ -14,6 +14,13 @@ through the tire spring ``ku``. With the seed's state vector
 
 become ``dx/dt = A x + B u`` with the seed's matrix ``A`` (section 4.2).
 All quantities are SI: kg, N/m, N·s/m, m, s.
+
+A tire damping ``cu`` (default 0, the seed's car) adds ``cu (x_u' - z_r')``
+to the tire force. The road's rate is never formed: the second state becomes
+``q = x_u' - (cu/mu) z_r``, whose equation holds no ``z_r'`` (the tire
+damper's ``cu z_r'/mu`` is exactly ``(cu/mu) z_r``'s rate), and ``xu' = q +
+(cu/mu) z_r``. With ``cu = 0``, ``q`` is the seed's ``xu'`` and every matrix
+is the seed's.
 """
 
 from __future__ import annotations
@@ -65,7 +72,15 @@ UNITS = {
     "body_acc": "m/s²",
 }
 
-_UNITS = {"ms": "kg", "mu": "kg", "ks": "N/m", "ku": "N/m", "zeta": "-", "cs": "N·s/m"}
+_UNITS = {
+    "ms": "kg",
+    "mu": "kg",
+    "ks": "N/m",
+    "ku": "N/m",
+    "zeta": "-",
+    "cs": "N·s/m",
+    "cu": "N·s/m",
+}
 _DESCRIPTIONS = {
     "ms": "sprung mass",
     "mu": "unsprung mass",
@@ -73,6 +88,7 @@ _DESCRIPTIONS = {
     "ku": "tire stiffness",
     "zeta": "nominal damping ratio cs/(2√(ks·ms))",
     "cs": "suspension damping",
+    "cu": "tire damping",
 }
 
 
@@ -100,6 +116,9 @@ class QuarterCarParams:
         given (seed, Table 1):
 
         .. math:: c_s = 2 \\zeta \\sqrt{k_s m_s}
+
+    cu : float, optional
+        Tire damping [N·s/m], >= 0. Default 0 (the seed's tire, a spring).
 
     Raises
     ------
@@ -129,9 +148,10 @@ class QuarterCarParams:
     ku: float = 29530.0
     zeta: float | None = None
     cs: float | None = None
+    cu: float = 0.0
 
     def __post_init__(self):
-        for name in ("ms", "mu", "ks", "ku", "zeta", "cs"):
+        for name in ("ms", "mu", "ks", "ku", "zeta", "cs", "cu"):
             value = getattr(self, name)
             if value is None and name in ("zeta", "cs"):
                 continue
@@ -143,7 +163,7 @@ class QuarterCarParams:
             value = float(value)
             if not math.isfinite(value):
                 raise ValueError(f"{name} must be finite, got {value!r}")
-            if name in ("zeta", "cs"):
+            if name in ("zeta", "cs", "cu"):
                 if value < 0:
                     raise ValueError(f"{name} must be >= 0, got {value!r}")
             elif value <= 0:
@@ -248,7 +268,8 @@ class QuarterCarParams:
         names = ("ms", "mu", "ks", "ku", "zeta", "cs")
         # the common case, a grid: dicts with the same keys, one column per key
         keys = designs[0].keys() if designs and isinstance(designs[0], Mapping) else None
-        if keys is None or not _FIELDS.issuperset(keys):
+        # a tire damping is rare in a grid: such designs are built one by one
+        if keys is None or not _FIELDS.issuperset(keys) or "cu" in keys:
             return out
         if not all(isinstance(d, Mapping) and d.keys() == keys for d in designs):
             return out
@@ -294,14 +315,14 @@ class QuarterCarParams:
             ok &= ~(fastest > MAX_RATE_SPAN * slowest)
         values = np.stack([ms, mu, ks, ku, zeta, cs], axis=1)
         for i, (row, good) in enumerate(zip(values.tolist(), ok.tolist())):
-            if good:  # what __post_init__ stores: six Python floats
+            if good:  # what __post_init__ stores: seven Python floats
                 p = object.__new__(cls)
-                vars(p).update(zip(names, row))
+                vars(p).update(zip(names, row), cu=0.0)
                 out[i] = p
         return out
 
     def to_dict(self, *, changing: Iterable[str] | None = None) -> dict[str, float]:
-        """The six values as a plain dict (``cs`` and ``zeta`` both resolved).
+        """The seven values as a plain dict (``cs`` and ``zeta`` both resolved).
 
         With ``changing``, the values to build a variant from when the fields
         in ``changing`` take new values: ``cs`` and ``zeta`` are one quantity,
@@ -330,32 +351,36 @@ def as_params(params) -> QuarterCarParams:
     return params_as(QuarterCarParams, params)
 
 
-def seed_matrices(ms, mu, ks, ku, cs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def seed_matrices(ms, mu, ks, ku, cs, cu=0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The seed's ``A`` (section 4.2) and the road and actuator columns of ``B``.
 
     Takes numbers or equal-shaped arrays (a batch of designs) and returns
     ``A (..., 4, 4)``, ``b_road = [0, ku/mu, 0, 0]`` and
-    ``b_act = [1/ms, -1/mu, 0, 0]``, each ``(..., 4)``.
+    ``b_act = [1/ms, -1/mu, 0, 0]``, each ``(..., 4)``. A tire damping
+    ``cu`` (see the module's note: the second state is then
+    ``q = xu' - (cu/mu) zr``) adds ``-cu/mu`` to ``A[1, 1]`` and
+    ``r = cu/mu`` times ``[cs/ms, -(cs + cu)/mu, 0, 1]`` to ``b_road``.
     """
-    ms, mu, ks, ku, cs = np.broadcast_arrays(
-        *(np.asarray(v, dtype=float) for v in (ms, mu, ks, ku, cs))
+    ms, mu, ks, ku, cs, cu = np.broadcast_arrays(
+        *(np.asarray(v, dtype=float) for v in (ms, mu, ks, ku, cs, cu))
     )
     zero, one = np.zeros_like(ms), np.ones_like(ms)
     A = np.stack(
         [
             np.stack([-cs / ms, cs / ms, -ks / ms, ks / ms], axis=-1),
-            np.stack([cs / mu, -cs / mu, ks / mu, -(ks + ku) / mu], axis=-1),
+            np.stack([cs / mu, -(cs + cu) / mu, ks / mu, -(ks + ku) / mu], axis=-1),
             np.stack([one, zero, zero, zero], axis=-1),
             np.stack([zero, one, zero, zero], axis=-1),
         ],
         axis=-2,
     )
-    b_road = np.stack([zero, ku / mu, zero, zero], axis=-1)
+    r = cu / mu  # xu' = q + r zr
+    b_road = np.stack([cs * r / ms, ku / mu - (cs + cu) * r / mu, zero, r], axis=-1)
     b_act = np.stack([1.0 / ms, -1.0 / mu, zero, zero], axis=-1)
     return A, b_road, b_act
 
 
-def quarter_car_abcd(ms, mu, ks, ku, cs, *, road: bool = False, actuator: bool = False):
+def quarter_car_abcd(ms, mu, ks, ku, cs, *, road: bool = False, actuator: bool = False, cu=0.0):
     """``A, B, C, D`` of the quarter car, for one design or a batch.
 
     Numbers give ``A (4, 4)``, ``B (4, k)``, ``C (5, 4)``, ``D (5, k)``;
@@ -365,9 +390,9 @@ def quarter_car_abcd(ms, mu, ks, ku, cs, *, road: bool = False, actuator: bool =
     ``xs``, ``xu``, ``susp_travel = xs - xu``, ``tire_defl = xu - zr`` and
     ``body_acc``, the first row of ``A x + B u`` (exact, no differencing).
     This is the one place the model's matrices are assembled: `quarter_car`
-    and the sweep engine both read it.
+    and the sweep engine both read it. ``cu`` is the tire damping (default 0).
     """
-    A, b_road, b_act = seed_matrices(ms, mu, ks, ku, cs)
+    A, b_road, b_act = seed_matrices(ms, mu, ks, ku, cs, cu)
     batch = A.shape[:-2]
     columns = [b for b, on in ((b_road, road), (b_act, actuator)) if on]
     B = np.stack(columns, axis=-1) if columns else np.zeros(batch + (4, 0))
@@ -426,7 +451,9 @@ def quarter_car(
     1.0
     """
     p = as_params(params)
-    A, B, C, D = quarter_car_abcd(p.ms, p.mu, p.ks, p.ku, p.cs, road=road, actuator=actuator)
+    A, B, C, D = quarter_car_abcd(
+        p.ms, p.mu, p.ks, p.ku, p.cs, road=road, actuator=actuator, cu=p.cu
+    )
     return control.ss(
         A,
         B,
@@ -475,8 +502,10 @@ def quarter_car_model(params=None, *, road: bool = False, actuator: bool = False
 
 def _quarter_car_batch(designs, *, road: bool, actuator: bool) -> BatchedModel:
     """`quarter_car_model`'s matrices for many designs at once (no loop per design)."""
-    ms, mu, ks, ku, cs = (
-        np.array([[d.ms, d.mu, d.ks, d.ku, d.cs] for d in map(as_params, designs)]).reshape(-1, 5).T
+    ms, mu, ks, ku, cs, cu = (
+        np.array([[d.ms, d.mu, d.ks, d.ku, d.cs, d.cu] for d in map(as_params, designs)])
+        .reshape(-1, 6)
+        .T
     )
-    A, B, C, D = quarter_car_abcd(ms, mu, ks, ku, cs, road=road, actuator=actuator)
+    A, B, C, D = quarter_car_abcd(ms, mu, ks, ku, cs, road=road, actuator=actuator, cu=cu)
     return BatchedModel(A, B, C, D, (ku,), ((ms + mu) * STANDARD_GRAVITY,))

@@ -6,6 +6,9 @@ meet the front wheels' road a wheelbase later (`delay`, `axle_inputs`,
 `corner_inputs`), and the left and right tracks of a random road are partly
 correlated (`isotropic_coherence`, `iso8608_tracks`).
 
+A measured profile's International Roughness Index is `iri` (ASTM E1926,
+in `qc_control.ride.roughness`).
+
 Every function returns ``zr`` on a given time grid ``T`` [s]; the random
 road is deterministic for a given seed. A road is an input linear between
 samples (python-control's assumption), so ``control.forced_response``
@@ -21,6 +24,7 @@ import scipy.special
 
 from ..numerics.integrate import check_time_grid, uniform_step
 from ..numerics.limits import check_memory
+from .roughness import IRI_SPEED, SMOOTHING_BASE, IRISegments, golden_car_matrices, iri
 
 __all__ = [
     "step",
@@ -43,6 +47,9 @@ __all__ = [
     "isotropic_coherence",
     "iso8608_profiles",
     "iso8608_tracks",
+    "iri",
+    "iso8608_iri",
+    "IRISegments",
 ]
 
 #: Reference spatial frequency n0 [cycles/m] of ISO 8608.
@@ -415,3 +422,39 @@ def iso8608_tracks(
     x, dx, lo, hi = _distance_grid(T, speed, band)
     xp, zl, zr = iso8608_profiles(max(x[-1], dx), dx, track, road_class, seed, (lo, hi))
     return np.vstack([np.interp(x, xp, zl), np.interp(x, xp, zr)])
+
+
+def iso8608_iri(road_class: str = "C", band=None) -> float:
+    """The expected IRI [m/km] of an ISO 8608 road class, from its spectrum.
+
+    The stroke velocity of the Golden Car on a Gaussian road is Gaussian,
+    so its mean absolute value is ``σ √(2/π)``, with
+
+    .. math:: σ^2 = \\int |H(j 2π n V)|^2\\, \\mathrm{sinc}^2(n L)\\, G_d(n)\\, dn
+
+    over the class's band of spatial frequencies ``n`` [cycles/m]: ``H`` is the
+    road-to-stroke-velocity response, ``sinc(nL)`` the 250 mm moving average
+    and ``G_d(n) = G_d(n_0) (n/n_0)^{-2}`` the class's displacement PSD
+    (ISO 8608; `iso8608_psd`). The IRI of a long profile of
+    the class (`iso8608_profile`) scatters about it.
+
+    Parameters
+    ----------
+    road_class : {'A', ..., 'H'}
+    band : (float, float), optional
+        Spatial frequencies [cycles/m]; default `ISO8608_BAND`.
+
+    Examples
+    --------
+    >>> round(iso8608_iri("A") * 4, 6) == round(iso8608_iri("C"), 6)  # 4x the RMS
+    True
+    """
+    low, high = band_limits(ISO8608_BAND if band is None else band)
+    n = np.geomspace(low, high, 4000)
+    A, B, C = golden_car_matrices()
+    s = 2j * np.pi * n * IRI_SPEED
+    rhs = np.broadcast_to(B, (n.size, 4, 1))
+    H = (C @ np.linalg.solve(s[:, None, None] * np.eye(4) - A, rhs))[:, 0, 0]
+    integrand = np.abs(H) ** 2 * np.sinc(n * SMOOTHING_BASE) ** 2 * iso8608_psd(n, road_class)
+    variance = float(np.sum(np.diff(n) * (integrand[1:] + integrand[:-1]) / 2))
+    return 1000.0 * math.sqrt(variance) * math.sqrt(2 / math.pi) / IRI_SPEED

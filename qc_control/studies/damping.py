@@ -292,7 +292,7 @@ def optimal_damping(
             "[...]}, model=..., road=qc.ISO8608Road(...))"
         )
     closed = isinstance(p, QuarterCarParams) and "comfort_wk" not in weights
-    closed = closed and not isinstance(params, VehicleModel)
+    closed = closed and not isinstance(params, VehicleModel) and not p.cu  # seed's tire
     if method == "closed form" and not closed:
         raise ValueError(
             "no closed form for this objective or vehicle (Wk weighting, or not a quarter "

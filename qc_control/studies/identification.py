@@ -1,0 +1,545 @@
+"""Grey-box identification of the quarter car from measured records.
+
+`identify` fits the quarter car's parameters by output error: the model is
+simulated exactly (`qc_control.numerics.exact`) under the measured inputs
+(road ``zr``, force ``fa``) and `scipy.optimize.least_squares` minimises the
+misfit of the measured outputs, each output's residual divided by that
+output's RMS so that a displacement and an acceleration weigh alike.
+Physical parameters are fitted as logarithms (they stay positive, and their
+steps are relative); input gains, which may be negative (a force channel
+of the opposite sign), are fitted as they are.
+
+What the records can determine is stated, not guessed. Scaling every mass,
+stiffness and damping by one factor leaves the response to the road
+unchanged and scales the response to a force by its inverse; with the road
+as the only input, or a force of unknown gain, only the ratios ``ks/ms``,
+``cs/ms``, ``ku/ms``, ``mu/ms`` (the Golden Car's form) are determined. The
+fit then holds ``ms`` at its start value, reports the ratios with their
+intervals, and names the absolute values undetermined until a mass is fixed.
+A Jacobian that is rank deficient for any other reason is reported the same
+way.
+
+Uncertainty comes from the Jacobian at the optimum (Ljung, *System
+Identification*, 2nd ed., §9.3): the parameters' covariance is the sandwich
+``(JᵀJ)⁻¹ (Σᵢ σᵢ² JᵢᵀJᵢ) (JᵀJ)⁻¹`` with ``σᵢ²`` the residual variance of
+output ``i``, which is ``σ² (JᵀJ)⁻¹`` for one output and stays right when
+the outputs' noise levels differ from their RMS weights.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import scipy.optimize
+import scipy.stats
+
+from ..models.quarter import QuarterCarParams, quarter_car_abcd, quarter_car_model
+from ..models.vehicle import VehicleModel
+from ..numerics.exact import exact_outputs
+from .measurement import INPUT_LABELS, Measurement
+
+__all__ = [
+    "identify",
+    "Identification",
+    "PHYSICAL",
+    "OUTPUT_LABELS",
+    "simulate_quarter",
+    "nrmse_fit",
+    "whiteness",
+]
+
+#: The quarter car's physical parameters that identification can fit.
+PHYSICAL = ("ms", "mu", "ks", "ku", "cs", "cu")
+#: What a fit leaves free by default: all but the tire damping (a seed car).
+DEFAULT_FREE = ("ms", "mu", "ks", "ku", "cs")
+#: The outputs the identified quarter car can be compared on.
+OUTPUT_LABELS = ("xs", "xu", "susp_travel", "tire_defl", "body_acc", "wheel_acc")
+#: A tire damping's start [N·s/m] when it is free and no start is given: a
+#: tire's damping is a few hundred N·s/m, far below the suspension's.
+CU_START = 100.0
+#: Two-sided 95 % quantile of the normal distribution.
+Z95 = 1.959963984540054
+#: A direction of the (column-scaled) Jacobian whose singular value is below
+#: this fraction of the largest is one the data does not determine: finite
+#: differences in double precision resolve about 1e-8 of a residual, so an
+#: exact symmetry shows as 1e-8 or less, and a determined parameter far above.
+RANK_TOLERANCE = 1e-6
+#: Lags of the residuals' autocorrelation checked for whiteness.
+WHITENESS_LAGS = 25
+_UNITS = {"ms": "kg", "mu": "kg", "ks": "N/m", "ku": "N/m", "cs": "N·s/m", "cu": "N·s/m"}
+
+
+def nrmse_fit(measured: np.ndarray, simulated: np.ndarray) -> float:
+    """The NRMSE fit [%] as MATLAB's ``compare`` reports it.
+
+    ``100 (1 - ‖y - ŷ‖ / ‖y - mean(y)‖)``: 100 is a perfect fit, 0 is no
+    better than the mean, and it is negative for a worse one.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> y = np.sin(np.linspace(0, 6, 100))
+    >>> nrmse_fit(y, y), round(nrmse_fit(y, np.zeros(100) + y.mean()), 6)
+    (100.0, 0.0)
+    """
+    y, yhat = np.asarray(measured, dtype=float), np.asarray(simulated, dtype=float)
+    spread = np.linalg.norm(y - y.mean())
+    if spread == 0:
+        return float("nan")
+    return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / spread))
+
+
+def whiteness(residual: np.ndarray, lags: int = WHITENESS_LAGS) -> tuple[float, bool]:
+    """The fraction of autocorrelation lags 1..``lags`` outside ±1.96/√N, and whether
+    the residual passes as white.
+
+    Each lag of a white residual falls outside the band with probability 5 %,
+    so a count of lags outside is binomial: the residual passes unless the
+    count is beyond that binomial's 99th percentile (4 of 25 lags), which a
+    white residual exceeds once in a hundred records; a model error shows as
+    a run of many lags outside.
+    """
+    e = np.asarray(residual, dtype=float) - np.mean(residual)
+    n = e.size
+    denom = float(e @ e)
+    if denom == 0 or n <= lags:
+        return 0.0, True
+    r = np.array([e[:-k] @ e[k:] / denom for k in range(1, lags + 1)])
+    outside = int(np.sum(np.abs(r) > Z95 / math.sqrt(n)))
+    return outside / lags, outside <= scipy.stats.binom.ppf(0.99, lags, 0.05)
+
+
+def _quarter_matrices(values: Mapping[str, float]):
+    """``A, B, C, D`` of the quarter car with inputs ``[zr, fa]`` and outputs
+    `OUTPUT_LABELS` (the wheel's acceleration as the second row of ``A x + B u``)."""
+    A, B, C, D = quarter_car_abcd(
+        values["ms"],
+        values["mu"],
+        values["ks"],
+        values["ku"],
+        values["cs"],
+        road=True,
+        actuator=True,
+        cu=values["cu"],
+    )
+    C = np.concatenate([C, A[None, 1, :]])
+    D = np.concatenate([D, B[None, 1, :]])
+    return A, B, C, D
+
+
+def simulate_quarter(
+    values: Mapping[str, float],
+    measurement: Measurement,
+    outputs: Sequence[str],
+    gains: Mapping[str, float] | None = None,
+    x0: np.ndarray | None = None,
+) -> np.ndarray:
+    """The quarter car's outputs, exact, under a measurement's inputs.
+
+    Parameters
+    ----------
+    values : mapping
+        ``ms, mu, ks, ku, cs, cu``.
+    measurement : Measurement
+        Its ``zr`` and ``fa`` are the inputs (zero where absent), each times
+        its gain.
+    outputs : sequence of str
+        Labels among `OUTPUT_LABELS`.
+    gains : mapping, optional
+        ``{input: gain}``: the model's input is ``gain × recorded``.
+    x0 : array, shape (4,), optional
+        The initial state; by default the car at rest in equilibrium with
+        the first input samples.
+
+    Returns
+    -------
+    ndarray, shape (len(outputs), N)
+    """
+    gains = gains or {}
+    A, B, C, D = _quarter_matrices(values)
+    N = len(measurement)
+    U = np.zeros((2, N))
+    for i, label in enumerate(INPUT_LABELS):
+        if label in measurement.signals:
+            U[i] = gains.get(label, 1.0) * measurement[label]
+    rows = [OUTPUT_LABELS.index(k) for k in outputs]
+    if x0 is None:  # at rest: x' = 0 under the first input
+        x0 = -np.linalg.solve(A, B @ U[:, 0])
+    y = exact_outputs(A, B, C[rows], D[rows], measurement.dt, U, x0)
+    if values["cu"] and "wheel_acc" in outputs:
+        # the wheel's acceleration is q' + (cu/mu) zr' (the state q hides the road's rate):
+        # the one place the recorded road is differentiated, for this output only
+        zr_rate = np.gradient(U[0], measurement.dt)
+        y[list(outputs).index("wheel_acc")] += values["cu"] / values["mu"] * zr_rate
+    return y
+
+
+@dataclass
+class _Problem:
+    """What the optimiser varies and how the values of the car follow from it."""
+
+    measurement: Measurement
+    outputs: tuple[str, ...]
+    base: dict[str, float]  # every physical value (the fixed ones final)
+    free: tuple[str, ...]  # physical parameters fitted (as logarithms)
+    gains: tuple[str, ...]  # inputs whose gain is fitted
+    estimate_x0: bool
+    weights: np.ndarray  # 1 / RMS of each measured output
+
+    def names(self) -> list[str]:
+        x0 = ["x0_vs", "x0_vu", "x0_xs", "x0_xu"] if self.estimate_x0 else []
+        return list(self.free) + [f"gain_{g}" for g in self.gains] + x0
+
+    def unpack(self, theta: np.ndarray):
+        values = dict(self.base)
+        k = len(self.free)
+        values.update(zip(self.free, np.exp(theta[:k])))
+        gains = dict(zip(self.gains, theta[k : k + len(self.gains)]))
+        x0 = theta[k + len(self.gains) :] if self.estimate_x0 else None
+        return values, gains, x0
+
+    def simulate(self, theta: np.ndarray) -> np.ndarray:
+        values, gains, x0 = self.unpack(theta)
+        return simulate_quarter(values, self.measurement, self.outputs, gains, x0)
+
+    def measured(self) -> np.ndarray:
+        return np.stack([self.measurement[k] for k in self.outputs])
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        e = (self.simulate(theta) - self.measured()) * self.weights[:, None]
+        return e.ravel()
+
+
+@dataclass
+class Identification:
+    """The result of `identify`.
+
+    Attributes
+    ----------
+    params : QuarterCarParams
+        The identified car (undetermined values at their start, see
+        ``undetermined``).
+    model : VehicleModel
+        The identified car with inputs ``zr`` and ``fa``.
+    gains : dict
+        ``{input: gain}``: the model's input is ``gain × recorded``.
+    x0 : ndarray
+        The initial state used (at rest, or estimated).
+    table : pandas.DataFrame
+        One row per fitted quantity: ``estimate``, ``std_error``,
+        ``ci_low``, ``ci_high`` (95 %), ``unit``, ``determined``.
+    correlation : pandas.DataFrame
+        The estimates' correlation matrix.
+    fit : pandas.Series
+        NRMSE fit [%] of each output.
+    whiteness : pandas.DataFrame
+        Per output: the fraction of autocorrelation lags outside the 95 %
+        band and whether the residual passes as white.
+    undetermined : tuple of str
+        Parameters the records do not determine.
+    ratios : pandas.DataFrame or None
+        When absolute values are undetermined, the ratios that are:
+        ``ks/ms``, ``cs/ms``, ``ku/ms``, ``mu/ms`` (and ``cu/ms``, gains
+        over ``ms``) with 95 % intervals.
+    notes : list of str
+        What the fit assumed or could not do, in words.
+    outputs : tuple of str
+    success : bool
+    nfev : int
+    """
+
+    params: QuarterCarParams
+    model: VehicleModel
+    gains: dict[str, float]
+    x0: np.ndarray
+    table: pd.DataFrame
+    correlation: pd.DataFrame
+    fit: pd.Series
+    whiteness: pd.DataFrame
+    undetermined: tuple[str, ...]
+    ratios: pd.DataFrame | None
+    notes: list[str]
+    outputs: tuple[str, ...]
+    success: bool
+    nfev: int
+    values: dict[str, float] = field(repr=False, default_factory=dict)
+
+    def simulate(self, measurement: Measurement, *, at_rest: bool = True) -> np.ndarray:
+        """The identified car's outputs under ``measurement``'s inputs, ``(outputs, N)``.
+
+        The record is taken to start at rest (``at_rest``), as a held-out
+        one is; False starts from the identified ``x0``.
+        """
+        x0 = None if at_rest else self.x0
+        return simulate_quarter(self.values, measurement, self.outputs, self.gains, x0)
+
+    def validate(self, other: Measurement) -> pd.Series:
+        """The fit [%] of each output on a second, held-out measurement."""
+        missing = [k for k in self.outputs if k not in other.signals]
+        if missing:
+            raise ValueError(f"the validation record lacks the output(s) {missing}")
+        y = self.simulate(other)
+        fits = {k: nrmse_fit(other[k], y[i]) for i, k in enumerate(self.outputs)}
+        return pd.Series(fits, name="fit [%]")
+
+    def __str__(self) -> str:
+        lines = ["Identified quarter car", self.table.to_string(float_format="{:.6g}".format)]
+        if self.ratios is not None:
+            lines += ["Determined ratios", self.ratios.to_string(float_format="{:.6g}".format)]
+        lines += ["Fit [%]", self.fit.to_string(float_format="{:.2f}".format)]
+        lines += [f"note: {n}" for n in self.notes]
+        return "\n".join(lines)
+
+
+def _as_names(values: Iterable[str] | None, what: str, allowed: Sequence[str]) -> tuple[str, ...]:
+    names = tuple(values or ())
+    for name in names:
+        if name not in allowed:
+            raise ValueError(f"{what} {name!r} is not one of {', '.join(allowed)}")
+    return names
+
+
+def _positive_values(values: Mapping[str, Any] | None, what: str) -> dict[str, float]:
+    out = {}
+    for name, value in (values or {}).items():
+        if name not in PHYSICAL:
+            raise ValueError(f"{what} parameter {name!r} is not one of {', '.join(PHYSICAL)}")
+        value = float(value)
+        if not math.isfinite(value) or value < 0 or (value == 0 and name != "cu"):
+            raise ValueError(f"{what} value of {name!r} must be > 0, got {value!r}")
+        out[name] = value
+    return out
+
+
+def _setup(measurement, free, fixed, start, gains, outputs) -> tuple[dict, tuple, tuple, tuple]:
+    """Checked arguments: the start values, free parameters, gains and outputs."""
+    if not isinstance(measurement, Measurement):
+        raise TypeError(f"measurement must be a Measurement, got {type(measurement).__name__}")
+    if not measurement.inputs:
+        raise ValueError("the measurement has no input: record the road zr or the force fa")
+    fixed_values = _positive_values(fixed, "fixed")
+    start_values = _positive_values(start, "start")
+    free_names = _as_names(DEFAULT_FREE if free is None else free, "free parameter", PHYSICAL)
+    free_names = tuple(n for n in free_names if n not in fixed_values)
+    gain_names = _as_names(gains, "gain", measurement.inputs)
+    outs = _as_names(
+        [k for k in measurement.outputs if k in OUTPUT_LABELS] if outputs is None else outputs,
+        "output",
+        [k for k in measurement.outputs if k in OUTPUT_LABELS],
+    )
+    if not outs:
+        raise ValueError(
+            f"the measurement has no output the model gives; expected one of {OUTPUT_LABELS}"
+        )
+    seed = QuarterCarParams()
+    base = {n: float(getattr(seed, n)) for n in PHYSICAL}
+    if "cu" in free_names:
+        base["cu"] = CU_START
+    base.update(start_values)
+    base.update(fixed_values)
+    if "cu" in free_names and base["cu"] == 0:
+        raise ValueError("a free cu needs a start > 0 (it is fitted as a logarithm)")
+    return base, free_names, gain_names, outs
+
+
+def _scale_free(base, free, gains, measurement) -> bool:
+    """Whether the records leave the absolute scale undetermined (see the module's note)."""
+    pinned = any(base[n] > 0 and n not in free for n in PHYSICAL)
+    force_known = "fa" in measurement.inputs and "fa" not in gains
+    return not pinned and not force_known
+
+
+def identify(
+    measurement: Measurement,
+    model: str = "quarter",
+    *,
+    free: Iterable[str] | None = None,
+    fixed: Mapping[str, float] | None = None,
+    start: Mapping[str, float] | None = None,
+    gains: Iterable[str] = (),
+    outputs: Iterable[str] | None = None,
+    x0: str = "rest",
+) -> Identification:
+    """Fit the quarter car to measured records by output error.
+
+    Parameters
+    ----------
+    measurement : Measurement
+        Inputs ``zr`` and/or ``fa``; outputs among `OUTPUT_LABELS`.
+    model : {'quarter'}
+        The model fitted (the quarter car, with its tire damping ``cu``).
+    free : iterable of str, optional
+        Parameters to fit among ``ms, mu, ks, ku, cs, cu``; default all but
+        ``cu`` (which stays at its start, 0 unless given).
+    fixed : mapping, optional
+        ``{name: value}`` held at known values (a weighed mass).
+    start : mapping, optional
+        ``{name: value}`` to start from; the seed's car otherwise.
+    gains : iterable of str
+        Inputs whose gain (scale and sign) is fitted too: the model's input
+        is ``gain × recorded``. Starts at 1.
+    outputs : iterable of str, optional
+        The measured outputs fitted; default all that the model gives.
+    x0 : {'rest', 'estimate'}
+        The record starts at rest (in equilibrium with its first inputs),
+        or its initial state is fitted too.
+
+    Returns
+    -------
+    Identification
+
+    Raises
+    ------
+    ValueError
+        For an unknown model, parameter, gain or output, a value <= 0, or
+        a measurement without inputs or fitted outputs.
+    """
+    if model != "quarter":
+        raise ValueError(f"identify fits the quarter car: model must be 'quarter', got {model!r}")
+    if x0 not in ("rest", "estimate"):
+        raise ValueError(f"x0 must be 'rest' or 'estimate', got {x0!r}")
+    base, free_names, gain_names, outs = _setup(measurement, free, fixed, start, gains, outputs)
+    notes = list(measurement.notes)
+    pinned_for_scale = _scale_free(base, free_names, gain_names, measurement) and (
+        "ms" in free_names
+    )
+    fitted = tuple(n for n in free_names if not (pinned_for_scale and n == "ms"))
+    rms = np.array([np.sqrt(np.mean(measurement[k] ** 2)) for k in outs])
+    if np.any(rms == 0):
+        raise ValueError(f"output {outs[int(np.argmin(rms))]!r} is zero throughout")
+    problem = _Problem(measurement, outs, base, fitted, gain_names, x0 == "estimate", 1.0 / rms)
+    theta0 = np.concatenate(
+        [np.log([base[n] for n in fitted]), np.ones(len(gain_names)), np.zeros(4 * (x0 != "rest"))]
+    )
+    if x0 == "estimate":  # start from rest in equilibrium with the first inputs
+        theta0[len(fitted) + len(gain_names) :] = _rest_state(problem, theta0)
+    solution = scipy.optimize.least_squares(
+        problem.residuals, theta0, method="trf", x_scale="jac", xtol=1e-12, ftol=1e-12
+    )
+    if not solution.success:
+        notes.append(f"the optimiser stopped: {solution.message}")
+    return _result(problem, solution, pinned_for_scale, notes)
+
+
+def _rest_state(problem: _Problem, theta: np.ndarray) -> np.ndarray:
+    values, gains, _ = problem.unpack(theta)
+    A, B, _, _ = _quarter_matrices(values)
+    signals = problem.measurement.signals
+    u0 = [gains.get(k, 1.0) * signals[k][0] if k in signals else 0.0 for k in INPUT_LABELS]
+    return -np.linalg.solve(A, B @ np.array(u0))
+
+
+def _covariance(n_out: int, J: np.ndarray, residual: np.ndarray):
+    """The sandwich covariance (module note) and the directions not determined;
+    the residual holds ``n_out`` outputs' blocks of equal length."""
+    p = J.shape[1]
+    norms = np.linalg.norm(J, axis=0)
+    norms[norms == 0] = 1.0
+    Js = J / norms  # column scaling: the rank test then sees directions, not units
+    _, s, Vt = np.linalg.svd(Js, full_matrices=False)
+    null = s < RANK_TOLERANCE * s[0]
+    N = residual.size // n_out
+    Jo = Js.reshape(n_out, N, p)
+    eo = residual.reshape(n_out, N)
+    sigma2 = np.sum(eo**2, axis=1) / max(N - p / n_out, 1.0)
+    inv = np.linalg.pinv(Js.T @ Js, rcond=RANK_TOLERANCE**2)
+    meat = sum(sigma2[i] * Jo[i].T @ Jo[i] for i in range(n_out))
+    cov = inv @ meat @ inv / np.outer(norms, norms)
+    # a parameter with a weight over 1 % in a null direction is not determined
+    undetermined = np.any(np.abs(Vt[null]) > 0.01, axis=0) if null.any() else np.zeros(p, bool)
+    return cov, undetermined
+
+
+def _table(names, theta, cov, undetermined, n_log) -> pd.DataFrame:
+    se = np.sqrt(np.clip(np.diag(cov), 0, None))
+    rows = []
+    for i, name in enumerate(names):
+        if i < n_log:  # fitted as a logarithm: the interval is exp of a symmetric one
+            value = math.exp(theta[i])
+            low, high = math.exp(theta[i] - Z95 * se[i]), math.exp(theta[i] + Z95 * se[i])
+            std = value * se[i]
+            unit = _UNITS[name]
+        else:
+            value, std = float(theta[i]), float(se[i])
+            low, high = value - Z95 * std, value + Z95 * std
+            unit = "-" if name.startswith("gain_") else ("m/s" if name[3] == "v" else "m")
+        rows.append((name, value, std, low, high, unit, not undetermined[i]))
+    columns = ["parameter", "estimate", "std_error", "ci_low", "ci_high", "unit", "determined"]
+    return pd.DataFrame(rows, columns=columns).set_index("parameter")
+
+
+def _ratios(table: pd.DataFrame, ms: float) -> pd.DataFrame:
+    """The ratios to ``ms`` (held at its start): each one's interval is its parameter's."""
+    rows = []
+    for name in table.index:
+        if name.startswith("x0_"):
+            continue
+        row = table.loc[name]
+        unit = {"mu": "-", "ks": "1/s²", "ku": "1/s²", "cs": "1/s", "cu": "1/s"}.get(name, "1/kg")
+        rows.append((f"{name}/ms", row.estimate / ms, row.ci_low / ms, row.ci_high / ms, unit))
+    columns = ["ratio", "estimate", "ci_low", "ci_high", "unit"]
+    return pd.DataFrame(rows, columns=columns).set_index("ratio")
+
+
+def _result(problem: _Problem, solution, pinned_for_scale, notes, covariance=None):
+    """The `Identification` of a solved problem; ``covariance`` is ``(cov,
+    undetermined)`` when the fit was not this problem's (the frequency domain)."""
+    names = problem.names()
+    theta = solution.x
+    if covariance is None:
+        covariance = _covariance(len(problem.outputs), solution.jac, solution.fun)
+    cov, undetermined = covariance
+    table = _table(names, theta, cov, undetermined, len(problem.free))
+    sd = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
+    correlation = pd.DataFrame(cov / np.outer(sd, sd), index=names, columns=names)
+    values, gains, x0 = problem.unpack(theta)
+    if x0 is None:
+        x0 = _rest_state(problem, theta)
+    y = problem.simulate(theta)
+    measured = problem.measured()
+    fit = pd.Series(
+        {k: nrmse_fit(measured[i], y[i]) for i, k in enumerate(problem.outputs)}, name="fit [%]"
+    )
+    white = [whiteness(measured[i] - y[i]) for i in range(len(problem.outputs))]
+    whiteness_table = pd.DataFrame(
+        white, index=list(problem.outputs), columns=["lags_outside", "white"]
+    )
+    undetermined_names = [n for n, u in zip(names, undetermined) if u]
+    ratios = None
+    if pinned_for_scale:
+        undetermined_names = ["ms", *undetermined_names]
+        ratios = _ratios(table, values["ms"])
+        notes.append(
+            "the records leave the absolute scale undetermined (the road is the only known "
+            "input, or the force's gain is free): ms is held at "
+            f"{values['ms']:.6g} kg and every other value follows it; the ratios to ms are "
+            "determined. Fix a mass (fixed={'ms': ...}) for absolute values"
+        )
+    elif undetermined_names:
+        notes.append(
+            "the Jacobian is rank deficient: the records do not determine "
+            + ", ".join(undetermined_names)
+        )
+    params = QuarterCarParams(**{n: values[n] for n in PHYSICAL})
+    return Identification(
+        params=params,
+        model=quarter_car_model(params, road=True, actuator=True),
+        gains=gains,
+        x0=np.asarray(x0, dtype=float),
+        table=table,
+        correlation=correlation,
+        fit=fit,
+        whiteness=whiteness_table,
+        undetermined=tuple(undetermined_names),
+        ratios=ratios,
+        notes=notes,
+        outputs=problem.outputs,
+        success=bool(solution.success),
+        nfev=int(solution.nfev),
+        values=values,
+    )

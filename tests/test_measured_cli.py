@@ -1,0 +1,86 @@
+"""``qc-control identify`` and ``qc-control iri`` (qc_control.cli.measured)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import qc_control as qc
+from qc_control.cli.parser import run
+
+DATA = Path(qc.__file__).parent / "data"
+
+
+def test_iri_prints_the_profile_and_segment_values(tmp_path, capsys):
+    x = np.arange(0.0, 500.0, 0.05)
+    z_mm = 3.0 * np.sin(2 * np.pi * x / 8.0) + 1.0 * np.sin(2 * np.pi * x / 1.7)
+    path = tmp_path / "profile.csv"
+    pd.DataFrame({"dist": x, "elev_mm": z_mm}).to_csv(path, index=False)
+    assert run(["iri", str(path), "--x", "dist", "--z", "elev_mm", "--z-scale", "0.001"]) == 0
+    printed = float(re.search(r"IRI (\S+) m/km", capsys.readouterr().out).group(1))
+    # the library's value, to the 3 decimals printed
+    assert printed == pytest.approx(qc.road.iri(x, z_mm / 1000), abs=5e-4)
+    # the same profile in mm read as metres: the IRI is linear in the profile, 1000x
+    assert run(["iri", str(path), "--x", "dist", "--z", "elev_mm", "--segment", "100"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 1 + 5 + 1  # header, five 100 m segments, the whole
+    overall = float(re.search(r"IRI (\S+) m/km", lines[-1]).group(1))
+    assert overall == pytest.approx(1000 * printed, rel=1e-3)
+
+
+def test_iri_bad_input_is_one_line_and_status_2(tmp_path, capsys):
+    path = tmp_path / "p.csv"
+    pd.DataFrame({"x": [0.0, 0.1, 0.1, 0.3], "z": [0.0] * 4}).to_csv(path, index=False)
+    assert run(["iri", str(path), "--x", "x", "--z", "z"]) == 2
+    assert "x must increase" in capsys.readouterr().err
+    assert run(["iri", str(path), "--x", "dist", "--z", "z"]) == 2
+    assert "column 'dist' is not among" in capsys.readouterr().err
+
+
+def test_identify_bad_map_names_the_column(tmp_path, capsys):
+    argv = ["identify", str(DATA / "rig_identification.csv"), "--time", "time_s"]
+    assert run([*argv, "--map", "zr=base_mm,speed=force_N", "--out", str(tmp_path / "r")]) == 2
+    assert "unknown label 'speed' for column 'force_N'" in capsys.readouterr().err
+    assert run([*argv, "--map", "zr", "--out", str(tmp_path / "r")]) == 2
+    assert "--map expects NAME=VALUE" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_identify_writes_the_report_with_the_command(tmp_path, capsys):
+    out = tmp_path / "report"
+    argv = [
+        "identify",
+        str(DATA / "rig_identification.csv"),
+        "--time",
+        "time_s",
+        "--map",
+        "zr=base_mm,fa=force_N,susp_travel=travel_mm,body_acc=body_acc_ms2,wheel_acc=wheel_acc_ms2",
+        "--units",
+        "zr=mm,susp_travel=mm",
+        "--gains",
+        "fa",
+        "--fix",
+        "ms=320",
+        "--free",
+        "mu,ks,ku,cs,cu",
+        "--start",
+        "cu=100",
+        "--validate",
+        str(DATA / "rig_validation.csv"),
+        "--out",
+        str(out),
+    ]
+    assert run(argv) == 0
+    table = pd.read_csv(out / "parameters.csv", index_col=0)
+    # the simulated rig's car (examples/make_rig_dataset.py) within 1 %
+    truth = dict(mu=45.0, ks=22000.0, ku=190000.0, cs=1800.0, cu=150.0)
+    for name, value in truth.items():
+        assert table.loc[name, "estimate"] == pytest.approx(value, rel=0.01), name
+    assert table.loc["gain_fa", "estimate"] == pytest.approx(-1.0, rel=0.01)
+    report = (out / "report.md").read_text(encoding="utf-8")
+    assert "qc-control identify" in report and "--gains fa" in report
+    assert (out / "validation_records.png").exists()

@@ -1,0 +1,64 @@
+"""The shipped rig records (qc_control/data) and the example that identifies a car
+from them: remade to the byte by their script, and the car found within 1 %."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from qc_control.studies.measurement import rig_record
+
+ROOT = Path(__file__).parent.parent
+DATA = ROOT / "qc_control" / "data"
+ENV = {"MPLBACKEND": "Agg", "PATH": ""}
+
+
+def test_shipped_records_are_small_and_say_they_are_simulated():
+    for name in ("rig_identification.csv", "rig_validation.csv"):
+        path = DATA / name
+        assert path.stat().st_size < 200_000  # "a few hundred kB at most", both together
+        assert path.read_text(encoding="utf-8").startswith("# SIMULATED")
+    record = rig_record()
+    assert record.inputs == ("zr", "fa") and len(record) == 3001 and record.dt == 0.005
+    with pytest.raises(ValueError, match="part must be"):
+        rig_record("training")
+
+
+@pytest.mark.slow
+def test_the_script_remakes_the_shipped_records(tmp_path):
+    script = ROOT / "examples" / "make_rig_dataset.py"
+    out = subprocess.run(
+        [sys.executable, str(script), str(tmp_path)], capture_output=True, text=True, env=ENV
+    )
+    assert out.returncode == 0, out.stderr
+    for name in ("rig_identification.csv", "rig_validation.csv"):
+        assert (tmp_path / name).read_bytes() == (DATA / name).read_bytes(), name
+
+
+@pytest.mark.slow
+def test_the_example_identifies_the_simulated_car(tmp_path):
+    out_dir = tmp_path / "a" / "rig"
+    run = subprocess.run(
+        [sys.executable, str(ROOT / "examples" / "identify_rig.py"), str(out_dir)],
+        capture_output=True,
+        text=True,
+        env=ENV,
+        timeout=600,
+    )
+    assert run.returncode == 0, run.stderr
+    table = pd.read_csv(out_dir / "parameters.csv", index_col=0)
+    # the car examples/make_rig_dataset.py simulated; 1 % sensor noise on 3001 samples
+    # leaves standard errors of 0.03-0.3 %, so 1 % holds with margin
+    truth = dict(mu=45.0, ks=22000.0, ku=190000.0, cs=1800.0, cu=150.0)
+    for name, value in truth.items():
+        assert table.loc[name, "estimate"] == pytest.approx(value, rel=0.01), name
+        assert table.loc[name, "ci_low"] <= value <= table.loc[name, "ci_high"], name
+    # the force channel was written with the opposite sign
+    assert table.loc["gain_fa", "estimate"] == pytest.approx(-1.0, rel=0.01)
+    fit = pd.read_csv(out_dir / "fit.csv", index_col=0)
+    assert (fit["validation"] > 98.0).all()  # 1 % noise caps the fit near 99 %
+    assert (out_dir / "report.html").exists() and (out_dir / "validation_psd.png").exists()
