@@ -699,6 +699,8 @@ def mpc_benchmark(quick: bool) -> tuple[list[str], list[str], list[list[str]]]:
     ]
     rows.append(["closed loop, preview 0.5 s", g(t_loop * 1e3), "", "", "", ""])
     return md, head, rows
+
+
 def identification_benchmark(quick: bool):
     """Issue 26: ``qc.identify`` of six parameters (mu, ks, ku, cs, cu and the force's
     gain, ms weighed) from 30 s of rig records at 500 Hz (smoke: 5 s), noise-free, from a
@@ -780,17 +782,13 @@ def main(argv=None) -> int:
     )
     args = ap.parse_args(argv)
     quick = args.quick
-    if args.only == "interconnect":
-        _, head, rows = interconnect_benchmark(quick)
-        print(table(head, rows))
-        return 0
-    if args.only == "mpc":
-        lines, _, _ = mpc_benchmark(quick)
-        print("\n".join(lines))
-        return 0
-    if args.only == "identify":
-        _, head, rows, _ = identification_benchmark(quick)
-        print(table(head, rows))
+    alone = {
+        "interconnect": lambda: table(*interconnect_benchmark(quick)[1:]),
+        "mpc": lambda: "\n".join(mpc_benchmark(quick)[0]),
+        "identify": lambda: table(*identification_benchmark(quick)[1:3]),
+    }
+    if args.only is not None:
+        print(alone[args.only]())
         return 0
     repeats = 1 if quick else 7
     n_samples = 1001 if quick else 10001  # the issue's default grid: 0-10 s at 1 ms

@@ -90,10 +90,8 @@ def _check_time(t: np.ndarray, column: str, first_row: int) -> None:
 
 def _check_signal(label: str, values, n: int, column: str, first_row: int, t) -> np.ndarray:
     if label not in SIGNAL_UNITS:
-        raise ValueError(
-            f"unknown label {label!r} for column {column!r}; expected one of "
-            f"{', '.join(sorted(SIGNAL_UNITS))}"
-        )
+        known = ", ".join(sorted(SIGNAL_UNITS))
+        raise ValueError(f"unknown label {label!r} for column {column!r}; expected one of {known}")
     try:
         x = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
