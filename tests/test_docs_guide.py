@@ -32,6 +32,7 @@ TOPICS = (
     "methods",
     "nonlinear",
     "control",
+    "identification",
     "vehicles",
     "roads",
     "sweeps",
