@@ -45,6 +45,7 @@ from ..responses.timeresp import (
     input_output_response,
 )
 from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
+from .peers import RTOLS, WorkPrecision, check_solvers, work_precision
 
 __all__ = [
     "ReferenceBudgetError",
@@ -191,6 +192,10 @@ class MethodComparison(ComparisonProblem):
     nonlinear : NonlinearStudy or None
         On a nonlinear system: events, the order with and without them,
         where Midpoint and Heun part, the linearisation behind ``modes``.
+    peers : WorkPrecision or None
+        With ``solvers``: every run of the work–precision study (the
+        fixed-step ladder, the peers and the adaptive pairs over the
+        tolerances), `qc_control.studies.peers`.
     """
 
     table: pd.DataFrame
@@ -213,6 +218,7 @@ class MethodComparison(ComparisonProblem):
     transmissibility: Transmissibility | None = None
     scenario: Provenance | None = None
     nonlinear: NonlinearStudy | None = None
+    peers: WorkPrecision | None = None
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""
@@ -934,6 +940,8 @@ def compare_methods(
     params: Any = None,
     events: bool | None = None,
     levels: int | None = None,
+    solvers: Sequence[str] | None = None,
+    rtols: Sequence[float] = RTOLS,
 ) -> MethodComparison:
     """Compare fixed-step methods with python-control's exact response.
 
@@ -991,6 +999,14 @@ def compare_methods(
         Nonlinear systems only: refinements h, h/2, ..., h/2**levels of the
         convergence study (default `NONLINEAR_LEVELS`, 2; a linear
         comparison always refines 5 times).
+    solvers : sequence of str, optional
+        Peers to run beside the methods (`qc_control.studies.peers.SOLVERS`:
+        ``'RK45'``, ``'DOP853'``, ``'LSODA'``, ``'Radau'``, ``'BDF'`` through
+        ``solve_ivp``, ``'control'`` through ``control.input_output_response``
+        at its defaults), each over ``rtols``, measured against the same
+        reference; ``cmp.peers`` holds the work–precision study.
+    rtols : sequence of float, default 1e-3, 1e-4, ..., 1e-10
+        The peers' tolerance ladder (and the embedded qc pairs').
 
     Returns
     -------
@@ -1025,6 +1041,7 @@ def compare_methods(
     """
     sys, model, params = _as_model(sys, U, params)
     problem = _checked_problem(sys, model, params, T, X0, U, methods, h, repeats)
+    peers = check_solvers(solvers)
     if is_nonlinear_system(sys):
         measured = _measure_nonlinear(problem, events, levels, timing, progress)
     else:
@@ -1034,7 +1051,31 @@ def compare_methods(
                 "no switching and always refines h five times"
             )
         measured = _measure_linear(problem, repeats, timing, progress)
-    return _comparison(problem, measured, input_description)
+    cmp = _comparison(problem, measured, input_description)
+    if peers:
+        cmp.peers = _peer_study(problem, measured, peers, rtols, progress)
+    return cmp
+
+
+def _peer_study(
+    problem: ComparisonProblem, measured: _Measured, solvers, rtols, progress
+) -> WorkPrecision:
+    """The work–precision study: the peers beside the methods' convergence ladder."""
+    sys = problem.system
+    return work_precision(
+        sys,
+        problem.T,
+        problem.X0,
+        problem.U,
+        measured.reference.response,
+        list(sys.output_labels).index(problem.model.body_disp),
+        measured.convergence,
+        methods=problem.methods,
+        solvers=solvers,
+        rtols=rtols,
+        reference_name=measured.reference.name,
+        progress=progress,
+    )
 
 
 # ---------------------------------------------------------------- nonlinear systems
