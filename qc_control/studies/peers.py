@@ -32,7 +32,7 @@ import math
 import time
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import control
 import numpy as np
@@ -180,18 +180,15 @@ def _control_run(sys, f, T, x0, budget):
     return x, counted.calls, counted.calls, 0, "control.input_output_response defaults", True
 
 
-def _body_rows(sys, x: np.ndarray | None, T, U, body: int) -> np.ndarray | None:
-    """The body displacement along the states ``x (n, N)``: a linear car's ``C x + D u``."""
+def _outputs_of(sys, x: np.ndarray | None, T, U) -> np.ndarray | None:
+    """The outputs ``(noutputs, N)`` along the states ``x (n, N)``: a linear car's ``C x + D u``."""
     if x is None:
         return None
-    if not is_nonlinear_system(sys):
-        y = np.asarray(sys.C, dtype=float)[body] @ x
-        if U is not None and sys.ninputs:
-            y = y + np.asarray(sys.D, dtype=float)[body] @ U
-        return y
     u = np.zeros((sys.ninputs, T.size)) if U is None else U
+    if not is_nonlinear_system(sys):
+        return np.asarray(sys.C, dtype=float) @ x + np.asarray(sys.D, dtype=float) @ u
     g = compat.output_function(sys)
-    return np.array([g(t, x[:, k], u[:, k])[body] for k, t in enumerate(T)])
+    return np.column_stack([g(t, x[:, k], u[:, k]) for k, t in enumerate(T)])
 
 
 def _error(y: np.ndarray | None, reference: np.ndarray) -> float:
@@ -233,15 +230,17 @@ def solver_runs(
     repeats: int = 1,
     budget: int = MAX_EVALUATIONS,
     progress: Callable[[str], None] | None = None,
-) -> pd.DataFrame:
+) -> tuple[pd.DataFrame, dict]:
     """Each peer over the tolerance ladder (``control`` once, at its defaults).
 
     Returns a long frame: kind (``'solver'``), name, rtol, atol (the largest
     of the per-state values), h (NaN), error [m], evaluations, nfev, njev,
-    time [s], success, message, default (python-control's default call).
+    time [s], success, message, default (python-control's default call);
+    and per peer the outputs ``(noutputs, N)`` of its loosest run (None
+    where it did not finish).
     """
     f = _derivative(problem.sys, problem.T, problem.U)
-    rows = []
+    rows, loosest = [], {}
     for solver in check_solvers(solvers):
         ladder = [_CONTROL_DEFAULTS[0]] if solver == "control" else list(_check_rtols(rtols))
         for rtol in ladder:
@@ -256,7 +255,8 @@ def solver_runs(
                     s, f, problem.T, problem.X0, r, a, budget
                 )
             (x, evaluations, nfev, njev, message, ok), seconds = _timed(run, repeats)
-            y = _body_rows(problem.sys, x, problem.T, problem.U, problem.body)
+            y = _outputs_of(problem.sys, x, problem.T, problem.U)
+            loosest.setdefault(solver, y)
             rows.append(
                 {
                     "kind": "solver",
@@ -264,7 +264,7 @@ def solver_runs(
                     "rtol": rtol,
                     "atol": float(np.max(atol)),
                     "h": math.nan,
-                    "error": _error(y, problem.reference),
+                    "error": _error(None if y is None else y[problem.body], problem.reference),
                     "evaluations": evaluations,
                     "nfev": nfev,
                     "njev": njev,
@@ -274,7 +274,7 @@ def solver_runs(
                     "default": solver == "control",
                 }
             )
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows), loosest
 
 
 def adaptive_runs(
@@ -369,6 +369,9 @@ class WorkPrecision:
         What the errors are measured against.
     atol_rule : str
         How each run's atol was set.
+    loosest_outputs : dict
+        Per peer, the outputs ``(noutputs, N)`` of its run at the loosest
+        tolerance (``'control'``: its defaults); None where it did not finish.
     tolerance : float
         The accuracy [m] `cheapest` names a winner for (`PEER_TOLERANCE`).
     """
@@ -376,6 +379,7 @@ class WorkPrecision:
     runs: pd.DataFrame
     reference_name: str
     atol_rule: str
+    loosest_outputs: dict = field(default_factory=dict)
     tolerance: float = PEER_TOLERANCE
 
     def cheapest(self, by: str = "evaluations", tolerance: float | None = None) -> pd.Series | None:
@@ -456,10 +460,11 @@ def work_precision(
     scale = np.maximum(scale, 1e-6 * max(float(scale.max()), 1e-12))
     ref_body = np.asarray(reference.outputs, dtype=float).reshape(sys.noutputs, -1)[body]
     problem = _Problem(sys, T, np.asarray(X0, dtype=float), U, body, ref_body, scale)
+    peers, loosest = solver_runs(problem, solvers, rtols, repeats=repeats, progress=progress)
     frames = [
         _fixed_rows(convergence),
         adaptive_runs(problem, methods, rtols, repeats=repeats, progress=progress),
-        solver_runs(problem, solvers, rtols, repeats=repeats, progress=progress),
+        peers,
     ]
     runs = pd.concat([f for f in frames if not f.empty], ignore_index=True)
     return WorkPrecision(
@@ -467,4 +472,5 @@ def work_precision(
         reference_name,
         "atol = rtol · max|x_i| per state over the reference (python-control's default "
         "call keeps scipy's atol 1e-6)",
+        loosest,
     )
