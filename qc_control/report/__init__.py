@@ -44,6 +44,7 @@ from .figures import (
 )
 from .findings import findings
 from .nonlinear import nonlinear_blocks, nonlinear_figures, nonlinear_tables, reference_text
+from .peers import peer_blocks, peer_figures, peer_tables
 from .pdf import to_pdf
 
 if TYPE_CHECKING:
@@ -252,6 +253,7 @@ def figure_specs(cmp) -> list[FigureSpec]:
             *_response_figures(cmp),
             *_analysis_figures(cmp),
             *(_FigureDraft(*figure) for figure in nonlinear_figures(cmp)),
+            *(_FigureDraft(*figure) for figure in peer_figures(cmp)),
             *_ride_figures(cmp),
         ]
     )
@@ -516,6 +518,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
             *_stability_blocks(cmp, figs),
             *_ride_blocks(cmp, figs),
             *nonlinear_blocks(cmp, figs),
+            *peer_blocks(cmp, figs),
             Heading("Findings"),
             *(Paragraph(text) for text in findings(cmp)),
             *_reproduce_blocks(cmp, command),
@@ -535,6 +538,7 @@ def _csv_tables(cmp) -> dict[str, pd.DataFrame]:
         "modes.csv": cmp.modes.to_frame(),
         "numerical_modes.csv": nm,
         **nonlinear_tables(cmp),
+        **peer_tables(cmp),
     }
 
 

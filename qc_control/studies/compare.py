@@ -663,12 +663,14 @@ def ride_comparison(
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """`ride_metrics` of the reference (first row) and of each method, and each
     method's numeric metrics against the reference's [%]."""
-    ride = pd.DataFrame(
-        {
-            "reference": ride_metrics(reference.response, model),
-            **{m: ride_metrics(r, model) for m, r in responses.items()},
-        }
-    ).T
+    # a diverged method's metrics overflow to inf or NaN: that is its answer, not a fault
+    with np.errstate(over="ignore", invalid="ignore"):
+        ride = pd.DataFrame(
+            {
+                "reference": ride_metrics(reference.response, model),
+                **{m: ride_metrics(r, model) for m, r in responses.items()},
+            }
+        ).T
     ride.index.name = "response"
     flags = [c for c in ride.columns if ride[c].map(lambda v: isinstance(v, bool)).all()]
     numeric = ride.drop(columns=flags).astype(float)
