@@ -11,7 +11,7 @@ from scipy.integrate import solve_ivp
 
 from qc_control.models.quarter import SEED_X0, quarter_car_model
 from qc_control.studies.compare import compare_methods
-from qc_control.studies.peers import SOLVERS, check_solvers, cheapest
+from qc_control.studies.peers import SOLVERS, cheapest, check_solvers
 
 # a short free response keeps the ladder quick: 0-2 s on 201 samples
 T = np.linspace(0.0, 2.0, 201)

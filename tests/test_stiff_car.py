@@ -57,9 +57,7 @@ def test_rk4_step_limit_falls_to_the_mounts_mode():
 def test_without_a_mount_the_seed_car_is_unchanged():
     seed = quarter_car(road=True)
     assert seed.nstates == 4
-    np.testing.assert_array_equal(
-        quarter_car(road=True, mount_stiffness=None).A, seed.A
-    )
+    np.testing.assert_array_equal(quarter_car(road=True, mount_stiffness=None).A, seed.A)
     assert quarter_car_model().rebuild_batch is not None
 
 

@@ -44,8 +44,8 @@ from .figures import (
 )
 from .findings import findings
 from .nonlinear import nonlinear_blocks, nonlinear_figures, nonlinear_tables, reference_text
-from .peers import peer_blocks, peer_figures, peer_tables
 from .pdf import to_pdf
+from .peers import peer_blocks, peer_figures, peer_tables
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
