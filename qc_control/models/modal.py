@@ -267,13 +267,7 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
     groups = _pair_eigenvalues(eigvals, eigvecs)
     names = _classify([_shape(v) for _, v in groups])
 
-    w2, phi = np.linalg.eig(MinvK)
-    order = np.argsort(np.abs(w2))
-    w2, phi = w2[order].real, phi[:, order].real
-    undamped_names = _classify(
-        [phi[1, i] / phi[0, i] if phi[0, i] else complex(math.inf) for i in range(2)]
-    )
-    fn_undamped = {n: math.sqrt(max(w, 0.0)) / (2 * math.pi) for n, w in zip(undamped_names, w2)}
+    fn_undamped = _undamped_frequencies(MinvK)
 
     modes = [
         _mode(name, lams, _shape(v), fn_undamped[name], zeta_nominal=float(zeta_nominal))
@@ -281,6 +275,18 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
     ]
     modes.sort(key=lambda m: m.name != BODY)
     return ModalAnalysis((modes[0], modes[1]), _damping_note(modes[0], MinvK))
+
+
+def _undamped_frequencies(MinvK: np.ndarray) -> dict[str, float]:
+    """The quarter car's undamped frequencies [Hz] by mode name, from ``K φ = ω² M φ``."""
+    w2, phi = np.linalg.eig(MinvK)
+    order = np.argsort(np.abs(w2))
+    w2, phi = w2[order].real, phi[:, order].real
+    undamped_names = _classify(
+        [phi[1, i] / phi[0, i] if phi[0, i] else complex(math.inf) for i in range(2)]
+    )
+    fn_undamped = {n: math.sqrt(max(w, 0.0)) / (2 * math.pi) for n, w in zip(undamped_names, w2)}
+    return fn_undamped
 
 
 def _is_mounted(sys) -> bool:
@@ -314,13 +320,7 @@ def _mounted_modes(sys: control.StateSpace) -> ModalAnalysis:
     names = _classify([_shape(v) for _, v in groups])
     # A[:2, 2:4] holds -M⁻¹(K + km e₁e₁ᵀ) and A[:2, 4] = M⁻¹ km e₁: add it back on xs
     MinvK = -(A[:2, 2:4] + np.outer(A[:2, 4], [1.0, 0.0]))
-    w2, phi = np.linalg.eig(MinvK)
-    order = np.argsort(np.abs(w2))
-    w2, phi = w2[order].real, phi[:, order].real
-    undamped_names = _classify(
-        [phi[1, i] / phi[0, i] if phi[0, i] else complex(math.inf) for i in range(2)]
-    )
-    fn_undamped = {n: math.sqrt(max(w, 0.0)) / (2 * math.pi) for n, w in zip(undamped_names, w2)}
+    fn_undamped = _undamped_frequencies(MinvK)
     # cs/ms = A[0, 4] / A[4, 2] (km/ms over km/cs), so the nominal ratio needs no params
     zeta_nominal = A[0, 4] / A[4, 2] / (2.0 * math.sqrt(MinvK[0, 0]))
     modes = [
