@@ -105,3 +105,11 @@ def test_stiff_scenario_kind_and_the_command_line(tmp_path):
     text = (out / "report.md").read_text(encoding="utf-8")
     assert "The solvers people use" in text and "top mount" in text
     assert (out / "work_precision.csv").exists()
+
+
+def test_a_bare_mounted_system_is_not_taken_for_the_seed_car():
+    # its signals are the quarter car's, its states are not: the roles need the model
+    sys = quarter_car(road=True, mount_stiffness=1e6)
+    T = np.linspace(0.0, 1.0, 101)
+    with pytest.raises(ValueError, match="not a known vehicle: pass a VehicleModel"):
+        compare_methods(sys, T, np.zeros(5), U=np.zeros(101), timing=False)

@@ -742,7 +742,9 @@ def _model_like(entry, params, sys) -> VehicleModel | None:
             model = entry.model(params, road=road, actuator=actuator)
         except (TypeError, ValueError):  # a model without that input
             continue
-        if (list(model.system.input_labels), list(model.system.output_labels)) == signals:
+        same = (list(model.system.input_labels), list(model.system.output_labels)) == signals
+        # and the same states: a model option (a damper top mount) may add one
+        if same and model.system.nstates == sys.nstates:
             return model
     return None
 
