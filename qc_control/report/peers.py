@@ -166,8 +166,9 @@ def peer_blocks(cmp, figs: dict[str, Image]) -> list:
             "and measured against the same reference as the methods. RHS evaluations are "
             "counted at the right-hand side itself: scipy's nfev, plus n per finite-difference "
             "Jacobian that Radau and BDF build outside it (LSODA's are inside its nfev). "
-            "The methods' times are step by step (the generic stepper); "
-            "the peers' the best of their runs."
+            "The methods' times are those of qc's default engine (for a linear car the "
+            "LTI engine, which gives the same trajectory as stepping; best of 3), the "
+            "peers' the best of their runs."
         ),
         figs["peers_evaluations.png"],
         figs["peers_time.png"],

@@ -1061,6 +1061,22 @@ def compare_methods(
     return cmp
 
 
+def _engine_times(problem: ComparisonProblem, convergence: pd.DataFrame) -> pd.DataFrame:
+    """The fixed-step ladder timed as a user runs it: a linear car through the LTI engine
+    (qc's default for it, the same trajectory), best of 3; a nonlinear one as stepped."""
+    if is_nonlinear_system(problem.system) or convergence["time"].isna().all():
+        return convergence
+    tabs = {t.name: t for t in problem.methods}
+    times = []
+    for method, level in zip(convergence["method"], convergence["level"]):
+        T, U = _refined(problem.T, level), _refined_input(problem.T, problem.U, level)
+        run = functools.partial(
+            _simulate, problem.system, T, problem.X0, U, tabs[method], problem.substeps
+        )
+        times.append(best_time(run, 3, warmup=True))
+    return convergence.assign(time=times)
+
+
 def _peer_study(
     problem: ComparisonProblem, measured: _Measured, solvers, rtols, progress
 ) -> WorkPrecision:
@@ -1073,7 +1089,7 @@ def _peer_study(
         problem.U,
         measured.reference.response,
         list(sys.output_labels).index(problem.model.body_disp),
-        measured.convergence,
+        _engine_times(problem, measured.convergence),
         methods=problem.methods,
         solvers=solvers,
         rtols=rtols,
