@@ -69,3 +69,27 @@ def test_pothole_scenario_kind():
     assert "--scenario pothole" in sc.command()
     # given values win over the kind's
     assert Scenario(kind="pothole", t_end=2.0).t_end == 2.0
+
+
+@pytest.mark.slow
+def test_the_example_prints_the_peaks_and_draws_both_figures(tmp_path):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).parent.parent / "examples" / "pothole.py"
+    out = subprocess.run(
+        [sys.executable, str(script), str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={"MPLBACKEND": "Agg", "PATH": ""},
+    )
+    assert out.returncode == 0, out.stderr
+    exact = control.forced_response(quarter_car(road=True), T, pothole_road(T), np.zeros(4))
+    peak = np.max(np.abs(exact.outputs[0]))
+    # printed to 4 decimals in mm: the exact peak, and the default call's 0
+    assert f"reference      {peak * 1e3:.4f} mm" in out.stdout
+    assert "control        0.0000 mm" in out.stdout
+    assert (tmp_path / "pothole_evaluations.png").exists()
+    assert (tmp_path / "pothole_time.png").exists()

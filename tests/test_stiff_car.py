@@ -113,3 +113,26 @@ def test_a_bare_mounted_system_is_not_taken_for_the_seed_car():
     T = np.linspace(0.0, 1.0, 101)
     with pytest.raises(ValueError, match="not a known vehicle: pass a VehicleModel"):
         compare_methods(sys, T, np.zeros(5), U=np.zeros(101), timing=False)
+
+
+@pytest.mark.slow
+def test_the_example_shows_the_mount_mode(tmp_path):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).parent.parent / "examples" / "stiff_car.py"
+    out = subprocess.run(
+        [sys.executable, str(script), str(tmp_path), "1.0"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={"MPLBACKEND": "Agg", "PATH": ""},
+    )
+    assert out.returncode == 0, out.stderr
+    fast = min(np.linalg.eigvals(_maxwell_matrix(QuarterCarParams(), 1e7)).real)
+    import re
+
+    printed = float(re.search(r"top mount\s+(-[\d.]+)\+", out.stdout).group(1))
+    assert printed == pytest.approx(fast, abs=1e-4)  # printed to 4 decimals
+    assert (tmp_path / "stiff_evaluations.png").exists()
