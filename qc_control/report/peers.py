@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from ..studies.scenarios import peak_table
 from .document import Heading, Image, Paragraph, Table, fmt
 
 __all__ = ["peer_figures", "peer_blocks", "peer_tables", "peer_findings", "peers_figure"]
@@ -177,6 +178,12 @@ def peer_blocks(cmp, figs: dict[str, Image]) -> list:
         figs["peers_evaluations.png"],
         figs["peers_time.png"],
         _best_table(cmp),
+        Table(
+            peak_table(cmp),
+            "What each run reports: the peaks of the exact response, of each method at h, "
+            "and of each peer at its loosest tolerance (python-control's default call at "
+            "its defaults)",
+        ),
         *(Paragraph(text) for text in peer_findings(cmp)),
     ]
 
