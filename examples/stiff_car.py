@@ -29,7 +29,7 @@ t_end = float(sys.argv[2]) if len(sys.argv) > 2 else 10.0
 print(f"writing into {out.resolve()}")
 
 cmp = stiff_car_comparison(
-    StiffCar(t_end=t_end),
+    StiffCar(grid=(t_end, 0.005)),
     solvers=("LSODA", "BDF", "Radau", "RK45", "control"),
     rtols=(1e-3, 1e-6),
     repeats=1,

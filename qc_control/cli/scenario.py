@@ -61,6 +61,7 @@ import numpy as np
 from ..models.quarter import QuarterCarParams
 from ..models.registry import MODELS, ModelEntry, get_model, model_for_params, parameter_keys
 from ..models.vehicle import VehicleModel
+from ..numerics import methods as catalogue
 from ..numerics.methods import METHODS, get_method
 from ..ride import road as roads
 from ..ride.spectral import ISO8608Road, road_parameter
@@ -1073,8 +1074,6 @@ class Scenario:
 
 def _named_tableaus() -> dict:
     """Every tableau known by name: `TABLEAUS` where the catalogue has it, else `METHODS`."""
-    from ..numerics import methods as catalogue
-
     return getattr(catalogue, "TABLEAUS", METHODS)
 
 

@@ -161,8 +161,7 @@ def _best_table(cmp) -> Table:
 
 def peer_blocks(cmp, figs: dict[str, Image]) -> list:
     """The section: both figures, the cheapest run per name, the findings."""
-    study = getattr(cmp, "peers", None)
-    if study is None:
+    if getattr(cmp, "peers", None) is None:
         return []
     return [
         Heading("The solvers people use"),

@@ -27,6 +27,7 @@ import pandas as pd
 
 from ..models.quarter import quarter_car_model
 from ..models.vehicle import VehicleModel
+from ..numerics import methods as catalogue
 from ..numerics.methods import METHODS
 from ..ride import road as roads
 from .compare import DEFAULT_METHODS, MethodComparison, compare_methods
@@ -49,8 +50,24 @@ __all__ = [
 _L_STABLE = ("backward_euler", "sdirk2", "radau2", "radau3")
 
 
+class _Grid:
+    """A run's ``grid = (t_end, h)`` [s] by name."""
+
+    grid: tuple[float, float]
+
+    @property
+    def t_end(self) -> float:
+        """The run's span [s]."""
+        return self.grid[0]
+
+    @property
+    def h(self) -> float:
+        """The sample spacing [s]."""
+        return self.grid[1]
+
+
 @dataclass(frozen=True)
-class Pothole:
+class Pothole(_Grid):
     """The pothole run: a 1 − cos dip met at ``t0`` [s] at ``speed`` [m/s].
 
     Attributes
@@ -61,36 +78,31 @@ class Pothole:
         [m/s].
     t0 : float
         When the wheel reaches the pothole [s].
-    t_end, h : float
-        The run's span and sample spacing [s].
+    grid : (float, float)
+        The run's span ``t_end`` and sample spacing ``h`` [s].
     """
 
     depth: float = 0.05
     length: float = 0.3
     speed: float = 20.0
     t0: float = 1.0
-    t_end: float = 3.0
-    h: float = 0.001
+    grid: tuple[float, float] = (3.0, 0.001)
 
     def road(self) -> dict:
         """The road as the Scenario's table: a bump of negative height."""
-        return {
-            "kind": "bump",
-            "height": -self.depth,
-            "length": self.length,
-            "speed": self.speed,
-            "t0": self.t0,
-        }
+        shape = dict(height=-self.depth, length=self.length, speed=self.speed, t0=self.t0)
+        return {"kind": "bump", **shape}
 
     def describe(self) -> str:
-        return (
-            f"a {self.depth * 100:g} cm deep, {self.length:g} m long 1 − cos pothole met at "
-            f"t = {self.t0:g} s at {self.speed:g} m/s"
+        """The pothole in words, for the report."""
+        depth, length = f"{self.depth * 100:g} cm", f"{self.length:g} m"
+        return f"a {depth} deep, {length} long 1 − cos pothole met at t = {self.t0:g} s at " + (
+            f"{self.speed:g} m/s"
         )
 
 
 @dataclass(frozen=True)
-class StiffCar:
+class StiffCar(_Grid):
     """The stiff car's run: the mount, the road and the step.
 
     Attributes
@@ -103,25 +115,20 @@ class StiffCar:
         [m/s].
     seed : int
         The road's random phases.
-    t_end, h : float
-        [s]; h = 5 ms samples the standard band at 20 m/s (limit 8.8 ms).
+    grid : (float, float)
+        ``t_end`` and ``h`` [s]; h = 5 ms samples the standard band at 20 m/s
+        (limit 8.8 ms).
     """
 
     mount_stiffness: float = 1e7
     road_class: str = "C"
     speed: float = 20.0
     seed: int = 0
-    t_end: float = 60.0
-    h: float = 0.005
+    grid: tuple[float, float] = (60.0, 0.005)
 
     def road(self) -> dict:
         """The road as the Scenario's table."""
-        return {
-            "kind": "iso8608",
-            "road_class": self.road_class,
-            "speed": self.speed,
-            "seed": self.seed,
-        }
+        return dict(kind="iso8608", road_class=self.road_class, speed=self.speed, seed=self.seed)
 
 
 #: The defaults of the two runs.
@@ -172,8 +179,6 @@ def stiff_car_model(
 
 def stiff_car_methods(names: Sequence[str] = DEFAULT_METHODS) -> tuple[str, ...]:
     """``names`` and the L-stable implicit tableaus known by name (`_L_STABLE`)."""
-    from ..numerics import methods as catalogue
-
     known = getattr(catalogue, "TABLEAUS", METHODS)
     return tuple(dict.fromkeys([*names, *(n for n in _L_STABLE if n in known)]))
 
