@@ -630,7 +630,7 @@ def work_precision_benchmark(quick: bool) -> tuple[list[str], list[str], list[li
     from qc_control.studies.compare import compare_methods
     from qc_control.studies.peers import RTOLS, SOLVERS
 
-    t_end = 2.0 if quick else 10.0
+    t_end = 1.0 if quick else 10.0
     T = np.linspace(0.0, t_end, round(t_end / 0.01) + 1)
     rtols = (1e-3, 1e-6) if quick else RTOLS
     cases = {
