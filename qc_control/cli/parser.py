@@ -269,6 +269,19 @@ def _add_report(sub, shown: str) -> None:
         "--methods", metavar="A,B,...", help="methods to compare (default euler,midpoint,heun,rk4)"
     )
     sc.add_argument(
+        "--solvers",
+        metavar="A,B,...",
+        help="peers over rtol 1e-3 ... 1e-10: RK45, DOP853, LSODA, Radau, BDF (solve_ivp), "
+        "control (input_output_response at its defaults)",
+    )
+    sc.add_argument(
+        "--scenario",
+        dest="kind",
+        choices=("pothole", "stiff"),
+        help="a run where the integrator decides the answer: the pothole, or the quarter car "
+        "with a stiff damper top mount on an ISO 8608 road",
+    )
+    sc.add_argument(
         "--max-steps",
         type=int,
         metavar="N",

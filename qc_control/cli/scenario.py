@@ -62,10 +62,13 @@ import numpy as np
 from ..models.quarter import QuarterCarParams
 from ..models.registry import MODELS, ModelEntry, get_model, model_for_params, parameter_keys
 from ..models.vehicle import VehicleModel
+from ..numerics import methods as catalogue
 from ..numerics.methods import METHODS, get_method
 from ..ride import road as roads
 from ..ride.spectral import ISO8608Road, road_parameter
 from ..studies.compare import DEFAULT_METHODS, MethodComparison, compare_methods
+from ..studies.peers import check_solvers
+from ..studies.scenarios import POTHOLE, STIFF_CAR, stiff_car_methods
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -377,7 +380,10 @@ def vehicle_keys() -> tuple[str, ...]:
 #: The Scenario's fields that hold a model's own options (`ModelOption`) by name;
 #: the options of other registered models are held in ``model_options``.
 _OPTION_KEYS = ("tire", "bump_stop", "events")
-RUN_KEYS = ("t_end", "h", "x0", "methods", "max_steps", "model", *_OPTION_KEYS)
+RUN_KEYS = ("t_end", "h", "x0", "methods", "max_steps", "model", *_OPTION_KEYS, "solvers", "kind")
+#: The scenario kinds (``kind`` in ``[scenario]``, ``--scenario``): each fills the values
+#: a scenario does not give (`qc_control.studies.scenarios`).
+KINDS = ("pothole", "stiff")
 
 
 def run_keys() -> tuple[str, ...]:
@@ -555,6 +561,16 @@ class Scenario:
         The options of a registered model that are not fields here
         (`qc_control.ModelOption`), by name; each checked by its option and
         defaulted. Held as ``((name, value), ...)``; `option` reads one.
+    solvers : sequence of str, optional
+        Peers run beside the methods over a ladder of tolerances
+        (`qc_control.studies.peers.SOLVERS`); none by default.
+    kind : {'pothole', 'stiff'}, optional
+        A scenario of `qc_control.studies.scenarios`, whose values fill those
+        not given: ``'pothole'``, the seed's car at rest into a 5 cm deep,
+        0.3 m long pothole at t = 1 s at 20 m/s, 0-3 s at 1 ms; ``'stiff'``,
+        the quarter car with a 1e7 N/m damper top mount on 60 s of an ISO
+        8608 class C road at 20 m/s, h = 5 ms, with the L-stable tableaus
+        known by name. Both run every peer.
 
     Examples
     --------
@@ -580,9 +596,12 @@ class Scenario:
     bump_stop: tuple[float, float] | None = None
     events: bool | None = None
     model_options: Any = None  # resolved: a tuple of (name, value) pairs, hashable
+    solvers: tuple[str, ...] = None  # type: ignore[assignment]  # resolved: () without peers
+    kind: str | None = None
 
     def __post_init__(self):
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
+        self._kind()
         put("model", _model_name(self.model, self.vehicle))
         put("vehicle", _vehicle(self.vehicle, self.model))
         defaults = self.entry.defaults
@@ -611,10 +630,47 @@ class Scenario:
                 "scenario",
                 "h",
             )
+        self._model_options()
         put("x0", self._x0(self.x0))
         if self.entry.road_layout != "single" and not isinstance(road, NoRoad):
             self._check_speed()
-        self._model_options()
+        try:
+            put("solvers", check_solvers(self.solvers))
+        except (TypeError, ValueError) as exc:
+            raise ScenarioError(f"solvers: {exc}", "scenario", "solvers") from None
+
+    def _kind(self) -> None:
+        """Fill what a scenario kind (`KINDS`) sets and the scenario does not give."""
+        put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
+        if self.kind is None:
+            return
+        if self.kind not in KINDS:
+            raise ScenarioError(
+                f"kind must be one of {', '.join(KINDS)}, got {self.kind!r}", "scenario", "kind"
+            )
+        if self.model not in (None, DEFAULT_MODEL):
+            raise ScenarioError(
+                f"kind = {self.kind!r} is a run of the quarter car, not of the {self.model} car",
+                "scenario",
+                "kind",
+            )
+        run = POTHOLE if self.kind == "pothole" else STIFF_CAR
+        if self.road is None or (isinstance(self.road, Mapping) and not self.road):
+            put("road", run.road())
+        put("t_end", run.t_end if self.t_end is None else self.t_end)
+        put("h", run.h if self.h is None else self.h)
+        put(
+            "solvers",
+            ("RK45", "DOP853", "LSODA", "Radau", "BDF", "control")
+            if self.solvers is None
+            else self.solvers,
+        )
+        if self.kind == "stiff":
+            options = dict(self.model_options or {})
+            options.setdefault("mount_stiffness", run.mount_stiffness)
+            put("model_options", options)
+            if tuple(self.methods) == DEFAULT_METHODS:
+                put("methods", stiff_car_methods())
 
     @property
     def entry(self) -> ModelEntry:
@@ -684,10 +740,11 @@ class Scenario:
             )
         if not names:
             raise ScenarioError("methods must name at least one method", "scenario", "methods")
-        unknown = [m for m in names if m.lower() not in METHODS]
+        known = _named_tableaus()
+        unknown = [m for m in names if m.lower() not in known]
         if unknown:
             raise ScenarioError(
-                f"methods: unknown method {unknown[0]!r}; known methods are {', '.join(METHODS)}",
+                f"methods: unknown method {unknown[0]!r}; known methods are {', '.join(known)}",
                 "scenario",
                 "methods",
             )
@@ -721,12 +778,13 @@ class Scenario:
             )
 
     def _x0(self, x0) -> tuple[float, ...]:
-        model = self.entry.model(self.vehicle)
+        build = self.option_arguments("build")  # an option may add states (a top mount)
+        model = self.entry.model(self.vehicle, **build)
         names = list(model.system.state_labels)
         if x0 is None:
             if not isinstance(self.road, NoRoad):
                 return (0.0,) * len(names)
-            return self.entry.free_start(self.vehicle)
+            return self.entry.free_start(self.vehicle, **build)
         values = _sequence(x0)
         if values is not None and all(isinstance(v, str) for v in values):
             try:
@@ -829,6 +887,7 @@ class Scenario:
             methods=self.methods,
             progress=progress,
             input_description=description,
+            solvers=self.solvers or None,
             **self.option_arguments("compare"),
         )
         cmp.scenario = self
@@ -944,6 +1003,10 @@ class Scenario:
         ]
         if self.max_steps != MAX_STEPS:
             lines.append(f"max_steps = {self.max_steps}")
+        if self.solvers:
+            lines.append(f"solvers = {_toml_value(self.solvers)}")
+        if self.kind is not None:
+            lines.append(f"kind = {_toml_value(self.kind)}")
         for option in self.entry.options:
             value = self.option(option.name)
             if value is not None:
@@ -989,6 +1052,10 @@ class Scenario:
         options += [("--x0", ",".join(map(repr, self.x0))), ("--methods", ",".join(self.methods))]
         if self.max_steps != MAX_STEPS:
             options.append(("--max-steps", str(self.max_steps)))
+        if self.solvers:
+            options.append(("--solvers", ",".join(self.solvers)))
+        if self.kind is not None:
+            options.append(("--scenario", self.kind))
         for option in self.entry.options:
             value = self.option(option.name)
             if isinstance(value, bool):
@@ -1004,6 +1071,11 @@ class Scenario:
                 (road_option(f), _cli_text(getattr(self.road, f.name))) for f in fields(self.road)
             ]
         return options
+
+
+def _named_tableaus() -> dict:
+    """Every tableau known by name: `TABLEAUS` where the catalogue has it, else `METHODS`."""
+    return getattr(catalogue, "TABLEAUS", METHODS)
 
 
 def option_name(key: str) -> str:

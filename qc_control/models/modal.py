@@ -18,7 +18,7 @@ import scipy.optimize
 
 from ..numerics import stability
 from .halfcar import FULL_CAR_CORNERS, HALF_CAR_CORNERS, FullCarParams, HalfCarParams
-from .quarter import QuarterCarParams, quarter_car
+from .quarter import MOUNT_STATE, QuarterCarParams, quarter_car
 from .vehicle import VehicleModel
 
 __all__ = [
@@ -31,6 +31,8 @@ __all__ = [
 ]
 
 BODY, WHEEL = "body bounce", "wheel hop"
+#: The real mode a damper top mount adds (`qc_control.models.quarter.mounted_abcd`).
+MOUNT = "top mount"
 
 
 @dataclass(frozen=True)
@@ -249,6 +251,8 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
         if not isinstance(sys_or_params.params, QuarterCarParams):
             return vehicle_modes(sys_or_params)
         sys_or_params = sys_or_params.system
+    if _is_mounted(sys_or_params):
+        return _mounted_modes(sys_or_params)
     if isinstance(sys_or_params, control.StateSpace) and sys_or_params.nstates != 4:
         return vehicle_modes(sys_or_params)
     if sys_or_params is None or isinstance(sys_or_params, (QuarterCarParams, dict)):
@@ -263,13 +267,7 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
     groups = _pair_eigenvalues(eigvals, eigvecs)
     names = _classify([_shape(v) for _, v in groups])
 
-    w2, phi = np.linalg.eig(MinvK)
-    order = np.argsort(np.abs(w2))
-    w2, phi = w2[order].real, phi[:, order].real
-    undamped_names = _classify(
-        [phi[1, i] / phi[0, i] if phi[0, i] else complex(math.inf) for i in range(2)]
-    )
-    fn_undamped = {n: math.sqrt(max(w, 0.0)) / (2 * math.pi) for n, w in zip(undamped_names, w2)}
+    fn_undamped = _undamped_frequencies(MinvK)
 
     modes = [
         _mode(name, lams, _shape(v), fn_undamped[name], zeta_nominal=float(zeta_nominal))
@@ -277,6 +275,66 @@ def modal_analysis(sys_or_params=None) -> ModalAnalysis:
     ]
     modes.sort(key=lambda m: m.name != BODY)
     return ModalAnalysis((modes[0], modes[1]), _damping_note(modes[0], MinvK))
+
+
+def _undamped_frequencies(MinvK: np.ndarray) -> dict[str, float]:
+    """The quarter car's undamped frequencies [Hz] by mode name, from ``K φ = ω² M φ``."""
+    w2, phi = np.linalg.eig(MinvK)
+    order = np.argsort(np.abs(w2))
+    w2, phi = w2[order].real, phi[:, order].real
+    undamped_names = _classify(
+        [phi[1, i] / phi[0, i] if phi[0, i] else complex(math.inf) for i in range(2)]
+    )
+    fn_undamped = {n: math.sqrt(max(w, 0.0)) / (2 * math.pi) for n, w in zip(undamped_names, w2)}
+    return fn_undamped
+
+
+def _is_mounted(sys) -> bool:
+    """Whether ``sys`` is a quarter car with a damper top mount (states ``[..., xd]``)."""
+    return (
+        isinstance(sys, control.StateSpace)
+        and sys.nstates == 5
+        and list(sys.state_labels) == ["vs", "vu", "xs", "xu", MOUNT_STATE]
+    )
+
+
+def _mounted_modes(sys: control.StateSpace) -> ModalAnalysis:
+    """Body bounce, wheel hop and the mount's real mode of a car with a top mount.
+
+    The mount adds one real eigenvalue, the spring relaxing through the
+    damper (near ``-km/cs``): the fastest real one. The other four are
+    paired and named as the seed's car's (`_pair_eigenvalues`, on their
+    ``[vs, vu, xs, xu]`` parts). Undamped, the damper carries no force, so
+    the mount carries none either: the undamped frequencies are the seed's,
+    from ``M⁻¹K`` with the mount's terms taken out of ``A``.
+    """
+    if not control.isctime(sys, strict=True):
+        raise ValueError(f"system {sys.name!r} must be continuous-time, got dt={sys.dt!r}")
+    A = np.asarray(sys.A, dtype=float)
+    eigvals, eigvecs = np.linalg.eig(A)
+    eigvals = stability.settle_marginal(eigvals)
+    real = [i for i in range(5) if eigvals[i].imag == 0]
+    mount = min(real, key=lambda i: eigvals[i].real)
+    rest = [i for i in range(5) if i != mount]
+    groups = _pair_eigenvalues(eigvals[rest], eigvecs[:4][:, rest])
+    names = _classify([_shape(v) for _, v in groups])
+    # A[:2, 2:4] holds -M⁻¹(K + km e₁e₁ᵀ) and A[:2, 4] = M⁻¹ km e₁: add it back on xs
+    MinvK = -(A[:2, 2:4] + np.outer(A[:2, 4], [1.0, 0.0]))
+    fn_undamped = _undamped_frequencies(MinvK)
+    # cs/ms = A[0, 4] / A[4, 2] (km/ms over km/cs), so the nominal ratio needs no params
+    zeta_nominal = A[0, 4] / A[4, 2] / (2.0 * math.sqrt(MinvK[0, 0]))
+    modes = [
+        _mode(name, lams, _shape(v), fn_undamped[name], zeta_nominal=float(zeta_nominal))
+        for name, (lams, v) in zip(names, groups)
+    ]
+    modes.sort(key=lambda m: m.name != BODY)
+    lam = eigvals[mount]
+    modes.append(_mode(MOUNT, (lam,), _shape(eigvecs[:, mount]), math.nan))
+    note = (
+        f"The damper's top mount adds a real mode at {lam.real:.4g} 1/s (time constant "
+        f"{-1e3 / lam.real:.3g} ms): it sets the step limit of explicit methods."
+    )
+    return ModalAnalysis(tuple(modes), note)
 
 
 def _mode(name: str, lams, ratio: complex, fn_undamped: float, **extra) -> Mode:

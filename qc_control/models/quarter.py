@@ -47,6 +47,9 @@ __all__ = [
     "STATES",
     "OUTPUTS",
     "UNITS",
+    "MOUNT_STATE",
+    "check_mount_stiffness",
+    "mounted_abcd",
 ]
 
 #: State names: the seed's ``[xs', xu', xs, xu]``.
@@ -70,7 +73,11 @@ UNITS = {
     "susp_travel": "m",
     "tire_defl": "m",
     "body_acc": "m/s²",
+    "xd": "m",
 }
+#: The extra state of a car with a damper top mount: the displacement of the
+#: damper's upper end, between the damper and the mount's spring [m].
+MOUNT_STATE = "xd"
 
 _UNITS = {
     "ms": "kg",
@@ -407,12 +414,70 @@ def quarter_car_abcd(ms, mu, ks, ku, cs, *, road: bool = False, actuator: bool =
     return A, B, C, D
 
 
+def check_mount_stiffness(value) -> float | None:
+    """``value`` as a mount stiffness [N/m]: None (no mount) or a finite number > 0."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+        raise ValueError(
+            f"mount_stiffness (the damper's top mount) must be a number in N/m or None, "
+            f"got {value!r}"
+        )
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"mount_stiffness must be a finite stiffness > 0 N/m, got {value!r}")
+    return float(value)
+
+
+def mounted_abcd(A, B, C, D, ms: float, mu: float, cs: float, km: float):
+    """The quarter car's ``A, B, C, D`` with the damper on a top mount of stiffness ``km``.
+
+    The mount is a spring in series with the damper (a Maxwell element). The
+    damper's upper end ``xd`` is one more state: the series pair carries the
+    force ``F = km (xs - xd) = cs (xd' - xu')`` (equal in the spring and the
+    damper, as the point between them has no mass), which replaces the
+    damper's ``cs (xs' - xu')`` on both masses, so
+
+    .. math::
+
+        \\dot x_d = \\dot x_u + \\frac{k_m}{c_s}(x_s - x_d)
+
+    As ``km -> inf``, ``xd -> xs`` and the seed's car returns. The mount adds
+    a real mode near ``-km/cs`` (the spring relaxing through the damper):
+    with the seed's damper, -645 1/s at 1e6 N/m and -6,633 1/s at 1e7 N/m.
+    The state is ``[vs, vu, xs, xu, xd]``; the outputs are unchanged, with
+    ``body_acc`` still the first row of ``A x + B u``.
+    """
+    if not cs > 0:
+        raise ValueError(
+            f"a damper top mount needs a damper: cs must be > 0 N·s/m with mount_stiffness, "
+            f"got cs={cs!r}"
+        )
+    A5 = np.zeros((5, 5))
+    A5[:4, :4] = A
+    # the damper's force on the masses becomes the mount's spring force km (xs - xd)
+    A5[0, :2] = A5[1, :2] = 0.0
+    A5[0, 2] += -km / ms
+    A5[0, 4] = km / ms
+    A5[1, 2] += km / mu
+    A5[1, 4] = -km / mu
+    A5[4, 1], A5[4, 2], A5[4, 4] = 1.0, km / cs, -km / cs
+    B5 = np.vstack([B, np.zeros((1, B.shape[1]))])
+    C5 = np.hstack([C, np.zeros((C.shape[0], 1))])
+    C5[4, :] = A5[0, :]  # body_acc: the first row of A x + B u, as without the mount
+    return A5, B5, C5, D
+
+
 def _inputs(road: bool, actuator: bool) -> list[str]:
     return [label for label, on in (("zr", road), ("fa", actuator)) if on]
 
 
 def quarter_car(
-    params=None, *, road: bool = False, actuator: bool = False, name: str = "quarter_car"
+    params=None,
+    *,
+    road: bool = False,
+    actuator: bool = False,
+    name: str = "quarter_car",
+    mount_stiffness: float | None = None,
 ) -> control.StateSpace:
     """The quarter car as a continuous-time ``control.StateSpace``.
 
@@ -428,6 +493,10 @@ def quarter_car(
         them apart, with ``B`` column ``[1/ms, -1/mu, 0, 0]``.
     name : str, default ``'quarter_car'``
         The system's name.
+    mount_stiffness : float, optional
+        The stiffness [N/m] of a rubber top mount in series with the damper
+        (see `mounted_abcd`): one more state, ``xd``, the damper's upper
+        end. None (default): the damper is fixed to the body, as the seed's.
 
     Returns
     -------
@@ -451,23 +520,42 @@ def quarter_car(
     1.0
     """
     p = as_params(params)
+    km = check_mount_stiffness(mount_stiffness)
+    if km is not None and p.cu:
+        raise ValueError(
+            f"a damper top mount (mount_stiffness={km!r} N/m) with tire damping (cu={p.cu!r} "
+            "N·s/m) is not modelled; give one of them"
+        )
     A, B, C, D = quarter_car_abcd(
         p.ms, p.mu, p.ks, p.ku, p.cs, road=road, actuator=actuator, cu=p.cu
     )
+    states = list(STATES)
+    if km is not None:
+        A, B, C, D = mounted_abcd(A, B, C, D, p.ms, p.mu, float(p.cs), km)  # type: ignore[arg-type]
+        states.append(MOUNT_STATE)
     return control.ss(
         A,
         B,
         C,
         D,
-        states=list(STATES),
+        states=states,
         inputs=_inputs(road, actuator),
         outputs=list(OUTPUTS),
         name=name,
     )
 
 
-def quarter_car_model(params=None, *, road: bool = False, actuator: bool = False) -> VehicleModel:
+def quarter_car_model(
+    params=None,
+    *,
+    road: bool = False,
+    actuator: bool = False,
+    mount_stiffness: float | None = None,
+) -> VehicleModel:
     """The quarter car as a `VehicleModel`: `quarter_car` plus the roles of its signals.
+
+    ``mount_stiffness`` [N/m] puts the damper on a top mount (`mounted_abcd`):
+    five states, the fifth the damper's upper end ``xd``.
 
     The body acceleration is ``body_acc``, the body displacement ``xs``;
     its one corner has the travel ``susp_travel``, the tire deflection
@@ -489,14 +577,17 @@ def quarter_car_model(params=None, *, road: bool = False, actuator: bool = False
         p.ku,
         (p.ms + p.mu) * STANDARD_GRAVITY,
     )
-    # partials of module-level functions, so that a model pickles to worker processes
+    km = check_mount_stiffness(mount_stiffness)
+    batch = functools.partial(_quarter_car_batch, road=road, actuator=actuator)
+    # partials of module-level functions, so that a model pickles to worker processes;
+    # a mounted car's batch stacks one rebuild per design (the batch form is the seed's)
     return VehicleModel(
-        quarter_car(p, road=road, actuator=actuator),
+        quarter_car(p, road=road, actuator=actuator, mount_stiffness=km),
         p,
         UNITS,
         SignalRoles("body_acc", "xs", (corner,)),
-        functools.partial(quarter_car_model, road=road, actuator=actuator),
-        functools.partial(_quarter_car_batch, road=road, actuator=actuator),
+        functools.partial(quarter_car_model, road=road, actuator=actuator, mount_stiffness=km),
+        None if km is not None else batch,
     )
 
 

@@ -33,7 +33,7 @@ import numpy as np
 
 from .halfcar import FullCarParams, HalfCarParams, full_car_model, half_car_model
 from .nonlinear import BumpStop, nonlinear_quarter_car_model
-from .quarter import SEED_X0, QuarterCarParams, quarter_car_model
+from .quarter import SEED_X0, QuarterCarParams, check_mount_stiffness, quarter_car_model
 from .vehicle import VehicleModel
 
 __all__ = [
@@ -200,11 +200,13 @@ class ModelEntry:
         """The parameter names: TOML keys and ``--name`` options."""
         return tuple(f.name for f in fields(self.params))
 
-    def free_start(self, params) -> tuple[float, ...]:
-        """The default start of a free response, in state order (see `DefaultRun`)."""
-        if self.defaults.x0 is not None:
-            return tuple(float(v) for v in self.defaults.x0)
-        model = self.model(params)
+    def free_start(self, params, **options) -> tuple[float, ...]:
+        """The default start of a free response, in state order (see `DefaultRun`);
+        ``options`` build the model (a model option may add states, e.g. a mount)."""
+        model = self.model(params, **options)
+        x0 = self.defaults.x0
+        if x0 is not None and len(x0) == model.system.nstates:
+            return tuple(float(v) for v in x0)
         body = model.body_disp
         return tuple(self.defaults.release if s == body else 0.0 for s in model.system.state_labels)
 
@@ -362,6 +364,17 @@ for _entry in (
         QuarterCarParams,
         quarter_car_model,
         "the seed's quarter car",
+        options=(
+            ModelOption(
+                "mount_stiffness",
+                None,
+                check_mount_stiffness,
+                "a rubber top mount in series with the damper [N/m] (one more state, "
+                "the damper's end; default none)",
+                parse=float,
+                metavar="N/M",
+            ),
+        ),
         defaults=DefaultRun(x0=SEED_X0),
         wheel_disp="xu",
     ),

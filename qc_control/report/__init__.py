@@ -46,6 +46,7 @@ from .figures import (
 from .findings import findings
 from .nonlinear import nonlinear_blocks, nonlinear_figures, nonlinear_tables, reference_text
 from .pdf import to_pdf
+from .peers import peer_blocks, peer_figures, peer_tables
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -253,6 +254,7 @@ def figure_specs(cmp) -> list[FigureSpec]:
             *_response_figures(cmp),
             *_analysis_figures(cmp),
             *(_FigureDraft(*figure) for figure in nonlinear_figures(cmp)),
+            *(_FigureDraft(*figure) for figure in peer_figures(cmp)),
             *_ride_figures(cmp),
         ]
     )
@@ -517,6 +519,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
             *_stability_blocks(cmp, figs),
             *_ride_blocks(cmp, figs),
             *nonlinear_blocks(cmp, figs),
+            *peer_blocks(cmp, figs),
             Heading("Findings"),
             *(Paragraph(text) for text in findings(cmp)),
             *_reproduce_blocks(cmp, command),
@@ -536,6 +539,7 @@ def _csv_tables(cmp) -> dict[str, pd.DataFrame]:
         "modes.csv": cmp.modes.to_frame(),
         "numerical_modes.csv": nm,
         **nonlinear_tables(cmp),
+        **peer_tables(cmp),
     }
 
 

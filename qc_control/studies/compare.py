@@ -45,6 +45,7 @@ from ..responses.timeresp import (
     input_output_response,
 )
 from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
+from .peers import RTOLS, WorkPrecision, check_solvers, work_precision
 
 __all__ = [
     "ReferenceBudgetError",
@@ -191,6 +192,10 @@ class MethodComparison(ComparisonProblem):
     nonlinear : NonlinearStudy or None
         On a nonlinear system: events, the order with and without them,
         where Midpoint and Heun part, the linearisation behind ``modes``.
+    peers : WorkPrecision or None
+        With ``solvers``: every run of the work–precision study (the
+        fixed-step ladder, the peers and the adaptive pairs over the
+        tolerances), `qc_control.studies.peers`.
     """
 
     table: pd.DataFrame
@@ -213,6 +218,7 @@ class MethodComparison(ComparisonProblem):
     transmissibility: Transmissibility | None = None
     scenario: Provenance | None = None
     nonlinear: NonlinearStudy | None = None
+    peers: WorkPrecision | None = None
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""
@@ -657,12 +663,14 @@ def ride_comparison(
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """`ride_metrics` of the reference (first row) and of each method, and each
     method's numeric metrics against the reference's [%]."""
-    ride = pd.DataFrame(
-        {
-            "reference": ride_metrics(reference.response, model),
-            **{m: ride_metrics(r, model) for m, r in responses.items()},
-        }
-    ).T
+    # a diverged method's metrics overflow to inf or NaN: that is its answer, not a fault
+    with np.errstate(over="ignore", invalid="ignore"):
+        ride = pd.DataFrame(
+            {
+                "reference": ride_metrics(reference.response, model),
+                **{m: ride_metrics(r, model) for m, r in responses.items()},
+            }
+        ).T
     ride.index.name = "response"
     flags = [c for c in ride.columns if ride[c].map(lambda v: isinstance(v, bool)).all()]
     numeric = ride.drop(columns=flags).astype(float)
@@ -734,7 +742,9 @@ def _model_like(entry, params, sys) -> VehicleModel | None:
             model = entry.model(params, road=road, actuator=actuator)
         except (TypeError, ValueError):  # a model without that input
             continue
-        if (list(model.system.input_labels), list(model.system.output_labels)) == signals:
+        same = (list(model.system.input_labels), list(model.system.output_labels)) == signals
+        # and the same states: a model option (a damper top mount) may add one
+        if same and model.system.nstates == sys.nstates:
             return model
     return None
 
@@ -941,6 +951,8 @@ def compare_methods(
     params: Any = None,
     events: bool | None = None,
     levels: int | None = None,
+    solvers: Sequence[str] | None = None,
+    rtols: Sequence[float] = RTOLS,
 ) -> MethodComparison:
     """Compare fixed-step methods with python-control's exact response.
 
@@ -998,6 +1010,14 @@ def compare_methods(
         Nonlinear systems only: refinements h, h/2, ..., h/2**levels of the
         convergence study (default `NONLINEAR_LEVELS`, 2; a linear
         comparison always refines 5 times).
+    solvers : sequence of str, optional
+        Peers to run beside the methods (`qc_control.studies.peers.SOLVERS`:
+        ``'RK45'``, ``'DOP853'``, ``'LSODA'``, ``'Radau'``, ``'BDF'`` through
+        ``solve_ivp``, ``'control'`` through ``control.input_output_response``
+        at its defaults), each over ``rtols``, measured against the same
+        reference; ``cmp.peers`` holds the work–precision study.
+    rtols : sequence of float, default 1e-3, 1e-4, ..., 1e-10
+        The peers' tolerance ladder (and the embedded qc pairs').
 
     Returns
     -------
@@ -1032,6 +1052,7 @@ def compare_methods(
     """
     sys, model, params = _as_model(sys, U, params)
     problem = _checked_problem(sys, model, params, T, X0, U, methods, h, repeats)
+    peers = check_solvers(solvers)
     if is_nonlinear_system(sys):
         measured = _measure_nonlinear(problem, events, levels, timing, progress)
     else:
@@ -1041,7 +1062,47 @@ def compare_methods(
                 "no switching and always refines h five times"
             )
         measured = _measure_linear(problem, repeats, timing, progress)
-    return _comparison(problem, measured, input_description)
+    cmp = _comparison(problem, measured, input_description)
+    if peers:
+        cmp.peers = _peer_study(problem, measured, peers, rtols, progress)
+    return cmp
+
+
+def _engine_times(problem: ComparisonProblem, convergence: pd.DataFrame) -> pd.DataFrame:
+    """The fixed-step ladder timed as a user runs it: a linear car through the LTI engine
+    (qc's default for it, the same trajectory), best of 3; a nonlinear one as stepped."""
+    if is_nonlinear_system(problem.system) or convergence["time"].isna().all():
+        return convergence
+    tabs = {t.name: t for t in problem.methods}
+    times = []
+    for method, level in zip(convergence["method"], convergence["level"]):
+        T, U = _refined(problem.T, level), _refined_input(problem.T, problem.U, level)
+        run = functools.partial(
+            _simulate, problem.system, T, problem.X0, U, tabs[method], problem.substeps
+        )
+        times.append(best_time(run, 3, warmup=True))
+    return convergence.assign(time=times)
+
+
+def _peer_study(
+    problem: ComparisonProblem, measured: _Measured, solvers, rtols, progress
+) -> WorkPrecision:
+    """The work–precision study: the peers beside the methods' convergence ladder."""
+    sys = problem.system
+    return work_precision(
+        sys,
+        problem.T,
+        problem.X0,
+        problem.U,
+        measured.reference.response,
+        list(sys.output_labels).index(problem.model.body_disp),
+        _engine_times(problem, measured.convergence),
+        methods=problem.methods,
+        solvers=solvers,
+        rtols=rtols,
+        reference_name=measured.reference.name,
+        progress=progress,
+    )
 
 
 # ---------------------------------------------------------------- nonlinear systems

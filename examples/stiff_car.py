@@ -1,0 +1,44 @@
+"""
+The stiff car: a damper top mount, and which integrator still copes
+===================================================================
+
+The seed's damper on a rubber top mount of 1e7 N/m (a spring in series
+with the damper, one more state) adds a real mode at −6,633 1/s: RK4 is
+stable only below 0.42 ms, while the body moves at 1 Hz. On an ISO 8608
+class C road at 20 m/s, each method at h = 5 ms and the solve_ivp peers are
+measured against python-control's exact response on the same sampled road;
+the Wk-weighted RMS body acceleration of each method is compared with the
+exact one. L-stable implicit tableaus join when they are known by name.
+
+Prints the mode table, each method's ride error and the work–precision
+findings; writes ``stiff_evaluations.png`` and ``stiff_time.png``.
+
+Run: ``python examples/stiff_car.py [OUT_DIR] [T_END]`` (default
+``./stiff_car_output``, 10 s; the scenario's full run is 60 s).
+"""
+
+import sys
+from pathlib import Path
+
+from qc_control.report.peers import peer_findings, peers_figure
+from qc_control.studies.scenarios import StiffCar, stiff_car_comparison
+
+out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
+out.mkdir(parents=True, exist_ok=True)
+t_end = float(sys.argv[2]) if len(sys.argv) > 2 else 10.0
+print(f"writing into {out.resolve()}")
+
+cmp = stiff_car_comparison(
+    StiffCar(grid=(t_end, 0.005)),
+    solvers=("LSODA", "BDF", "Radau", "RK45", "control"),
+    rtols=(1e-3, 1e-6),
+    repeats=1,
+)
+print(cmp.modes)
+print(cmp.table[["h_max [s]", "stable"]].to_string())
+if cmp.ride_error is not None:
+    print(cmp.ride_error.iloc[:, :1].to_string())
+for text in peer_findings(cmp):
+    print(text)
+for by in ("evaluations", "time"):
+    peers_figure(cmp, by).savefig(out / f"stiff_{by}.png", dpi=120)

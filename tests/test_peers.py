@@ -1,0 +1,142 @@
+"""The solver peers of the work–precision study (qc_control.studies.peers).
+
+Every count and error is checked against scipy or python-control run
+directly in the test, on python-control's exact response.
+"""
+
+import control
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from qc_control.models.quarter import SEED_X0, quarter_car_model
+from qc_control.studies.compare import compare_methods
+from qc_control.studies.peers import SOLVERS, cheapest, check_solvers
+
+# a short free response keeps the ladder quick: 0-2 s on 201 samples
+T = np.linspace(0.0, 2.0, 201)
+RTOLS = (1e-4, 1e-8)
+
+
+@pytest.fixture(scope="module")
+def study():
+    model = quarter_car_model()
+    cmp = compare_methods(
+        model, T, SEED_X0, methods=("euler", "rk4"), solvers=SOLVERS, rtols=RTOLS, timing=False
+    )
+    exact = control.initial_response(model.system, T, SEED_X0)
+    return model, cmp, exact
+
+
+def test_counts_and_errors_match_scipy_run_directly(study):
+    model, cmp, exact = study
+    A = np.asarray(model.system.A)
+    scale = np.max(np.abs(exact.states), axis=1)
+    runs = cmp.peers.runs
+    for solver in ("RK45", "DOP853", "LSODA", "Radau", "BDF"):
+        for rtol in RTOLS:
+            row = runs[(runs["name"] == solver) & (runs["rtol"] == rtol)].iloc[0]
+            sol = solve_ivp(
+                lambda t, x: A @ x,
+                (T[0], T[-1]),
+                SEED_X0,
+                method=solver,
+                t_eval=T,
+                rtol=rtol,
+                atol=rtol * scale,
+            )
+            assert row["atol"] == pytest.approx(rtol * scale.max(), rel=1e-15)
+            # scipy's own counts: equal where it counts every call, a lower bound where
+            # its finite-difference Jacobians (n calls each, or more) sit outside nfev
+            if solver in ("Radau", "BDF"):
+                assert row["evaluations"] >= sol.nfev + 4 * sol.njev
+                assert row["nfev"] == sol.nfev and row["njev"] == sol.njev
+            else:
+                assert row["evaluations"] == sol.nfev
+            # the same solve, measured on python-control's exact response: identical
+            # arithmetic, so equal to rounding (1e-15 m on a 5 cm response)
+            direct = np.max(np.abs(sol.y[2] - np.asarray(exact.outputs)[0]))
+            assert row["error"] == pytest.approx(direct, rel=1e-9, abs=1e-15)
+
+
+def test_tight_tolerance_reaches_the_exact_response(study):
+    _, cmp, _ = study
+    runs = cmp.peers.runs
+    tight = runs[(runs["kind"] == "solver") & (runs["rtol"] == 1e-8)]
+    # atol = 1e-8 · 5 cm per state: a global error below 1e-6 m leaves a 20x margin
+    # for error growth over the 2 s run
+    assert (tight["error"] < 1e-6).all(), tight[["name", "error"]]
+
+
+def test_control_default_is_control_input_output_response(study):
+    model, cmp, exact = study
+    row = cmp.peers.control_default()
+    resp = control.input_output_response(model.system, T, 0.0, SEED_X0)
+    direct = np.max(np.abs(np.asarray(resp.outputs)[0] - np.asarray(exact.outputs)[0]))
+    # the same solve_ivp call on the same right-hand side: equal to rounding
+    assert row["error"] == pytest.approx(direct, rel=1e-9, abs=1e-15)
+    assert row["rtol"] == 1e-3 and row["atol"] == 1e-6
+
+
+def test_the_cheapest_run_reaches_the_tolerance_and_none_is_cheaper(study):
+    _, cmp, _ = study
+    runs = cmp.peers.runs
+    best = cmp.peers.cheapest("evaluations", 1e-6)
+    assert best["error"] <= 1e-6
+    reaching = runs[(runs["error"] <= 1e-6) & runs["success"].astype(bool)]
+    assert best["evaluations"] == reaching["evaluations"].min()
+    assert cheapest(runs, "evaluations", 1e-30) is None
+    with pytest.raises(ValueError, match="by must be"):
+        cheapest(runs, "money", 1e-6)
+
+
+def test_fixed_step_ladder_is_the_convergence_study(study):
+    _, cmp, _ = study
+    fixed = cmp.peers.runs[cmp.peers.runs["kind"] == "method"]
+    assert list(fixed["evaluations"]) == list(cmp.convergence["nfev"])
+    assert list(fixed["error"]) == list(cmp.convergence["error"])
+
+
+def test_solver_names_are_checked():
+    assert check_solvers("rk45, lsoda,Control") == ("RK45", "LSODA", "control")
+    with pytest.raises(ValueError, match="unknown solver 'euler'"):
+        check_solvers(["euler"])
+    with pytest.raises(ValueError, match="distinct"):
+        check_solvers(["BDF", "bdf"])
+    with pytest.raises(TypeError, match="sequence of solver names"):
+        check_solvers(3)
+    with pytest.raises(ValueError, match="unknown solver"):
+        compare_methods(None, T, SEED_X0, solvers=("ode45",), timing=False)
+
+
+def test_report_has_both_figures_and_the_findings(study, tmp_path):
+    from qc_control.report import build_blocks, figure_specs
+    from qc_control.report.peers import peer_findings
+
+    _, cmp, _ = study
+    names = [spec.name for spec in figure_specs(cmp)]
+    assert "peers_evaluations.png" in names and "peers_time.png" in names
+    text = " ".join(peer_findings(cmp))
+    assert "Cheapest to reach 1e-06 m" in text and "python-control's default call" in text
+    assert build_blocks(cmp)
+
+
+@pytest.mark.slow
+def test_the_benchmark_runs_the_work_precision_table():
+    """A smoke run of the benchmark's work–precision section (its ratios are its own
+    business): every row names a run, and RK4's own ratio is 1 in both cars."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).parent.parent / "benchmarks" / "run.py"
+    out = subprocess.run(
+        [sys.executable, str(script), "--quick", "--only", "peers"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert out.returncode == 0, out.stderr
+    rows = [line for line in out.stdout.splitlines() if line.startswith("| rk4 ")]
+    cells = [c.strip() for c in rows[0].strip("|").split("|")]
+    assert [cells[i] for i in (3, 4, 7, 8)] == ["1"] * 4  # evals/rk4, time/rk4, both cars

@@ -1,0 +1,95 @@
+"""The pothole: python-control's default call steps over it; a fixed step cannot.
+
+The exact peaks are python-control's forced_response on the same samples.
+"""
+
+import control
+import numpy as np
+import pytest
+
+from qc_control.cli.scenario import Scenario
+from qc_control.models.quarter import quarter_car
+from qc_control.ride.road import bump
+from qc_control.studies.scenarios import POTHOLE, peak_table, pothole_comparison, pothole_road
+
+T = np.linspace(0.0, 3.0, 3001)
+
+
+@pytest.fixture(scope="module")
+def cmp():
+    return pothole_comparison(
+        methods=("euler", "rk4"), solvers=("RK45", "control"), rtols=(1e-3,), timing=False
+    )
+
+
+def test_the_road_is_a_bump_turned_down():
+    # the (1 - cos) bump of road.bump with a negative height: 5 cm down at its middle
+    zr = pothole_road(T)
+    # its deepest point, 1.0075 s, lies between the 1 ms samples: a 10 us grid holds it
+    fine = np.linspace(1.0, 1.015, 1501)
+    assert pothole_road(fine).min() == pytest.approx(-0.05, abs=1e-12)
+    assert np.array_equal(zr, bump(T, height=-0.05, length=0.3, speed=20.0, t0=1.0))
+    with pytest.raises(ValueError, match="depth must be a number > 0 m"):
+        pothole_road(T, depth=-0.05)
+
+
+def test_peaks_are_the_exact_ones_and_the_default_call_misses(cmp):
+    exact = control.forced_response(quarter_car(road=True), T, pothole_road(T), np.zeros(4))
+    peaks = peak_table(cmp)
+    ref = peaks.loc["reference"]
+    # python-control's exact response, to rounding; and the issue's numbers to 0.5 um
+    assert ref["peak |xs| [m]"] == pytest.approx(np.max(np.abs(exact.outputs[0])), rel=1e-12)
+    assert ref["peak |xs| [m]"] == pytest.approx(2.743e-3, abs=5e-7)
+    assert ref["peak |susp_travel| [m]"] == pytest.approx(2.552e-3, abs=5e-7)
+    # RK4 at 1 ms: within 3e-11 m of the exact response everywhere (its error is h^4-small)
+    rk4 = cmp.responses["rk4"].outputs[0]
+    assert np.max(np.abs(rk4 - exact.outputs[0])) < 3e-11
+    # the default call: every state stays 0, so the whole peak is missed
+    assert peaks.loc["control", "peak |xs| [m]"] == 0.0
+    assert peaks.loc["control", "peak |susp_travel| [m]"] == 0.0
+    default = cmp.peers.control_default()
+    assert default["error"] == pytest.approx(ref["peak |xs| [m]"], rel=1e-12)
+    direct = control.input_output_response(quarter_car(road=True), T, pothole_road(T), 0.0)
+    assert np.max(np.abs(direct.states)) == 0.0
+
+
+def test_the_report_states_the_miss(cmp):
+    from qc_control.report.peers import peer_findings
+
+    text = " ".join(peer_findings(cmp))
+    assert "the whole response" in text and "#1152" in text
+
+
+def test_pothole_scenario_kind():
+    sc = Scenario(kind="pothole")
+    assert (sc.t_end, sc.h) == (POTHOLE.t_end, POTHOLE.h)
+    assert sc.road.height == -0.05 and sc.road.t0 == 1.0
+    assert "control" in sc.solvers
+    assert Scenario.from_toml_string(sc.to_toml()) == sc
+    assert "--scenario pothole" in sc.command()
+    # given values win over the kind's
+    assert Scenario(kind="pothole", t_end=2.0).t_end == 2.0
+
+
+@pytest.mark.slow
+def test_the_example_prints_the_peaks_and_draws_both_figures(tmp_path):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).parent.parent / "examples" / "pothole.py"
+    out = subprocess.run(
+        [sys.executable, str(script), str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={"MPLBACKEND": "Agg", "PATH": ""},
+    )
+    assert out.returncode == 0, out.stderr
+    exact = control.forced_response(quarter_car(road=True), T, pothole_road(T), np.zeros(4))
+    peak = np.max(np.abs(exact.outputs[0]))
+    # printed to 4 decimals in mm: the exact peak, and the default call's 0
+    assert f"reference      {peak * 1e3:.4f} mm" in out.stdout
+    assert "control        0.0000 mm" in out.stdout
+    assert (tmp_path / "pothole_evaluations.png").exists()
+    assert (tmp_path / "pothole_time.png").exists()
