@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+import qc_control as qc
 from qc_control.models.quarter import SEED_X0, quarter_car_model
 from qc_control.studies.compare import compare_methods
 from qc_control.studies.peers import SOLVERS, cheapest, check_solvers
@@ -140,3 +141,27 @@ def test_the_benchmark_runs_the_work_precision_table():
     rows = [line for line in out.stdout.splitlines() if line.startswith("| rk4 ")]
     cells = [c.strip() for c in rows[0].strip("|").split("|")]
     assert [cells[i] for i in (3, 4, 7, 8)] == ["1"] * 4  # evals/rk4, time/rk4, both cars
+
+
+def test_the_adaptive_pairs_are_rows_of_the_work_precision_study():
+    # an embedded pair over the tolerance ladder goes through the responses'
+    # rtol/atol. Dormand-Prince with scipy's controller takes RK45's steps, so
+    # each of its rows equals the RK45 row at the same tolerances (those rows
+    # are checked against solve_ivp re-run in this file): the same
+    # evaluations, and the same error to rounding (1e-9 relative)
+    T = np.linspace(0.0, 10.0, 1001)
+    cmp = compare_methods(
+        None, T, SEED_X0, methods=("rk4", "dormand_prince"), solvers=("RK45",),
+        rtols=(1e-4, 1e-8), timing=False,
+    )  # fmt: skip
+    runs = cmp.peers.runs
+    ours = runs[runs["kind"] == "adaptive"].set_index("rtol")
+    scipy_rows = runs[runs["name"] == "RK45"].set_index("rtol")
+    assert list(ours.index) == [1e-4, 1e-8] and set(ours["name"]) == {"dormand_prince"}
+    for rtol in ours.index:
+        assert ours.loc[rtol, "evaluations"] == scipy_rows.loc[rtol, "evaluations"]
+        assert ours.loc[rtol, "error"] == pytest.approx(scipy_rows.loc[rtol, "error"], rel=1e-9)
+    # the error falls with the tolerance, and stays below the response's own size
+    exact = control.initial_response(qc.quarter_car(), T, SEED_X0).outputs[0]
+    assert ours.loc[1e-4, "error"] > 1e3 * ours.loc[1e-8, "error"] > 0
+    assert ours.loc[1e-4, "error"] < np.abs(exact).max()
