@@ -553,6 +553,7 @@ def _car_sensor_law():
     return control.interconnect([car, sensor, law], inputs="zr", outputs=outputs, name="cl3")
 
 
+@pytest.mark.slow
 def test_fused_steps_with_chained_static_subsystems_against_control():
     # Two static blocks, the second fed by the first (several outputs: the general loop),
     # the controller smooth (tanh), so that solve_ivp at tight tolerance is a reference.
