@@ -43,8 +43,10 @@ $(STAMP_NOTEBOOK): pyproject.toml | $(BIN)/python
 report: $(STAMP_BASE)
 	$(BIN)/qc-control report --out report
 
+# every core (pytest-xdist); a group of tests that share one computed artefact
+# (the docs build and the notebook run, the installed wheel) stays on one worker
 test: $(STAMP_TEST)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto --dist loadgroup
 
 docs: $(STAMP_DOCS)
 	$(BIN)/sphinx-build -W --keep-going -q -b html docs docs/_build/html

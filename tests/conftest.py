@@ -1,6 +1,12 @@
 """Shared fixtures and strategies."""
 
+import copy
 import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+from types import SimpleNamespace
 
 import matplotlib
 import pytest
@@ -23,6 +29,116 @@ valid_params = st.builds(
 
 #: Doctests that run a whole comparison, by node id (a docstring can't carry a marker).
 SLOW_DOCTESTS = {"qc_control/__init__.py::qc_control"}  # the quickstart: about 3 s
+
+
+#: The course notebook, executed once per run (`course_run`).
+COURSE = Path(__file__).parent.parent / "examples" / "course.ipynb"
+#: The instructor's answers to the notebook's exercises, each computed with
+#: qc_control as a student would.
+SOLUTIONS = {
+    "1": "answer_1 = qc.modal_analysis(params).body.fn",
+    "2": 'answer_2 = qc.max_stable_step("euler", sys)',
+    "3": """
+e = []
+for h in (0.01, 0.005):
+    Th = np.linspace(0.0, 10.0, round(10.0 / h) + 1)
+    r = qc.initial_response(sys, Th, X0, method="heun")
+    ex = control.initial_response(sys, Th, X0)
+    e.append(np.max(np.abs(output_signal(r, "xs") - output_signal(ex, "xs"))))
+answer_3 = np.log2(e[0] / e[1])
+""",
+    "4": 'answer_4 = qc.numerical_modes("euler", 0.01, sys).loc["body bounce", "zeta_h"]',
+    "5": "answer_5 = zetas[np.argmin(comfort)]",
+}
+
+
+@pytest.fixture(scope="session")
+def course_run(tmp_path_factory):
+    """The course notebook executed once, as a student runs it, in a fresh kernel.
+
+    The shipped cells run first; then, in the same kernel, each exercise's
+    answer (`SOLUTIONS`) and a copy of its check cell (tagged
+    ``answered-check-N``), and a wrong answer to exercise 1 with its check
+    (``wrong-check-1``). Returns ``shipped`` (the shipped cells with their
+    outputs: what the docs render), ``answered`` (the whole executed
+    notebook) and ``files_written`` (what the run left in its folder).
+    """
+    import nbformat
+
+    nbclient = pytest.importorskip("nbclient", reason="the test extra is not installed")
+    nb = nbformat.read(COURSE, as_version=4)
+    n_shipped = len(nb.cells)
+    checks = {}
+    for cell in nb.cells:
+        for tag in cell.get("metadata", {}).get("tags", []):
+            if tag.startswith("check-"):
+                checks[tag.removeprefix("check-")] = cell.source
+
+    def cell(source, tag=None):
+        new = nbformat.v4.new_code_cell(source.strip())
+        if tag:
+            new.metadata["tags"] = [tag]
+        return new
+
+    for n, code in SOLUTIONS.items():
+        nb.cells += [cell(code), cell(checks[n], f"answered-check-{n}")]
+    nb.cells += [
+        cell("answer_1 = 2.0  # Hz: the wheel's, not the body's"),
+        cell(checks["1"], "wrong-check-1"),
+    ]
+    folder = tmp_path_factory.mktemp("course")
+    # at most 120 s per cell, in the notebook's own folder-less temporary directory
+    nbclient.NotebookClient(
+        nb, timeout=120, kernel_name="python3", resources={"metadata": {"path": str(folder)}}
+    ).execute()
+    shipped = copy.deepcopy(nb)
+    shipped.cells = shipped.cells[:n_shipped]
+    return SimpleNamespace(
+        shipped=shipped, answered=nb, files_written=sorted(p.name for p in folder.iterdir())
+    )
+
+
+@pytest.fixture(scope="session")
+def docs_build(tmp_path_factory, course_run):
+    """The docs site built once per run (``sphinx-build -W``): the user guide
+    (every cell executed), API reference, gallery and course notebook, from a
+    copy of the sources so that the build's generated files stay out of the tree.
+
+    The gallery runs every example here, with an output folder under the
+    build directory (``docs/_build/gallery_output/NAME``); tests/test_examples.py
+    reads what they wrote and printed. The course notebook is the one
+    `course_run` executed, its outputs rendered as they are: myst-nb's
+    per-notebook setting keeps the build from executing it again.
+    Returns ``src`` (the copied docs folder), ``html``, ``returncode`` and
+    ``stderr``.
+    """
+    for name in ("sphinx", "numpydoc", "sphinx_gallery", "myst_nb"):
+        pytest.importorskip(name, reason="the docs extra is not installed: `make docs` installs it")
+    import nbformat
+
+    root = Path(__file__).parent.parent
+    tmp = tmp_path_factory.mktemp("site")
+    ignore = shutil.ignore_patterns(
+        "_build", "auto_examples", "notebooks", "sg_execution_times.rst", "*_output"
+    )
+    shutil.copytree(root / "docs", tmp / "docs", ignore=ignore)
+    shutil.copytree(root / "examples", tmp / "examples", ignore=ignore)
+    shutil.copytree(root / "benchmarks", tmp / "benchmarks", ignore=ignore)  # Performance page
+    executed = copy.deepcopy(course_run.shipped)
+    executed.metadata["mystnb"] = {"execution_mode": "off"}
+    nbformat.write(executed, tmp / "examples" / "course.ipynb")
+    html = tmp / "docs" / "_build" / "html"
+    run = subprocess.run(
+        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html"]
+        + [str(tmp / "docs"), str(html)],
+        capture_output=True,
+        text=True,
+        timeout=1800,
+        env={"MPLBACKEND": "Agg", "PATH": str(Path(sys.executable).parent)},
+    )
+    return SimpleNamespace(
+        src=tmp / "docs", html=html, returncode=run.returncode, stderr=run.stderr
+    )
 
 
 @pytest.fixture

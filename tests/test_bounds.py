@@ -86,6 +86,7 @@ def test_a_grid_just_under_the_limit_is_built_and_one_just_over_is_refused(monke
         design_grid({"ks": np.linspace(2e4, 5e4, 10), "ms": np.linspace(250, 400, 100)})
 
 
+@pytest.mark.slow
 def test_an_allowed_grid_sweeps_every_design(monkeypatch):
     """A sweep of a grid under an 8 MiB limit runs (its streamed chunk is 4 MiB,
     its 96 designs 240 kB) and equals python-control's exact free response

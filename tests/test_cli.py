@@ -314,6 +314,7 @@ def test_report_reproduces_from_its_own_command_and_scenario_toml(files, capsys)
         ["--zeta", "0", "--t-end", "1"],
     ],
 )
+@pytest.mark.slow
 def test_degenerate_designs_report_without_a_warning_flood(tmp_path, args):
     # a real process: pytest would otherwise capture the warnings before stderr
     done = run("report", *args, "--quiet", "--out", str(tmp_path / "R"))
@@ -326,6 +327,7 @@ def test_degenerate_designs_report_without_a_warning_flood(tmp_path, args):
     assert "beyond the stability limit" in text  # the finding says what happened, in words
 
 
+@pytest.mark.slow
 def test_undamped_car_has_no_stable_euler_step_in_words(tmp_path):
     assert main(["report", "--zeta", "0", "--t-end", "1", "--quiet", "--out", str(tmp_path)]) == 0
     assert "Euler has no stable step" in (tmp_path / "report.md").read_text()
@@ -490,6 +492,7 @@ def test_folders_made_for_the_lock_are_removed_when_nothing_is_written(files, mo
     assert not (files / "a").exists()
 
 
+@pytest.mark.slow
 def test_runs_into_two_folders_of_one_parent_both_succeed(files, capsys, quick_figures):
     """Item 9: with the lock on the parent, '--out reps/one' and '--out reps/two'
     excluded each other. Each report has its own lock: while one is held (another

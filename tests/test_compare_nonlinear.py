@@ -172,6 +172,7 @@ def skyhook_loop():
     return qc.closed_loop(car, sky), T, zr
 
 
+@pytest.mark.slow
 def test_semi_active_closed_loop_runs_through_compare_methods(skyhook_loop):
     loop, T, zr = skyhook_loop
     assert isinstance(loop.system, control.InterconnectedSystem)
@@ -268,6 +269,7 @@ def test_write_report_of_a_nonlinear_comparison(lift_off, tmp_path):
     assert (out / "parting.png").exists() and (out / "events_convergence.png").exists()
 
 
+@pytest.mark.slow
 def test_scenario_with_a_bump_stop_steps_to_every_event():
     """The Scenario's nonlinear car: the lift-off bump with a 5 cm bump stop of 1e5 N/m.
 

@@ -87,6 +87,7 @@ def test_report_files_and_axes(cmp, tmp_path):
     assert len(ax.get_lines()) == 3  # one curve per linear design
 
 
+@pytest.mark.slow
 def test_cli_control_report(tmp_path, capsys):
     out = tmp_path / "cr"
     argv = ["control-report", "--designs", "passive (seed),skyhook", "--out", str(out)]

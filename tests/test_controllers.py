@@ -291,6 +291,7 @@ def test_hinf_gamma_is_the_closed_loop_norm():
     assert np.min(-poles.real / np.abs(poles)) > 0.2
 
 
+@pytest.mark.slow
 def test_hinf_reproduces_matlab_example_gammas():
     """MATLAB's published γ for its own car (mb 300, mw 60, bs 1000, ks 16000, kt 190000).
 

@@ -1,13 +1,11 @@
 """The docs site: the user guide, API reference, example gallery and course
 notebook, built with Sphinx with warnings as errors (what ``make docs`` runs),
-then read offline in headless Chromium: the formulas typeset with nothing
-fetched, no raw TeX left on the page."""
+once per run by conftest's ``docs_build``, then read offline in headless
+Chromium: the formulas typeset with nothing fetched, no raw TeX left on the
+page."""
 
 import pkgutil
 import re
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -34,32 +32,14 @@ def test_every_public_module_is_in_the_api_reference():
 
 
 @pytest.fixture(scope="module")
-def site(tmp_path_factory):
-    """The docs built once, from a copy of the sources, so that the build's
-    generated files stay out of the tree: the HTML folder."""
-    for name in ("sphinx", "numpydoc", "sphinx_gallery", "myst_nb"):
-        pytest.importorskip(name, reason="the docs extra is not installed: `make docs` installs it")
-    tmp_path = tmp_path_factory.mktemp("site")
-    ignore = shutil.ignore_patterns(
-        "_build", "auto_examples", "notebooks", "sg_execution_times.rst", "*_output"
-    )
-    shutil.copytree(DOCS, tmp_path / "docs", ignore=ignore)
-    shutil.copytree(ROOT / "examples", tmp_path / "examples", ignore=ignore)
-    shutil.copytree(ROOT / "benchmarks", tmp_path / "benchmarks", ignore=ignore)  # Performance
-    html = tmp_path / "docs" / "_build" / "html"
-    run = subprocess.run(
-        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html"]
-        + [str(tmp_path / "docs"), str(html)],
-        capture_output=True,
-        text=True,
-        timeout=1800,
-        env={"MPLBACKEND": "Agg", "PATH": str(Path(sys.executable).parent)},
-    )
-    assert run.returncode == 0, run.stderr[-5000:]
-    return html
+def site(docs_build):
+    """The built site's HTML folder (the build, once per run, must have passed)."""
+    assert docs_build.returncode == 0, docs_build.stderr[-5000:]
+    return docs_build.html
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("docs")
 def test_docs_build_with_warnings_as_errors(site):
     html = site
     api = (html / "api.html").read_text(encoding="utf-8")
@@ -78,11 +58,12 @@ def test_docs_build_with_warnings_as_errors(site):
         page = (html / "auto_examples" / f"{script.stem}.html").read_text(encoding="utf-8")
         assert re.search(r'<img [^>]*src="\.\./_images/sphx_glr_' + script.stem, page), script
     course = (html / "notebooks" / "course.html").read_text(encoding="utf-8")
-    assert "Exercise 5: not answered yet" in course  # executed during the build
+    assert "Exercise 5: not answered yet" in course  # the run's outputs, rendered
     assert course.count("<img") >= 5
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("docs")
 def test_every_guide_page_ran_its_code(site):
     """Each guide page is in the site with its cells' outputs: the build ran them."""
     for page in (DOCS / "guide").glob("*.md"):
@@ -122,6 +103,7 @@ TYPESET = """async () => {
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("docs")
 @pytest.mark.parametrize("name", MATH_PAGES)
 def test_formulas_render_offline(site, browser, name):  # noqa: F811
     """The page opened from disk with the browser offline: MathJax (served

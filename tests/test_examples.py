@@ -1,7 +1,11 @@
 """Every script in examples/ runs and writes what it says, with the numbers it should.
 
-Each example runs in a fresh process, as a student runs it, into an output
-folder whose parents do not exist yet. Every test checks something specific
+Each example runs once per run of the suite: in the docs build, where the
+gallery runs it with an output folder under the build directory as its
+argument (conftest's ``docs_build``), and the tests here read what it wrote
+and printed there (the printed lines from the gallery page's output
+blocks). Two examples also run in a fresh process with no argument, as a
+student runs them, to check where they write then. Every test checks something specific
 in what the example produced: file names and image sizes, and printed
 numbers against an independent computation in the test (numpy's matrix
 power for Euler's trajectory, eigenvalues of a matrix assembled here, the
@@ -24,7 +28,7 @@ EXAMPLES = {p.stem: p for p in sorted((ROOT / "examples").glob("*.py"))}
 ENV = {"MPLBACKEND": "Agg", "PATH": ""}
 PNG = b"\x89PNG\r\n\x1a\n"
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("docs")]
 
 
 def run(name, *args, cwd=None):
@@ -38,6 +42,31 @@ def run(name, *args, cwd=None):
     )
     assert out.returncode == 0, out.stderr
     return out.stdout
+
+
+def gallery_run(docs_build, name) -> tuple[str, Path]:
+    """What example ``name`` printed in the docs build, and the folder it wrote."""
+    assert docs_build.returncode == 0, docs_build.stderr[-5000:]
+    page = (docs_build.src / "auto_examples" / f"{name}.rst").read_text(encoding="utf-8")
+    return printed_blocks(page), docs_build.src / "_build" / "gallery_output" / name
+
+
+def printed_blocks(page: str) -> str:
+    """The captured stdout of a gallery page: its output blocks, dedented and joined.
+
+    sphinx-gallery writes each block's stdout under ``.. rst-class::
+    sphx-glr-script-out`` as a ``code-block`` indented by 4 spaces.
+    """
+    lines = []
+    for block in page.split(".. rst-class:: sphx-glr-script-out")[1:]:
+        body = block.split(".. code-block:: none\n", 1)[1].splitlines()[1:]
+        for line in body:
+            if line and not line.startswith("    "):
+                break
+            lines.append(line[4:])
+        while lines and not lines[-1]:
+            lines.pop()
+    return "\n".join(lines) + "\n"
 
 
 def png_size(path: Path) -> tuple[int, int]:
@@ -84,9 +113,8 @@ def test_without_an_argument_it_writes_beside_the_caller_and_says_where(name, tm
     assert f"writing into {folder.resolve()}" in stdout
 
 
-def test_four_methods(tmp_path):
-    out = tmp_path / "not" / "yet" / "there"
-    stdout = run("four_methods", out)
+def test_four_methods(docs_build):
+    stdout, out = gallery_run(docs_build, "four_methods")
     rows = re.findall(r"(\w+)\s+max \|xs error\| = (\S+) m with (\d+) RHS evaluations", stdout)
     errors = {m: float(e) for m, e, _ in rows}
     nfev = {m: int(n) for m, _, n in rows}
@@ -107,9 +135,8 @@ def test_four_methods(tmp_path):
         assert (out / name).stat().st_size > 20_000
 
 
-def test_seed_paper(tmp_path):
-    out = tmp_path / "a" / "b"
-    stdout = run("seed_paper", out)
+def test_seed_paper(docs_build):
+    stdout, out = gallery_run(docs_build, "seed_paper")
     names = sorted(p.name for p in out.glob("*.png"))
     assert names == [
         "seed_figure_3_euler.png",
@@ -125,9 +152,8 @@ def test_seed_paper(tmp_path):
         assert abs(orders[method] - p) < 0.2, (method, orders[method])
 
 
-def test_custom_method_writes_a_full_report(tmp_path):
-    out = tmp_path / "x" / "y"
-    run("custom_method", out)
+def test_custom_method_writes_a_full_report(docs_build):
+    _, out = gallery_run(docs_build, "custom_method")
     report = out / "custom_report"
     with open(report / "methods.csv", newline="", encoding="utf-8") as fh:
         rows = {r["method"]: r for r in csv.DictReader(fh)}
@@ -144,9 +170,8 @@ def test_custom_method_writes_a_full_report(tmp_path):
     assert (report / "report.pdf").read_bytes()[:5] == b"%PDF-"
 
 
-def test_modal_analysis(tmp_path):
-    out = tmp_path / "deep" / "er"
-    stdout = run("modal_analysis", out)
+def test_modal_analysis(docs_build):
+    stdout, out = gallery_run(docs_build, "modal_analysis")
     # the body mode of the seed's car, independently: the slower pair of A's eigenvalues
     lam = np.linalg.eigvals(seed_A())
     body = min(lam[lam.imag > 0], key=abs)
@@ -158,9 +183,8 @@ def test_modal_analysis(tmp_path):
     assert png_size(out / "modal_tire_stiffness.png") == (770, 495)  # 7 × 4.5 in at 110 dpi
 
 
-def test_road_comfort(tmp_path):
-    out = tmp_path / "r" / "c"
-    stdout = run("road_comfort", out)
+def test_road_comfort(docs_build):
+    stdout, out = gallery_run(docs_build, "road_comfort")
     with open(out / "road_comfort.csv", newline="", encoding="utf-8") as fh:
         rows = list(csv.reader(fh))
     head, body = rows[0], rows[1:]
@@ -179,9 +203,8 @@ def test_road_comfort(tmp_path):
     assert png_size(out / "road_comfort.png")[0] == 1100  # 10 in at 110 dpi
 
 
-def test_design_sweep(tmp_path):
-    out = tmp_path / "s" / "w"
-    stdout = run("design_sweep", out)
+def test_design_sweep(docs_build):
+    stdout, out = gallery_run(docs_build, "design_sweep")
     with open(out / "design_sweep.csv", newline="", encoding="utf-8") as fh:
         rows = list(csv.DictReader(fh))
     assert len(rows) == 1000  # 40 stiffnesses x 25 damping ratios
@@ -195,15 +218,14 @@ def test_design_sweep(tmp_path):
     assert png_size(out / "design_sweep.png") == (880, 495)  # 8 × 4.5 in at 110 dpi
 
 
-def test_half_car_pitch(tmp_path):
+def test_half_car_pitch(docs_build):
     """The printed peaks against python-control's exact response of the same bump,
     and the wheelbase-filtering frequencies from the wheelbase and the speed."""
     import control
 
     import qc_control as qc
 
-    out = tmp_path / "h" / "p"
-    stdout = run("half_car_pitch", out)
+    stdout, out = gallery_run(docs_build, "half_car_pitch")
     car = qc.HalfCarParams(seat_x=0.3)
     L = car.a + car.b
     T = np.linspace(0.0, 3.0, 3001)
@@ -223,7 +245,7 @@ def test_half_car_pitch(tmp_path):
     assert png_size(out / "half_car_wheelbase_filtering.png") == (880, 495)
 
 
-def test_full_car_roll(tmp_path):
+def test_full_car_roll(docs_build):
     """The roll frequencies against the eigenvalues of A, and the peak roll
     against python-control's exact response."""
     import dataclasses
@@ -232,8 +254,7 @@ def test_full_car_roll(tmp_path):
 
     import qc_control as qc
 
-    out = tmp_path / "f" / "r"
-    stdout = run("full_car_roll", out)
+    stdout, out = gallery_run(docs_build, "full_car_roll")
     plain = qc.FullCarParams()
     barred = dataclasses.replace(plain, arb_front=20e3, arb_rear=8e3)
     T = np.linspace(0.0, 3.0, 3001)
@@ -264,9 +285,8 @@ def test_no_example_or_library_figure_calls_show():
         assert "import matplotlib.pyplot" not in text, path
 
 
-def test_active_suspension(tmp_path):
-    out = tmp_path / "a" / "s"
-    stdout = run("active_suspension", out)
+def test_active_suspension(docs_build):
+    stdout, out = gallery_run(docs_build, "active_suspension")
     p = qc_params()
     printed = float(re.search(r"cs = (\S+) N·s/m", stdout).group(1))
     assert printed == pytest.approx(p.ks * np.sqrt((p.ms + p.mu) / p.ku), abs=0.05)  # closed form
@@ -285,11 +305,11 @@ def qc_params():
     return QuarterCarParams()
 
 
-def test_lift_off(tmp_path):
+def test_lift_off(docs_build):
     from scipy.integrate import solve_ivp
 
-    stdout = run("lift_off", tmp_path / "lo")
-    assert png_size(tmp_path / "lo" / "lift_off.png") == (700, 500)  # 7 × 5 in at 100 dpi
+    stdout, out = gallery_run(docs_build, "lift_off")
+    assert png_size(out / "lift_off.png") == (700, 500)  # 7 × 5 in at 100 dpi
     # the lift-off time, by solve_ivp on the equations written out here (seed car, gravity)
     ms, mu, ks, ku, cs, g = (
         301.2,

@@ -51,7 +51,13 @@ def _max_rel(a, b):
 
 @pytest.mark.parametrize(
     "method, substeps, events",
-    [("rk4", 1, False), ("heun", 1, False), ("midpoint", 2, False), ("rk4", 1, True)],
+    [
+        # RK4's two runs take over 2 s each; Heun and the midpoint rule keep the quick loop's
+        pytest.param("rk4", 1, False, marks=pytest.mark.slow),
+        ("heun", 1, False),
+        ("midpoint", 2, False),
+        pytest.param("rk4", 1, True, marks=pytest.mark.slow),
+    ],
 )
 def test_each_design_is_its_own_input_output_response(method, substeps, events):
     model = qc.nonlinear_quarter_car_model(**OPTIONS)
@@ -140,6 +146,7 @@ def test_compiled_steps_diverge_as_the_numpy_steps(monkeypatch):
     assert np.array_equal(np.isfinite(compiled.states), np.isfinite(plain.states))
 
 
+@pytest.mark.slow
 def test_compiled_steps_without_a_writable_cache(tmp_path):
     """Where numba finds no place to cache machine code (here: no cache locator
     that accepts the package, as for a read-only installation and home),

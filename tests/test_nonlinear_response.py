@@ -173,6 +173,7 @@ def _closed_loop_reference(umax=2.0, r=lambda t: 0.5 + 0.1 * t, x0=(0.5, 0.0, 0.
     return solve_ivp(rhs, (0, 10), list(x0), **TIGHT).sol
 
 
+@pytest.mark.slow
 def test_interconnection_against_solve_ivp():
     cl = _closed_loop()
     assert isinstance(cl, control.InterconnectedSystem)
@@ -553,6 +554,7 @@ def _car_sensor_law():
     return control.interconnect([car, sensor, law], inputs="zr", outputs=outputs, name="cl3")
 
 
+@pytest.mark.slow
 def test_fused_steps_with_chained_static_subsystems_against_control():
     # Two static blocks, the second fed by the first (several outputs: the general loop),
     # the controller smooth (tanh), so that solve_ivp at tight tolerance is a reference.

@@ -1,20 +1,20 @@
 """The course notebook runs from top to bottom, and its exercise checks work.
 
-Executed with nbclient in a fresh kernel, as a student runs it: once as
-shipped (every check says "not answered yet"), and once with the answers
-filled in (every check says "correct", and a wrong answer is refused).
-The checks compute their expected values independently of qc_control
-(eigenvalues of a matrix assembled from M, C, K; closed forms).
+Executed once per run with nbclient in a fresh kernel, as a student runs
+it (the ``course_run`` fixture of ``conftest.py``): the notebook as shipped
+(every check says "not answered yet"), then, in the same kernel, each
+exercise's answer followed by its check (every check says "correct") and a
+wrong answer (refused). The docs build renders the shipped cells of this
+same run (tests/test_docs.py), so the notebook is executed once, not three
+times. The checks compute their expected values independently of
+qc_control (eigenvalues of a matrix assembled from M, C, K; closed forms).
 """
-
-from pathlib import Path
 
 import nbformat
 import pytest
+from conftest import COURSE, SOLUTIONS
 
-nbclient = pytest.importorskip("nbclient", reason="the test extra (nbclient) is not installed")
-
-NOTEBOOK = Path(__file__).parent.parent / "examples" / "course.ipynb"
+NOTEBOOK = COURSE
 SECTIONS = [
     "## 1. The model and its modes",
     "## 2. The four methods",
@@ -23,37 +23,11 @@ SECTIONS = [
     "## 5. Roads and comfort",
     "## Exercises",
 ]
-#: The instructor's answers, each computed with qc_control as a student would.
-SOLUTIONS = {
-    "1": "answer_1 = qc.modal_analysis(params).body.fn",
-    "2": 'answer_2 = qc.max_stable_step("euler", sys)',
-    "3": """
-e = []
-for h in (0.01, 0.005):
-    Th = np.linspace(0.0, 10.0, round(10.0 / h) + 1)
-    r = qc.initial_response(sys, Th, X0, method="heun")
-    ex = control.initial_response(sys, Th, X0)
-    e.append(np.max(np.abs(output_signal(r, "xs") - output_signal(ex, "xs"))))
-answer_3 = np.log2(e[0] / e[1])
-""",
-    "4": 'answer_4 = qc.numerical_modes("euler", 0.01, sys).loc["body bounce", "zeta_h"]',
-    "5": "answer_5 = zetas[np.argmin(comfort)]",
-}
-
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("docs")]
 
 
 def tagged(nb, tag):
     return [c for c in nb.cells if tag in c.get("metadata", {}).get("tags", [])]
-
-
-def execute(nb, tmp_path):
-    """Run every cell in a fresh kernel, in ``tmp_path``; at most 120 s per cell."""
-    client = nbclient.NotebookClient(
-        nb, timeout=120, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
-    )
-    client.execute()
-    return nb
 
 
 def printed(cell) -> str:
@@ -75,8 +49,8 @@ def test_the_notebook_walks_the_seed_paper_and_is_stored_clean():
         assert answer.source.strip() == f"answer_{n} = None"
 
 
-def test_runs_as_shipped_and_every_check_waits_for_an_answer(tmp_path):
-    nb = execute(nbformat.read(NOTEBOOK, as_version=4), tmp_path)
+def test_runs_as_shipped_and_every_check_waits_for_an_answer(course_run):
+    nb = course_run.shipped
     errors = [o for c in nb.cells for o in c.get("outputs", []) if o.output_type == "error"]
     assert not errors
     images = [o for c in nb.cells for o in c.get("outputs", []) if "image/png" in o.get("data", {})]
@@ -84,21 +58,13 @@ def test_runs_as_shipped_and_every_check_waits_for_an_answer(tmp_path):
     for n in SOLUTIONS:
         (check,) = tagged(nb, f"check-{n}")
         assert printed(check).strip() == f"Exercise {n}: not answered yet"
-    assert list(tmp_path.iterdir()) == []  # it writes no files
+    assert course_run.files_written == []  # it writes no files
 
 
-def test_the_checks_accept_right_answers_and_refuse_a_wrong_one(tmp_path):
-    nb = nbformat.read(NOTEBOOK, as_version=4)
-    for n, code in SOLUTIONS.items():
-        (answer,) = tagged(nb, f"answer-{n}")
-        answer.source = code.strip()
-    (check_1,) = tagged(nb, "check-1")
-    nb.cells += [
-        nbformat.v4.new_code_cell("answer_1 = 2.0  # Hz: the wheel's, not the body's"),
-        nbformat.v4.new_code_cell(check_1.source),
-    ]
-    nb = execute(nb, tmp_path)
+def test_the_checks_accept_right_answers_and_refuse_a_wrong_one(course_run):
+    answered = course_run.answered
     for n in SOLUTIONS:
-        (check,) = tagged(nb, f"check-{n}")
+        (check,) = tagged(answered, f"answered-check-{n}")
         assert printed(check).strip() == f"Exercise {n}: correct", printed(check)
-    assert printed(nb.cells[-1]).startswith("Exercise 1: not yet.")
+    (wrong,) = tagged(answered, "wrong-check-1")
+    assert printed(wrong).startswith("Exercise 1: not yet.")

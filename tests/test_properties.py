@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import io
 import math
+import re
 from pathlib import Path
 
 import control
@@ -56,8 +57,21 @@ def build(values):
     except ValueError as exc:
         # refused: the message names what is wrong and the values it saw
         text = str(exc)
-        assert "time scales" in text or any(k in text for k in values), text
+        assert "time scales" in text or names_a_field(text, values), text
         return None
+
+
+def names_a_field(text: str, fields) -> bool:
+    """Whether ``text`` names one of ``fields`` as a word ("mu", not the "mu" of "must")."""
+    return any(re.search(rf"\b{re.escape(k)}\b", text) for k in fields)
+
+
+def test_the_field_check_needs_the_field_as_a_word():
+    fields = ("ms", "mu", "ks", "ku", "zeta")
+    assert not names_a_field("the value must be a number", fields)  # "mu" of "must"
+    assert not names_a_field("itemsize too large: kusp", fields)
+    assert names_a_field("mu (unsprung mass) must be > 0 kg, got 0.0", fields)
+    assert names_a_field("ks = 1e300 overflows", fields)
 
 
 def rk4_amplification(z):

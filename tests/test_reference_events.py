@@ -123,6 +123,7 @@ def test_reference_through_bump_stop_events(clearance, stiffness, height):
     assert np.all(np.isfinite(ref.x)) and 0 < ref.accuracy < 1e-9
 
 
+@pytest.mark.slow
 def test_reference_of_a_tire_of_1e9():
     """The CLI's `--ku 1e9`: the wheel bounces off the road, ~20 contacts in 0.8 s."""
     p = qc.QuarterCarParams(ku=1e9)
@@ -160,6 +161,7 @@ def test_a_car_at_rest_has_an_exact_reference():
     assert cmp.reference_error == 0.0 and cmp.nonlinear.t_events.size == 0
 
 
+@pytest.mark.slow
 def test_scenario_with_a_stop_of_clearance_0():
     """`Scenario(model='nonlinear', bump_stop=(0, 1e5)).run()`, against the hand solve."""
     from qc_control.cli.scenario import Scenario

@@ -292,6 +292,7 @@ def test_sweep_against_control(seated):
         )
 
 
+@pytest.mark.slow
 def test_write_report_draws_its_wheel(seated, tmp_path):
     from qc_control.report.figures import method_figure, reference_figure
 
@@ -325,6 +326,7 @@ def _rk4(A, B, T, U, x0):
     return np.array(xs).T
 
 
+@pytest.mark.slow
 def test_scenario_and_cli_report_from_toml(seated, tmp_path, capsys):
     config = tmp_path / "seated.toml"
     config.write_text(

@@ -73,6 +73,7 @@ def test_ruff_format_is_clean():
 
 
 @pytest.mark.slow  # measured 0.9-3 s with a warm .mypy_cache, 8-21 s cold
+@pytest.mark.xdist_group("mypy")  # one .mypy_cache in the work tree: one writer at a time
 def test_mypy_is_clean():
     run = _run([sys.executable, "-m", "mypy", "qc_control"])
     assert run.returncode == 0, run.stdout + run.stderr
@@ -91,6 +92,7 @@ def test_import_contracts_hold():
     assert run.returncode == 0, run.stdout + run.stderr
 
 
+@pytest.mark.xdist_group("mypy")
 def test_the_tools_accept_their_configuration(tmp_path):
     """The strict xfails above would also hide a broken configuration; this
     does not: mypy reads [tool.mypy] without a warning, and import-linter
