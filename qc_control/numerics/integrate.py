@@ -687,7 +687,7 @@ def _integrate_events(f, t, x, tab, substeps, events, jac=None) -> Solution:
         message=message,
         t_events=np.array(run.t_events),
         i_events=np.array(run.i_events, dtype=int),
-        x_events=np.array(run.x_events).reshape(len(run.x_events), -1).T,
+        x_events=np.array(run.x_events).reshape(len(run.x_events), x.size).T,
     )
 
 

@@ -76,6 +76,7 @@ from ..numerics.trajectory_stability import (
 )
 from ..responses.timeresp import (
     check_initial_state,
+    forcing_samples,
     check_input_samples,
     input_output_response,
 )
@@ -86,9 +87,6 @@ __all__ = ["simulate_batch", "BatchResponse", "nonlinear_sweep", "beyond_stabili
 #: Samples per block: the states of a block, ``(n, m, BLOCK)``, are turned into
 #: outputs and reduced together (a few MB for a thousand designs).
 BLOCK = 64
-#: The forcing of a batch whose law depends on time is evaluated at most at
-#: this many samples (evenly spread) for the growth bound (`beyond_stability`).
-GROWTH_SAMPLES = 4096
 #: Designs stepped together when no executor splits them: large enough that
 #: NumPy's per-call cost is spread over many designs, small enough for the cache.
 NL_VECTOR_DESIGNS = 2048
@@ -301,13 +299,15 @@ def _forcing_peak(dynamics, T, U, x0: np.ndarray) -> np.ndarray:
 
     A `_time_free` batch's forcing depends on the inputs only: it is bounded
     by ``‖f(x0, u0)‖ + ‖B‖₂ max‖u - u0‖₂`` with ``B = ∂f/∂u`` at the start (by
-    differences), one set of calls; otherwise it is evaluated at up to
-    `GROWTH_SAMPLES` samples.
+    differences), one set of calls; otherwise it is evaluated at the samples
+    `qc_control.responses.timeresp.forcing_samples` picks, as for a single run.
     """
     with np.errstate(over="ignore", invalid="ignore"):
         if not _time_free(dynamics):
-            pick = np.unique(np.linspace(0, T.size - 1, GROWTH_SAMPLES).round().astype(int))
-            rows = [np.linalg.norm(dynamics.rhs(float(T[k]), x0, U[:, k]), axis=0) for k in pick]
+            rows = [
+                np.linalg.norm(dynamics.rhs(float(T[k]), x0, U[:, [k] * x0.shape[1]]), axis=0)
+                for k in forcing_samples(U).tolist()
+            ]
             return np.max(rows, axis=0)
         u0 = np.repeat(U[:, :1], x0.shape[1], axis=1)
         f0 = np.asarray(dynamics.rhs(float(T[0]), x0, u0))
