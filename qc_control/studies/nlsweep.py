@@ -76,8 +76,8 @@ from ..numerics.trajectory_stability import (
 )
 from ..responses.timeresp import (
     check_initial_state,
-    forcing_samples,
     check_input_samples,
+    forcing_samples,
     input_output_response,
 )
 from ..ride.metrics import METRICS, Metric, MetricStream, RideSignals
