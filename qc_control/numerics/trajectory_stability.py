@@ -175,8 +175,8 @@ class TrajectoryWatch:
 
     For each state ``i`` and design ``j``: the sample index right after the
     state's largest change between samples, and the whole state there; and
-    how far each design has moved from its start (``departure``). Memory
-    ``O(n² m)``, whatever the number of samples.
+    each state's range, from which `departure` is read. Memory ``O(n² m)``,
+    whatever the number of samples.
 
     Parameters
     ----------
@@ -189,24 +189,41 @@ class TrajectoryWatch:
         n, m = x0.shape
         self.first = x0.copy()
         self.prev = x0.copy()
+        self.high, self.low = x0.copy(), x0.copy()
         self.jump = np.full((n, m), -1.0)
         self.index = np.zeros((n, m), dtype=int)
         self.states = np.broadcast_to(x0[:, None, :], (n, n, m)).copy()  # [state, tracker, design]
-        self.departure = np.zeros(m)  # the largest ‖x - x0‖₂ so far
+
+    @property
+    def departure(self) -> np.ndarray:
+        """``(m,)``: the 2-norm of each state's largest distance from its start, at
+        least the largest ``‖x - x0‖₂`` and at most ``√n`` times it (NaN: ``inf``)."""
+        with np.errstate(invalid="ignore", over="ignore"):
+            far = np.maximum(self.high - self.first, self.first - self.low)
+            norm = np.sqrt(np.sum(far * far, axis=0))
+        return np.where(np.isnan(norm), np.inf, norm)
 
     def update(self, start: int, xb: np.ndarray) -> None:
-        """Take in the samples ``start .. start + L - 1`` (``xb`` ``(n, m, L)``, ``start >= 1``)."""
+        """Take in the samples ``start .. start + L - 1`` (``xb`` ``(n, m, L)``, ``start >= 1``).
+
+        The work runs along the samples of ``(n, L, m)``: `simulate_batch`'s
+        blocks are laid out so, with each sample's designs contiguous.
+        """
+        y = np.swapaxes(xb, 1, 2)
+        n, L, m = y.shape
+        step = np.empty((n, L, m))
         with np.errstate(invalid="ignore", over="ignore"):
-            step = np.abs(np.diff(xb, axis=-1, prepend=self.prev[:, :, None]))
-            away = np.sqrt(np.sum((xb - self.first[:, :, None]) ** 2, axis=0)).max(axis=-1)
-            self.departure = np.fmax(self.departure, np.where(np.isnan(away), np.inf, away))
-        step[~np.isfinite(step)] = -1.0
-        k = np.argmax(step, axis=-1)  # (n, m)
-        best = np.take_along_axis(step, k[..., None], axis=-1)[..., 0]
+            np.subtract(y[:, :1], self.prev[:, None], out=step[:, :1])
+            np.subtract(y[:, 1:], y[:, :-1], out=step[:, 1:])
+            np.abs(step, out=step)
+            np.fmax(self.high, y.max(axis=1), out=self.high)
+            np.fmin(self.low, y.min(axis=1), out=self.low)
+        best = step.max(axis=1)  # (n, m); NaN where a design diverged: never kept
         better = best > self.jump
         if np.any(better):
-            self.jump[better] = best[better]
-            self.index[better] = start + k[better]
-            at = np.take_along_axis(xb[:, None, :, :], k[None, :, :, None], axis=-1)[..., 0]
-            self.states[:, better] = at[:, better]
-        self.prev = xb[..., -1].copy()
+            i, j = np.nonzero(better)
+            k = np.argmax(step[i, :, j], axis=-1)  # only where the block holds a new largest
+            self.jump[i, j] = best[i, j]
+            self.index[i, j] = start + k
+            self.states[:, i, j] = y[:, k, j]
+        self.prev = y[:, -1].copy()

@@ -1791,12 +1791,58 @@ def _check_samples(traj: _IOTrajectory) -> np.ndarray:
     return np.unique(np.concatenate(picks))
 
 
+#: Of the stage states of the steps replayed around the fastest changes, this
+#: many (those where the state moves fastest) have their Jacobian checked.
+STAGE_CHECKS = 16
+
+
+def _stage_points(rhs, traj: _IOTrajectory, u_of_t, h: float):
+    """``(t, x (n, P), u (k, P))``: the states at which the method evaluated the
+    right-hand side in the intervals around each state's fastest change (its
+    steps taken again, `integrate`), where it moves fastest.
+
+    A stiff branch visited only inside an interval (a stop engaged between two
+    samples) is seen there: the samples on either side may both lie outside it.
+    """
+    x = traj.x
+    finite = np.all(np.isfinite(x), axis=0)
+    last = int(np.flatnonzero(finite)[-1]) if np.any(finite) else 0
+    if last < 1 or traj.computed.method.implicit:  # an A-stable method has no limit
+        return None
+    after = fastest_changes(x[:, : last + 1])
+    starts = np.unique(np.concatenate([after - 1, np.minimum(after, last - 1)]))
+    seen: list = []
+
+    def recorded(t, xs):
+        du = rhs(t, xs, np.asarray(u_of_t(t), dtype=float).reshape(-1))
+        seen.append((t, np.array(xs), float(np.linalg.norm(du))))
+        return du
+
+    with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore"):
+        warnings.simplefilter("ignore")  # the replay of a diverging step warns again
+        for k in starts.tolist():
+            span = traj.t[k : k + 2]
+            n_sub = max(1, round(float(span[1] - span[0]) / h))
+            integrate(recorded, span, x[:, k], traj.computed.method, substeps=n_sub)
+    rates = np.nan_to_num(np.array([r for _, _, r in seen]), nan=np.inf)
+    keep = np.argsort(-rates, kind="stable")[:STAGE_CHECKS]
+    t = np.array([seen[i][0] for i in keep])
+    xs = np.stack([seen[i][1] for i in keep], axis=1)
+    us = np.array([np.asarray(u_of_t(s), dtype=float).reshape(-1) for s in t]).T
+    return t, xs, us.reshape(-1, t.size)
+
+
 def _check_points(rhs, traj: _IOTrajectory, u: np.ndarray, u_of_t, h: float):
-    """``(t, x (n, P), u (k, P))``: the samples `_check_samples` picks and, with
-    events, the states just past (at most `EVENT_CHECKS` of) them, in the
-    branch each event enters."""
+    """``(t, x (n, P), u (k, P))``: the samples `_check_samples` picks, the stage
+    states `_stage_points` picks and, with events, the states just past (at
+    most `EVENT_CHECKS` of) them, in the branch each event enters."""
     samples = _check_samples(traj)
     t, x, u_at = traj.t[samples], traj.x[:, samples], u[:, samples]
+    stages = _stage_points(rhs, traj, u_of_t, h)
+    if stages is not None:
+        t = np.concatenate([t, stages[0]])
+        x = np.concatenate([x, stages[1]], axis=1)
+        u_at = np.concatenate([u_at, stages[2]], axis=1)
     xe = traj.x_events
     if xe is None or not xe.size:
         return t, x, u_at
