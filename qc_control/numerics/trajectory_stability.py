@@ -174,7 +174,8 @@ class TrajectoryWatch:
     """Follows ``m`` trajectories block by block and keeps where to look (module notes).
 
     For each state ``i`` and design ``j``: the sample index right after the
-    state's largest change between samples, and the whole state there; and
+    state's largest change between samples, and the whole state there and
+    at the sample before (``states``, ``before``: ``[state, tracker, design]``); and
     each state's range, from which `departure` is read. Memory ``O(n² m)``,
     whatever the number of samples.
 
@@ -193,6 +194,7 @@ class TrajectoryWatch:
         self.jump = np.full((n, m), -1.0)
         self.index = np.zeros((n, m), dtype=int)
         self.states = np.broadcast_to(x0[:, None, :], (n, n, m)).copy()  # [state, tracker, design]
+        self.before = self.states.copy()  # the sample before each of those
 
     @property
     def departure(self) -> np.ndarray:
@@ -226,4 +228,5 @@ class TrajectoryWatch:
             self.jump[i, j] = best[i, j]
             self.index[i, j] = start + k
             self.states[:, i, j] = y[:, k, j]
+            self.before[:, i, j] = np.where(k > 0, y[:, np.maximum(k - 1, 0), j], self.prev[:, j])
         self.prev = y[:, -1].copy()

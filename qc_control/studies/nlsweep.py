@@ -291,7 +291,42 @@ def beyond_stability(dynamics, T, U, tab, substeps: int, watch: TrajectoryWatch)
     points += [(watch.index[i], watch.states[:, i]) for i in range(n)]
     for index, x in points:
         bad |= unstable_designs(tab, h, _batch_jacobians(dynamics, T, U, index, x))
+    if not tab.implicit and _time_free(dynamics):
+        for i in range(n):
+            bad |= _stages_unstable(dynamics, T, U, tab, substeps, watch, i)
     return bad
+
+
+def _stages_unstable(dynamics, T, U, tab, substeps: int, watch: TrajectoryWatch, i: int):
+    """``(m,)`` bool: each design's interval into state ``i``'s fastest change taken
+    again (`integrate` on the batch, each design from its own sample), judged at
+    the stage state where the design moves fastest.
+
+    As `qc_control.input_output_response`'s stage check: a stiff branch visited
+    only inside an interval has its stages there. A `_time_free` batch only (each
+    design's inputs at its own stage times, one set of calls).
+    """
+    m = watch.first.shape[1]
+    dt = float(T[1] - T[0])
+    t0 = T[np.maximum(watch.index[i], 1) - 1]  # (m,) each design's interval start
+    u_of = linear_input(T, U)
+    seen: list = []
+
+    def f(tau, X):
+        u = u_of.at(t0 + tau).T  # (k, m)
+        dx = np.asarray(dynamics.rhs(float(T[0]), np.ascontiguousarray(X.T), u))
+        seen.append((tau, X.T.copy(), np.linalg.norm(dx, axis=0)))
+        return dx.T
+
+    with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore"):
+        warnings.simplefilter("ignore")  # a diverging replay warns again
+        integrate(f, [0.0, dt], watch.before[:, i].T, tab, substeps=substeps)
+    rates = np.nan_to_num(np.stack([r for _, _, r in seen]), nan=np.inf)  # (S, m)
+    pick = np.argmax(rates, axis=0)
+    xs = np.stack([x for _, x, _ in seen])[pick, :, np.arange(m)].T  # (n, m)
+    taus = np.array([tau for tau, _, _ in seen])[pick]
+    J = jacobians(dynamics.rhs, float(T[0]), xs, u_of.at(t0 + taus).T)
+    return unstable_designs(tab, dt / substeps, J)
 
 
 def _forcing_peak(dynamics, T, U, x0: np.ndarray) -> np.ndarray:
