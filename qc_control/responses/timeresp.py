@@ -2083,7 +2083,14 @@ def input_output_response(
         With ``method``, ``h`` (the largest step), ``substeps``, ``steps``,
         ``nfev``, ``t_events`` and ``event_labels``; ``success`` False with
         a ``message`` if the state became non-finite (the response then
-        stops at the last finite sample).
+        stops at the last finite sample), or, at a fixed step with an
+        explicit method, if the step exceeds the method's stability limit
+        of the Jacobian along the trajectory or the state grew past its
+        linearisation's bound (a `DivergenceWarning` names the method,
+        ``h`` and the limit; see
+        `qc_control.numerics.trajectory_stability`). A
+        `control.StateSpace` is judged on its ``A``, as `initial_response`
+        judges it.
 
     Notes
     -----
@@ -2093,7 +2100,11 @@ def input_output_response(
     linearisation at the initial point (python-control's
     `~control.NonlinearIOSystem.linearize`). Away from that point the
     Jacobian changes, so this is a guide, not a bound: give ``substeps`` or
-    ``max_step`` when the dynamics speed up along the trajectory.
+    ``max_step`` when the dynamics speed up along the trajectory. The run
+    is then checked where the Jacobian matters (the start, the end, each
+    state's peak and fastest change, the stages of the steps around it, the
+    states just past each located event): a stop that engages beyond the
+    step's limit makes ``success`` False.
 
     Unlike on a linear system, Midpoint and Heun differ here: they agree on
     ``x' = Ax + Bu`` with ``u`` linear within a step, not on a nonlinear
