@@ -236,3 +236,39 @@ def test_success_agrees_with_a_tight_reference(
     assert r.success or r.message
     if r.success:
         assert _within_judgement(r.states, _reference(car, T))
+
+
+# ------------------------------------------------------------ the pieces
+
+
+def test_watch_keeps_what_the_whole_trajectory_shows():
+    """TrajectoryWatch fed block by block against the whole trajectory at once:
+    each state's largest change (np.diff over all samples), the states on
+    either side of it, and the largest distance from the start."""
+    from qc_control.numerics.trajectory_stability import TrajectoryWatch
+
+    rng = np.random.default_rng(7)
+    n, m, N = 3, 5, 200
+    x = np.cumsum(rng.normal(size=(n, m, N)), axis=-1)
+    x[..., 0] = rng.normal(size=(n, m))
+    watch = TrajectoryWatch(x[..., 0])
+    for start in range(0, N, 64):  # blocks as simulate_batch yields them (sample 0 first)
+        watch.update(start, np.ascontiguousarray(x[..., start : start + 64]))
+    after = np.argmax(np.abs(np.diff(x, axis=-1)), axis=-1) + 1  # (n, m)
+    np.testing.assert_array_equal(watch.index, after)
+    for i in range(n):
+        for j in range(m):
+            np.testing.assert_array_equal(watch.states[:, i, j], x[:, j, after[i, j]])
+            np.testing.assert_array_equal(watch.before[:, i, j], x[:, j, after[i, j] - 1])
+    far = np.max(np.abs(x - x[..., :1]), axis=-1)  # each state's farthest, (n, m)
+    np.testing.assert_allclose(watch.departure, np.sqrt(np.sum(far**2, axis=0)), rtol=1e-15)
+
+
+def test_growth_limit_is_the_closed_form_on_a_decaying_mode():
+    """z' = -a z + w: sup|z| = w/a (kappa = 1), so the limit is 100 w/a."""
+    from qc_control.numerics.trajectory_stability import GROWTH_FACTOR, growth_limit
+
+    a, w = 4.0, 2.0
+    limit = growth_limit(np.array([[[-a]], [[a]]]), np.array([w, w]))
+    assert limit[0] == pytest.approx(GROWTH_FACTOR * w / a, rel=1e-12)
+    assert limit[1] == np.inf  # a growing linearisation bounds nothing
