@@ -128,7 +128,12 @@ def test_compiled_steps_equal_the_numpy_steps(method, substeps, options, monkeyp
     monkeypatch.setattr(NonlinearQuarterCarBatch, "compiled_stepper", lambda self: None)
     plain = simulate_batch(dynamics, T2, np.zeros(4), U, method, substeps=substeps)
     assert _max_rel(compiled.states, plain.states) < 1e-13
-    assert np.array_equal(compiled.success, plain.success) and compiled.success.all()
+    assert np.array_equal(compiled.success, plain.success)
+    # no design blew up; success also says the step stayed within the stability limit
+    # along the trajectory, which Euler at 1 ms is not on the knee damper's softer
+    # branch (body mode -0.16 ± 19.2j 1/s: Euler's limit 2·0.16/19.2² = 0.86 ms)
+    assert np.isfinite(compiled.states).all()
+    assert compiled.success.all() or (method == "euler" and options is OPTIONS)
     if options.get("tire", "unilateral") == "unilateral":  # a wheel does leave the road
         assert np.any(plain.outputs["tire_force"] == 0.0)
 

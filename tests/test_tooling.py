@@ -125,7 +125,7 @@ def test_every_numerics_module_is_kept_from_the_vehicle():
     assert numerics == {
         "integrate", "interconnect", "limits", "lti", "messages", "methods",
         "order_conditions", "recurrence", "stability", "stepper", "compiled_stepper",
-        "adaptive", "sampled", "clocked", "exact",
+        "adaptive", "sampled", "clocked", "exact", "trajectory_stability",
     }  # fmt: skip
     vehicle = {p.stem for p in (PACKAGE / "models").glob("*.py")}
     assert {"vehicle", "quarter", "halfcar", "nonlinear", "nlkernel"} <= vehicle

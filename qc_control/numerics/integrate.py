@@ -96,6 +96,8 @@ class Solution:
     i_events : ndarray of int, shape (k,)
         Which event function (its index in the vector ``events`` returns)
         changed sign at each of ``t_events``.
+    x_events : ndarray, shape (n, k)
+        The state at each of ``t_events`` (the method's step to it).
     accepted_times : ndarray or None
         An adaptive run's start and the end of each accepted step
         (``n_accepted + 1`` times, as ``solve_ivp(...).t``); None at a
@@ -119,6 +121,7 @@ class Solution:
     message: str
     t_events: np.ndarray = field(default_factory=lambda: np.empty(0))
     i_events: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=int))
+    x_events: np.ndarray = field(default_factory=lambda: np.empty((0, 0)))
     accepted_times: np.ndarray | None = None
     n_accepted: int = 0
     n_rejected: int = 0
@@ -684,6 +687,7 @@ def _integrate_events(f, t, x, tab, substeps, events, jac=None) -> Solution:
         message=message,
         t_events=np.array(run.t_events),
         i_events=np.array(run.i_events, dtype=int),
+        x_events=np.array(run.x_events).reshape(len(run.x_events), x.size).T,
     )
 
 
@@ -703,6 +707,7 @@ class _EventSteps:
         self.calls = self.steps = 0
         self.t_events: list[float] = []
         self.i_events: list[int] = []
+        self.x_events: list[np.ndarray] = []
         self._shape: tuple[int, ...] | None = None  # of the switching functions
 
     def _counted(self, t, x):
@@ -752,6 +757,7 @@ class _EventSteps:
             ta = ta + s_root
             self.t_events.append(ta)
             self.i_events.append(k)
+            self.x_events.append(np.array(x))
             if ta >= tb:
                 return x
         return xb

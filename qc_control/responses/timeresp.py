@@ -68,6 +68,13 @@ from ..numerics.methods import TABLEAUS, ButcherTableau, get_method
 from ..numerics.sampled import linear_input
 from ..numerics.stability import max_stable_step, stability_coefficients, step_is_stable
 from ..numerics.stepper import substeps_for
+from ..numerics.trajectory_stability import (
+    GROWTH_FACTOR,
+    fastest_changes,
+    first_unstable,
+    growth_limit,
+    jacobians,
+)
 
 __all__ = [
     "FixedStepResponse",
@@ -1497,6 +1504,7 @@ class _IOTrajectory(NamedTuple):
     event_labels: tuple[str, ...]
     fused: FusedSteps | None  # whose nonlinear outputs were kept from each step's first stage
     compiled: CompiledInterconnect | None
+    x_events: np.ndarray | None = None  # (n, k): the state at each of t_events
 
 
 def _io_problem(sys, T, U, X0, params) -> _IOProblem:
@@ -1629,6 +1637,7 @@ def _io_integrate(sys, prob: _IOProblem, grid, at, n_sub, computed: _Computed, i
     if io.opts.adaptive:
         return _io_adaptive(sys, prob, grid, at, computed, io, u_of_t)
     t_events: np.ndarray = np.empty(0)
+    x_events: np.ndarray | None = None
     event_labels: tuple[str, ...] = ()
     compiled = compile_interconnect(sys) if io.fast else None
     fused = None
@@ -1656,7 +1665,7 @@ def _io_integrate(sys, prob: _IOProblem, grid, at, n_sub, computed: _Computed, i
             return g(t, x, u_of_t(t), current)
 
         sol = integrate(f, grid, x0, tab, substeps=n_sub, events=switching)
-        t_events = sol.t_events
+        t_events, x_events = sol.t_events, sol.x_events
         event_labels = tuple(
             labels[i] if i < len(labels) else str(i) for i in sol.i_events.tolist()
         )
@@ -1664,8 +1673,9 @@ def _io_integrate(sys, prob: _IOProblem, grid, at, n_sub, computed: _Computed, i
     keep = np.arange(sol.t.size) if at is None else at[at < sol.t.size]
     t_out, x = (sol.t, sol.x) if at is None else (sol.t[keep], sol.x[:, keep])
     return _IOTrajectory(
-        t_out, x, keep, computed, sol.success, sol.message, t_events, event_labels, fused, compiled
-    )
+        t_out, x, keep, computed, sol.success, sol.message, t_events, event_labels, fused,
+        compiled, x_events,
+    )  # fmt: skip
 
 
 def _io_adaptive(sys, prob: _IOProblem, grid, at, computed: _Computed, io, u_of_t):
@@ -1747,16 +1757,207 @@ def _io_response(sys, T, U, X0, layout: _Layout, io: _IOOptions):
     else:
         traj = _io_integrate(sys, prob, grid, at, n_sub, computed, io, u_of_t)
     u, y = _io_signals(sys, prob, traj, u_of_t)
+    success, message = traj.success, traj.message
+    if prob.x0.size and not io.opts.adaptive:
+        beyond = _beyond_stability_along(sys, traj, u, u_of_t, computed.h)
+        if beyond:
+            success, message = False, "; ".join(filter(None, [beyond, message]))
     resp = _response(
         sys,
         (traj.t, y, traj.x if prob.x0.size else None, u),
         layout,
         "Input/output response for " + sys.name,
-        traj.success,
-        traj.message,
+        success,
+        message,
     )
     resp.t_events, resp.event_labels = traj.t_events, traj.event_labels
     return _finalise(traj.computed.stamp(resp))
+
+
+#: At most this many located events have the Jacobian checked after them
+#: (spread over the run): enough to see every branch a piecewise law has.
+EVENT_CHECKS = 32
+#: The Jacobian after an event is taken this fraction of a step past it, along
+#: the motion: inside the branch just entered, well beyond the probe.
+EVENT_NUDGE = 1e-2
+
+
+def _check_samples(traj: _IOTrajectory) -> np.ndarray:
+    """The output samples whose Jacobian is checked (`qc_control.numerics.
+    trajectory_stability`, "Where to look"): first, last, each state's peak and
+    the sample after its fastest change."""
+    x = traj.x
+    finite = np.all(np.isfinite(x), axis=0)
+    last = int(np.flatnonzero(finite)[-1]) if np.any(finite) else 0
+    picks = [np.array([0, last])]
+    if last >= 1:
+        xs = x[:, : last + 1]
+        picks += [fastest_changes(xs), np.argmax(np.abs(xs), axis=-1)]
+    return np.unique(np.concatenate(picks))
+
+
+#: Of the stage states of the steps replayed around the fastest changes, this
+#: many (those where the state moves fastest) have their Jacobian checked.
+STAGE_CHECKS = 16
+
+
+def _stage_points(rhs, traj: _IOTrajectory, u_of_t, h: float):
+    """``(t, x (n, P), u (k, P))``: the states at which the method evaluated the
+    right-hand side in the intervals around each state's fastest change (its
+    steps taken again, `integrate`), where it moves fastest.
+
+    A stiff branch visited only inside an interval (a stop engaged between two
+    samples) is seen there: the samples on either side may both lie outside it.
+    """
+    x = traj.x
+    finite = np.all(np.isfinite(x), axis=0)
+    last = int(np.flatnonzero(finite)[-1]) if np.any(finite) else 0
+    if last < 1 or traj.computed.method.implicit:  # an A-stable method has no limit
+        return None
+    after = fastest_changes(x[:, : last + 1])
+    starts = np.unique(np.concatenate([after - 1, np.minimum(after, last - 1)]))
+    seen: list = []
+
+    def recorded(t, xs):
+        du = rhs(t, xs, np.asarray(u_of_t(t), dtype=float).reshape(-1))
+        seen.append((t, np.array(xs), float(np.linalg.norm(du))))
+        return du
+
+    with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore"):
+        warnings.simplefilter("ignore")  # the replay of a diverging step warns again
+        for k in starts.tolist():
+            span = traj.t[k : k + 2]
+            n_sub = max(1, round(float(span[1] - span[0]) / h))
+            integrate(recorded, span, x[:, k], traj.computed.method, substeps=n_sub)
+    rates = np.nan_to_num(np.array([r for _, _, r in seen]), nan=np.inf)
+    keep = np.argsort(-rates, kind="stable")[:STAGE_CHECKS]
+    t = np.array([seen[i][0] for i in keep])
+    xs = np.stack([seen[i][1] for i in keep], axis=1)
+    us = np.array([np.asarray(u_of_t(s), dtype=float).reshape(-1) for s in t]).T
+    return t, xs, us.reshape(-1, t.size)
+
+
+def _check_points(rhs, traj: _IOTrajectory, u: np.ndarray, u_of_t, h: float):
+    """``(t, x (n, P), u (k, P))``: the samples `_check_samples` picks, the stage
+    states `_stage_points` picks and, with events, the states just past (at
+    most `EVENT_CHECKS` of) them, in the branch each event enters."""
+    samples = _check_samples(traj)
+    t, x, u_at = traj.t[samples], traj.x[:, samples], u[:, samples]
+    stages = _stage_points(rhs, traj, u_of_t, h)
+    if stages is not None:
+        t = np.concatenate([t, stages[0]])
+        x = np.concatenate([x, stages[1]], axis=1)
+        u_at = np.concatenate([u_at, stages[2]], axis=1)
+    xe = traj.x_events
+    if xe is None or not xe.size:
+        return t, x, u_at
+    pick = np.unique(np.linspace(0, xe.shape[1] - 1, EVENT_CHECKS).round().astype(int))
+    te = traj.t_events[pick] + EVENT_NUDGE * h
+    ue = np.stack([np.asarray(u_of_t(s), dtype=float).reshape(-1) for s in te], axis=1)
+    ue = ue.reshape(u.shape[0], te.size)
+    with np.errstate(over="ignore", invalid="ignore"):
+        moved = [
+            xe[:, i] + EVENT_NUDGE * h * np.asarray(rhs(s, xe[:, i], ue[:, k]), dtype=float)
+            for k, (i, s) in enumerate(zip(pick.tolist(), traj.t_events[pick].tolist()))
+        ]
+    return (
+        np.concatenate([t, te]),
+        np.concatenate([x, np.stack(moved, axis=1)], axis=1),
+        np.concatenate([u_at, ue], axis=1),
+    )
+
+
+#: The linearisation's forcing ``f(t, x0, u(t))`` is evaluated at this many
+#: output samples (evenly spread) and where each input peaks, for the growth
+#: bound: a road bump lasting a 256th of the run is seen; a shorter one makes
+#: the bound smaller than it is, never the step's verdict on the Jacobians.
+GROWTH_SAMPLES = 256
+
+
+def forcing_samples(u: np.ndarray) -> np.ndarray:
+    """The samples of ``u`` ``(k, N)`` at which the growth bound's forcing is
+    evaluated: `GROWTH_SAMPLES` evenly spread, and where each input peaks."""
+    even = np.linspace(0, u.shape[-1] - 1, GROWTH_SAMPLES).round().astype(int)
+    peaks = [np.argmax(u, axis=-1), np.argmin(u, axis=-1)] if u.size else []
+    return np.unique(np.concatenate([even, *peaks]))
+
+
+def _guarded(rhs, n: int):
+    """``rhs`` that gives NaNs where the system's own code refuses a state (an
+    interconnection's loop that does not converge at a diverged state): such a
+    Jacobian is not judged (`first_unstable`)."""
+
+    def f(t, x, u):
+        try:
+            return np.asarray(rhs(t, x, u), dtype=float).reshape(n)
+        except Exception:  # the user's code, at a state the run may not have reached
+            return np.full(n, np.nan)
+
+    return f
+
+
+def _growth_beyond(rhs, traj: _IOTrajectory, u: np.ndarray, J0: np.ndarray) -> str:
+    """Words for a run that moved from its start past `growth_limit` of its
+    linearisation there (`qc_control.numerics.trajectory_stability`), else ''."""
+    x = traj.x
+    finite = np.all(np.isfinite(x), axis=0)
+    if not np.any(finite[1:]):
+        return ""
+    x0 = x[:, 0]
+    with np.errstate(over="ignore", invalid="ignore"):
+        departure = float(np.max(np.linalg.norm(x[:, finite] - x0[:, None], axis=0)))
+        pick = forcing_samples(u)
+        w = float(np.max([np.linalg.norm(rhs(traj.t[k], x0, u[:, k])) for k in pick.tolist()]))
+    limit = float(growth_limit(J0[None], np.array([w]))[0])
+    if departure <= limit:
+        return ""
+    return (
+        f"the state moved {departure:.4g} from its start, past {limit:.4g} "
+        f"({GROWTH_FACTOR:g} times what its linearisation at the start allows)"
+    )
+
+
+def _beyond_stability_along(sys, traj: _IOTrajectory, u: np.ndarray, u_of_t, h) -> str:
+    """The warning's words when the step ``h`` exceeds the method's stability
+    limit of the Jacobian somewhere along the trajectory, or the state grew
+    past its linearisation's bound, else ''.
+
+    A `control.StateSpace` is its own Jacobian ``A`` (the linear engine's
+    verdict, `_beyond_stability`); any other system's Jacobian is differenced
+    at the points `_check_points` picks (`qc_control.numerics.trajectory_stability`).
+    """
+    tab = traj.computed.method
+    if not h or traj.t.size == 0 or not np.all(np.isfinite(traj.x[:, 0])):
+        return ""
+    if isinstance(sys, control.StateSpace):
+        A = np.asarray(sys.A, dtype=float)
+        return _beyond_stability(tab, h, np.linalg.eigvals(A), A, sys.name)
+    rhs = _guarded(compat.state_derivative(sys), traj.x.shape[0])
+    t, x, u_at = _check_points(rhs, traj, u, u_of_t, h)
+
+    def columns(_, xs, which):
+        return np.stack([rhs(t[k], xs[:, k], u_at[:, k]) for k in which], axis=1)
+
+    J = jacobians(columns, None, x, range(t.size))
+    bad, h_max = first_unstable(tab, h, J)
+    if bad is not None:
+        message = (
+            f"h = {h:.6g} s exceeds the stability limit {h_max:.6g} s of {tab.name} for "
+            f"system {sys.name!r} at t = {float(t[bad]):.6g} s (the eigenvalues of the "
+            "Jacobian of its right-hand side there): the response grows"
+        )
+    else:
+        grown = _growth_beyond(rhs, traj, u, J[0])
+        if not grown:
+            return ""
+        h_max = max_stable_step(tab, np.linalg.eigvals(J[0]))  # J[0] is finite: x0 is
+        message = (
+            f"{grown} at h = {h:.6g} s with {tab.name} for system {sys.name!r} (stability "
+            f"limit {h_max:.6g} s at the start): the step is beyond the limit of a stiffer "
+            "branch between the samples; the response grows"
+        )
+    warnings.warn(message, DivergenceWarning, stacklevel=_stacklevel())
+    return message
 
 
 def _ivp_tolerances(ivp: dict, method, rtol, atol):
@@ -1929,7 +2130,14 @@ def input_output_response(
         With ``method``, ``h`` (the largest step), ``substeps``, ``steps``,
         ``nfev``, ``t_events`` and ``event_labels``; ``success`` False with
         a ``message`` if the state became non-finite (the response then
-        stops at the last finite sample).
+        stops at the last finite sample), or, at a fixed step with an
+        explicit method, if the step exceeds the method's stability limit
+        of the Jacobian along the trajectory or the state grew past its
+        linearisation's bound (a `DivergenceWarning` names the method,
+        ``h`` and the limit; see
+        `qc_control.numerics.trajectory_stability`). A
+        `control.StateSpace` is judged on its ``A``, as `initial_response`
+        judges it.
 
     Notes
     -----
@@ -1939,7 +2147,11 @@ def input_output_response(
     linearisation at the initial point (python-control's
     `~control.NonlinearIOSystem.linearize`). Away from that point the
     Jacobian changes, so this is a guide, not a bound: give ``substeps`` or
-    ``max_step`` when the dynamics speed up along the trajectory.
+    ``max_step`` when the dynamics speed up along the trajectory. The run
+    is then checked where the Jacobian matters (the start, the end, each
+    state's peak and fastest change, the stages of the steps around it, the
+    states just past each located event): a stop that engages beyond the
+    step's limit makes ``success`` False.
 
     Unlike on a linear system, Midpoint and Heun differ here: they agree on
     ``x' = Ax + Bu`` with ``u`` linear within a step, not on a nonlinear

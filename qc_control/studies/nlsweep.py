@@ -68,14 +68,21 @@ from ..numerics.limits import check_memory
 from ..numerics.methods import ButcherTableau, get_method
 from ..numerics.sampled import linear_input
 from ..numerics.stepper import GridSteps, rk_steps
+from ..numerics.trajectory_stability import (
+    TrajectoryWatch,
+    growth_limit,
+    jacobians,
+    unstable_designs,
+)
 from ..responses.timeresp import (
     check_initial_state,
     check_input_samples,
+    forcing_samples,
     input_output_response,
 )
 from ..ride.metrics import METRICS, Metric, MetricStream, RideSignals
 
-__all__ = ["simulate_batch", "BatchResponse", "nonlinear_sweep", "BLOCK"]
+__all__ = ["simulate_batch", "BatchResponse", "nonlinear_sweep", "beyond_stability", "BLOCK"]
 
 #: Samples per block: the states of a block, ``(n, m, BLOCK)``, are turned into
 #: outputs and reduced together (a few MB for a thousand designs).
@@ -96,7 +103,9 @@ class BatchResponse:
     outputs : dict label -> ndarray (m, N)
     success : ndarray of bool (m,)
         Whether each design's state stayed finite (a design that blows up
-        becomes NaN from there on; the others are unaffected).
+        becomes NaN from there on; the others are unaffected) and its step
+        stayed within the method's stability limit along its trajectory
+        (`beyond_stability`).
     t_events : list of ndarray
         Per design, the located event times (empty without ``events``).
     """
@@ -242,6 +251,110 @@ def _locate(dynamics, hit, ta, tb, x_a, x_b, tab, u_of, t_events):
             t_events[j] = np.concatenate([t_events[j], sol.t_events])
 
 
+def _time_free(dynamics) -> bool:
+    """Whether the batch's right-hand side depends on time only through its
+    inputs, so that each design's Jacobian can take its own inputs in one call.
+
+    A batch with compiled steps has no time-dependent law (the compiled step
+    takes the inputs at the stage times, never the time).
+    """
+    return getattr(dynamics, "compiled_stepper", lambda: None)() is not None
+
+
+def _batch_jacobians(dynamics, T, U, index: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Each design's Jacobian ``(m, n, n)`` at its own sample ``index`` ``(m,)``, state
+    ``x`` ``(n, m)``: one set of calls when the batch is `_time_free`, else one per
+    distinct sample (the designs there taken alone, ``dynamics.take``)."""
+    if _time_free(dynamics) or np.all(index == index[0]):
+        return jacobians(dynamics.rhs, float(T[index[0]]), x, U[:, index])
+    J = np.empty((x.shape[1],) + (x.shape[0],) * 2)
+    for k in np.unique(index).tolist():
+        at = np.flatnonzero(index == k)
+        J[at] = jacobians(dynamics.take(at).rhs, float(T[k]), x[:, at], U[:, [k] * at.size])
+    return J
+
+
+def beyond_stability(dynamics, T, U, tab, substeps: int, watch: TrajectoryWatch) -> np.ndarray:
+    """``(m,)`` bool: the designs whose step exceeds the method's stability limit
+    of their Jacobian at the start, at the end or right after any state's
+    fastest change (`qc_control.numerics.trajectory_stability`), as
+    `qc_control.input_output_response` checks a single run."""
+    m = watch.first.shape[1]
+    h = float(T[1] - T[0]) / substeps if T.size > 1 else 0.0
+    if h == 0.0:
+        return np.zeros(m, dtype=bool)
+    n = watch.first.shape[0]
+    J0 = _batch_jacobians(dynamics, T, U, np.zeros(m, dtype=int), watch.first)
+    bad = unstable_designs(tab, h, J0)
+    bad |= watch.departure > growth_limit(J0, _forcing_peak(dynamics, T, U, watch.first))
+    points = [(np.full(m, T.size - 1), watch.prev)]
+    points += [(watch.index[i], watch.states[:, i]) for i in range(n)]
+    for index, x in points:
+        bad |= unstable_designs(tab, h, _batch_jacobians(dynamics, T, U, index, x))
+    if not tab.implicit and _time_free(dynamics):
+        for i in range(n):
+            bad |= _stages_unstable(dynamics, T, U, tab, substeps, watch, i)
+    return bad
+
+
+def _stages_unstable(dynamics, T, U, tab, substeps: int, watch: TrajectoryWatch, i: int):
+    """``(m,)`` bool: each design's interval into state ``i``'s fastest change taken
+    again (`integrate` on the batch, each design from its own sample), judged at
+    the stage state where the design moves fastest.
+
+    As `qc_control.input_output_response`'s stage check: a stiff branch visited
+    only inside an interval has its stages there. A `_time_free` batch only (each
+    design's inputs at its own stage times, one set of calls).
+    """
+    m = watch.first.shape[1]
+    dt = float(T[1] - T[0])
+    t0 = T[np.maximum(watch.index[i], 1) - 1]  # (m,) each design's interval start
+    u_of = linear_input(T, U)
+    seen: list = []
+
+    def f(tau, X):
+        u = u_of.at(t0 + tau).T  # (k, m)
+        dx = np.asarray(dynamics.rhs(float(T[0]), np.ascontiguousarray(X.T), u))
+        seen.append((tau, X.T.copy(), np.linalg.norm(dx, axis=0)))
+        return dx.T
+
+    with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore"):
+        warnings.simplefilter("ignore")  # a diverging replay warns again
+        integrate(f, [0.0, dt], watch.before[:, i].T, tab, substeps=substeps)
+    rates = np.nan_to_num(np.stack([r for _, _, r in seen]), nan=np.inf)  # (S, m)
+    pick = np.argmax(rates, axis=0)
+    xs = np.stack([x for _, x, _ in seen])[pick, :, np.arange(m)].T  # (n, m)
+    taus = np.array([tau for tau, _, _ in seen])[pick]
+    J = jacobians(dynamics.rhs, float(T[0]), xs, u_of.at(t0 + taus).T)
+    return unstable_designs(tab, dt / substeps, J)
+
+
+def _forcing_peak(dynamics, T, U, x0: np.ndarray) -> np.ndarray:
+    """``sup‖f(t, x0, u(t))‖₂`` per design (`growth_limit`'s forcing).
+
+    A `_time_free` batch's forcing depends on the inputs only: it is bounded
+    by ``‖f(x0, u0)‖ + ‖B‖₂ max‖u - u0‖₂`` with ``B = ∂f/∂u`` at the start (by
+    differences), one set of calls; otherwise it is evaluated at the samples
+    `qc_control.responses.timeresp.forcing_samples` picks, as for a single run.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        if not _time_free(dynamics):
+            rows = [
+                np.linalg.norm(dynamics.rhs(float(T[k]), x0, U[:, [k] * x0.shape[1]]), axis=0)
+                for k in forcing_samples(U).tolist()
+            ]
+            return np.max(rows, axis=0)
+        u0 = np.repeat(U[:, :1], x0.shape[1], axis=1)
+        f0 = np.asarray(dynamics.rhs(float(T[0]), x0, u0))
+        if U.shape[0] == 0:
+            return np.linalg.norm(f0, axis=0)
+        B = jacobians(lambda t, uu, _: dynamics.rhs(t, x0, uu), float(T[0]), u0, None)
+        gain = np.linalg.norm(B, ord=2, axis=(1, 2))
+        return np.linalg.norm(f0, axis=0) + gain * float(
+            np.max(np.linalg.norm(U - U[:, :1], axis=0))
+        )
+
+
 def _check(dynamics, T, X0, U, method, substeps):
     tab = get_method(method)
     T = check_time_grid(T, "T")
@@ -281,6 +394,7 @@ def simulate_batch(
     tab, T, X0, U, substeps = _check(dynamics, T, X0, U, method, substeps)
     m, n = dynamics.size, len(dynamics.state_labels)
     p = len(dynamics.output_labels)
+    watch = TrajectoryWatch(np.broadcast_to(X0[:, None], (n, m)))
     check_memory(
         m * (n + p) * T.size * 8.0,
         f"a batch of {m} designs over {T.size} samples",
@@ -292,10 +406,12 @@ def simulate_batch(
     for start, xb in _march(dynamics, T, X0, U, tab, substeps, events, t_events):
         sl = slice(start, start + xb.shape[-1])
         states[:, :, sl] = np.moveaxis(xb, 0, 1)
+        watch.update(start, xb)
         with np.errstate(over="ignore", invalid="ignore"):
             for label, y in dynamics.outputs(T[sl], xb, U[:, sl]).items():
                 outputs[label][:, sl] = y
     success = np.asarray(np.isfinite(states).all(axis=(1, 2)))
+    success &= ~beyond_stability(dynamics, T, U, tab, substeps, watch)
     return BatchResponse(T, states, outputs, success, t_events)
 
 
@@ -343,7 +459,9 @@ def _run_vectorised(
     if stream is not None:
         stream.start(final)
     ys: dict = {}
+    watch = TrajectoryWatch(np.broadcast_to(np.asarray(X0, dtype=float)[:, None], (n, m)))
     for start, xb in _march(dynamics, T, X0, U, tab, substeps, events, None):
+        watch.update(start, xb)
         L = xb.shape[-1]
         sl = slice(start, start + L)
         if x_all is not None:
@@ -356,7 +474,8 @@ def _run_vectorised(
             kept[label][:, sl] = ys[label]
     final.update({label: np.array(y[:, -1]) for label, y in ys.items()})
     # a state that was ever non-finite stays so (x + h Σ b_i k_i keeps an inf or a nan)
-    result: dict = {"stable": np.asarray(np.isfinite(xb[..., -1]).all(axis=0))}
+    finite = np.asarray(np.isfinite(xb[..., -1]).all(axis=0))
+    result: dict = {"stable": finite & ~beyond_stability(dynamics, T, U, tab, substeps, watch)}
     with np.errstate(over="ignore", invalid="ignore"):
         if streamed:
             if stream is not None:
@@ -465,7 +584,9 @@ def nonlinear_sweep(
     Returns
     -------
     (stable, table, states)
-        ``stable (designs,)``: the state stayed finite; ``table``: column ->
+        ``stable (designs,)``: the state stayed finite and the step within
+        the method's stability limit along the trajectory
+        (`beyond_stability`); ``table``: column ->
         ``(designs,)`` (NaN for rejected designs); ``states`` ``(designs, n,
         N)`` or None.
     """

@@ -604,7 +604,9 @@ def sweep(
         a nonlinear system without one (`qc_control.closed_loop` with a
         clipped controller) runs one `qc_control.input_output_response` per
         design: the same numbers, as slow as that many responses. For a
-        nonlinear model ``stable`` says the state stayed finite.
+        nonlinear model ``stable`` says the state stayed finite and the step
+        within the method's stability limit along the trajectory, as a
+        single run's ``success`` (`qc_control.studies.nlsweep.beyond_stability`).
     substeps : int, default 1
     chunk_size : int, optional
         Designs per chunk: the unit of work sent to the executor (make it
