@@ -56,12 +56,14 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, ClassVar, cast
 
+import control
 import numpy as np
 
 from ..models.quarter import QuarterCarParams
 from ..models.registry import MODELS, ModelEntry, get_model, model_for_params, parameter_keys
 from ..models.vehicle import VehicleModel
 from ..numerics.methods import METHODS, get_method
+from ..numerics.stability import max_stable_step
 from ..ride import road as roads
 from ..ride.spectral import ISO8608Road, road_parameter
 from ..studies.compare import DEFAULT_METHODS, MethodComparison, compare_methods
@@ -444,6 +446,11 @@ def _culprit(values: Mapping, cls: type) -> str | None:
     return None
 
 
+#: The default step is lowered below a method's stability limit by at most
+#: this factor (10 ms to 1 ms); a limit further down is warned about instead.
+_STABLE_DEFAULT_SPAN = 10.0
+
+
 def _iso_step(limit: float) -> float:
     """The largest step of the 1-2-5 series (…, 1, 2, 5, 10 ms, …) not above ``limit`` [s]."""
     e = math.floor(math.log10(limit))
@@ -593,7 +600,7 @@ class Scenario:
         limit = road.largest_step()
         chosen = self.h is None
         if chosen:
-            put("h", defaults.h if defaults.h <= limit else _iso_step(limit))
+            put("h", self._default_step(defaults.h, limit))
         else:
             put("h", _number("scenario", "h", self.h, "s", positive=True))
         m = self.max_steps
@@ -664,6 +671,40 @@ class Scenario:
             for o in self.entry.options
             if o.target == target
         }
+
+    def _default_step(self, h: float, road_limit: float) -> float:
+        """The model's default step, lowered to the 1-2-5 series below the road's
+        limit and below every requested method's stability limit.
+
+        A default beyond a method's limit would report growth, not accuracy.
+        A limit more than `_STABLE_DEFAULT_SPAN` times below the default (a
+        nearly undamped mode, a featherweight design) would make the
+        convergence study's refinements too long a run: it is left to the
+        warning (`beyond_limits`) instead.
+        """
+        if h > road_limit:
+            h = _iso_step(road_limit)
+        stable = [limit for limit in self.step_limits().values() if 0 < limit < h]
+        if not stable:
+            return h
+        step = _iso_step(min(stable))
+        return step if step * _STABLE_DEFAULT_SPAN >= h else h
+
+    def step_limits(self) -> dict[str, float]:
+        """Each method's stability limit h_max [s] on this scenario's car.
+
+        `qc_control.max_stable_step` of the car's state matrix, by method
+        name; empty for a model without one (the nonlinear car, whose
+        comparison reports the limits of its linearisation).
+        """
+        system = self.entry.model(self.vehicle).system
+        if not isinstance(system, control.StateSpace):
+            return {}
+        return {m: max_stable_step(m, system) for m in self.methods}
+
+    def beyond_limits(self) -> dict[str, float]:
+        """The methods whose limit h_max [s] this scenario's step exceeds, with it."""
+        return {m: h for m, h in self.step_limits().items() if self.h > h * (1 + 1e-12)}
 
     def _check_speed(self) -> None:
         if getattr(self.road, "speed", None) is None:

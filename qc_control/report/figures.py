@@ -17,6 +17,7 @@ Conventions, so that a projected figure reads at a glance:
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -163,7 +164,10 @@ def method_figure(cmp, method: str) -> Figure:
     for name, style, _, _ in drawn:
         ax.plot(ref.time, output_signal(ref, name) * _MM, label=f"exact {name}", **_EXACT[style])
     for name, _, line, what in drawn:
-        ax.plot(resp.time, output_signal(resp, name) * _MM, line, lw=1.2, label=f"{what} {name}")
+        color, ls = line[0], line[1:]
+        exact = output_signal(ref, name) * _MM
+        values = output_signal(resp, name) * _MM
+        _plot_cut(ax, resp.time, values, exact, f"{what} {name}", color=color, ls=ls, lw=1.2)
     title = f"{method}, h = {cmp.h:g} s"
     same = [g for g in coincidence_groups(cmp) if method in g]
     if same:
@@ -175,6 +179,44 @@ def method_figure(cmp, method: str) -> Figure:
     return fig
 
 
+#: A method's curve is cut where it leaves this multiple of the exact
+#: response's range (its largest magnitude): past it the method has diverged,
+#: and drawing on would scale the axis so that every other curve is flat.
+DIVERGED_RANGE = 10.0
+
+
+def diverged_at(time, values, exact) -> int | None:
+    """The index where ``values`` first leave `DIVERGED_RANGE` times the
+    range of ``exact`` (or become inf or NaN); None if they never do."""
+    span = float(np.max(np.abs(exact))) if np.size(exact) else 0.0
+    if not span > 0 or not math.isfinite(span):
+        return None
+    with np.errstate(invalid="ignore"):
+        outside = ~(np.abs(np.asarray(values)) <= DIVERGED_RANGE * span)
+    return int(np.argmax(outside)) if outside.any() else None
+
+
+def _plot_cut(ax, time, values, exact, label: str, **style) -> None:
+    """Plot ``values`` against ``time``, cut and marked where they diverge."""
+    cut = diverged_at(time, values, exact)
+    if cut is None:
+        ax.plot(time, values, label=label, **style)
+        return
+    kept = max(cut, 1)
+    (line,) = ax.plot(
+        time[:kept], values[:kept], label=f"{label}: diverged at t = {time[cut]:.3g} s", **style
+    )
+    ax.plot(time[kept - 1], values[kept - 1], "x", color=line.get_color(), ms=8, mew=2)
+    ax.annotate(
+        f"diverged at t = {time[cut]:.3g} s",
+        (time[kept - 1], values[kept - 1]),
+        xytext=(4, 4),
+        textcoords="offset points",
+        fontsize="small",
+        color=line.get_color(),
+    )
+
+
 def overlay_figure(cmp) -> Figure:
     """Every method's body displacement over the exact response."""
     colors, rank = _colors(cmp.responses), _rank(cmp)
@@ -183,13 +225,16 @@ def overlay_figure(cmp) -> Figure:
     ref = cmp.reference
     body = body_wheel_road(cmp)[0]
     ax.plot(ref.time, output_signal(ref, body) * _MM, color="k", lw=4, alpha=0.25, label="exact")
+    exact = output_signal(ref, body) * _MM
     for name, resp in cmp.responses.items():
-        ax.plot(
+        _plot_cut(
+            ax,
             resp.time,
             output_signal(resp, body) * _MM,
+            exact,
+            name,
             color=colors[name],
             lw=1.2,
-            label=name,
             **_style(cmp, name, rank),
         )
     ax.set(
