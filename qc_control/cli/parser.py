@@ -471,6 +471,8 @@ def _report(args, scenario: Scenario, out: Path) -> int:
     say = (lambda message: None) if args.quiet else _progress
     for line in beyond_limit_warnings(scenario):  # before the work, even when quiet
         print(f"{_PROG}: warning: {line}", file=sys.stderr, flush=True)
+    if args.h is None and scenario.step_note():
+        say(f"{_PROG}: note: {scenario.step_note()}")
     road = scenario.road.describe()
     say(
         f"qc-control report: {', '.join(scenario.methods)} at h = {scenario.h:g} s over "
