@@ -45,6 +45,7 @@ from .figures import (
 from .findings import findings
 from .nonlinear import nonlinear_blocks, nonlinear_figures, nonlinear_tables, reference_text
 from .pdf import to_pdf
+from .summary import summary
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -163,7 +164,8 @@ def _response_figures(cmp) -> list[_FigureDraft]:
         _FigureDraft("reference.png", _reference_caption(cmp), lambda: reference_figure(cmp)),
         _FigureDraft(
             "overlay.png",
-            "All methods' body displacement over the exact response",
+            "All methods' body displacement over the "
+            + ("exact response" if getattr(cmp, "nonlinear", None) is None else "reference"),
             lambda: overlay_figure(cmp),
         ),
     ]
@@ -260,12 +262,15 @@ def figure_specs(cmp) -> list[FigureSpec]:
 def _scenario_text(cmp) -> str:
     t0, t1 = cmp.T[0], cmp.T[-1]
     x0 = ", ".join(fmt(v) for v in cmp.X0)
-    kind = (
-        "free response (no input)"
-        if cmp.U is None
-        else f"forced response to the input(s) {', '.join(cmp.system.input_labels)}"
-        + (f" ({cmp.input_description})" if getattr(cmp, "input_description", "") else "")
-    )
+    described = getattr(cmp, "input_description", "")
+    if cmp.U is None:
+        # a road the model evaluates as a function of time is an input all the
+        # same, though the system has no input signal: name it
+        kind = f"response to {described}" if described else "free response (no input)"
+    else:
+        kind = f"forced response to the input(s) {', '.join(cmp.system.input_labels)}" + (
+            f" ({described})" if described else ""
+        )
     model = getattr(cmp, "model", None)
     # the states' units in order of first use: "m/s and m" on a quarter car
     units = (
@@ -505,6 +510,8 @@ def build_blocks(cmp, command: str | None = None) -> list:
     figs = {spec.name: Image(spec.name, spec.caption, spec.label) for spec in figure_specs(cmp)}
     return _numbered(
         [
+            Heading("Summary"),
+            *(Paragraph(text) for text in summary(cmp)),
             *_problem_card(cmp, figs),
             *_response_blocks(cmp, figs),
             *_accuracy_blocks(cmp, figs),

@@ -18,6 +18,7 @@ Conventions, so that a projected figure reads at a glance:
 from __future__ import annotations
 
 import math
+import textwrap
 from typing import Any
 
 import numpy as np
@@ -122,6 +123,17 @@ def body_wheel_road(cmp) -> tuple[str, str | None, str | None]:
     return body, wheel, road
 
 
+def reference_word(cmp) -> str:
+    """What the methods are measured against: 'exact' on a linear car; on a
+    nonlinear one, which has no exact solution, 'reference (solve_ivp)'."""
+    return "exact" if getattr(cmp, "nonlinear", None) is None else "reference (solve_ivp)"
+
+
+def _title(text: str, width: int = 60) -> str:
+    """A figure title wrapped so that it never runs into the legend beside the axes."""
+    return textwrap.fill(text, width)
+
+
 def reference_figure(cmp) -> Figure:
     """The exact response the methods are measured against (and the road, if any)."""
     ref = cmp.reference
@@ -131,16 +143,14 @@ def reference_figure(cmp) -> Figure:
     if cmp.U is not None and road is not None:
         zr = np.asarray(cmp.U)[list(cmp.system.input_labels).index(road)]
         ax.plot(cmp.T, zr * _MM, color="tab:brown", lw=0.9, label=f"road {road}")
-    ax.plot(ref.time, output_signal(ref, body) * _MM, "r-", lw=1.3, label=f"body {body} (exact)")
+    word = reference_word(cmp)
+    ax.plot(ref.time, output_signal(ref, body) * _MM, "r-", lw=1.3, label=f"body {body} ({word})")
     if wheel is not None:
-        ax.plot(
-            ref.time, output_signal(ref, wheel) * _MM, "b--", lw=1.1, label=f"wheel {wheel} (exact)"
-        )
-    ax.set(
-        xlabel="time [s]",
-        ylabel="displacement [mm]",
-        title=cmp.input_description or "Free response: the exact solution",
-    )
+        wheel_mm = output_signal(ref, wheel) * _MM
+        ax.plot(ref.time, wheel_mm, "b--", lw=1.1, label=f"wheel {wheel} ({word})")
+    free = "Free response: the " + ("exact solution" if word == "exact" else word)
+    ax.set(xlabel="time [s]", ylabel="displacement [mm]")
+    ax.set_title(_title(cmp.input_description or free), fontsize="medium")
     ax.grid(alpha=0.3)
     _legend(fig)
     return fig
@@ -162,7 +172,12 @@ def method_figure(cmp, method: str) -> Figure:
     if wheel is not None:
         drawn.append((wheel, "wheel", "b--", "wheel"))
     for name, style, _, _ in drawn:
-        ax.plot(ref.time, output_signal(ref, name) * _MM, label=f"exact {name}", **_EXACT[style])
+        ax.plot(
+            ref.time,
+            output_signal(ref, name) * _MM,
+            label=f"{reference_word(cmp)} {name}",
+            **_EXACT[style],
+        )
     for name, _, line, what in drawn:
         color, ls = line[0], line[1:]
         exact = output_signal(ref, name) * _MM
@@ -224,7 +239,8 @@ def overlay_figure(cmp) -> Figure:
     ax = fig.subplots()
     ref = cmp.reference
     body = body_wheel_road(cmp)[0]
-    ax.plot(ref.time, output_signal(ref, body) * _MM, color="k", lw=4, alpha=0.25, label="exact")
+    word = reference_word(cmp)
+    ax.plot(ref.time, output_signal(ref, body) * _MM, color="k", lw=4, alpha=0.25, label=word)
     exact = output_signal(ref, body) * _MM
     for name, resp in cmp.responses.items():
         _plot_cut(
@@ -240,7 +256,7 @@ def overlay_figure(cmp) -> Figure:
     ax.set(
         xlabel="time [s]",
         ylabel=f"body displacement {body} [mm]",
-        title=f"All methods against the exact response, h = {cmp.h:g} s",
+        title=f"All methods against the {word.split(' ')[0]} response, h = {cmp.h:g} s",
     )
     ax.grid(alpha=0.3)
     _legend(fig, coincidence_note(cmp))
