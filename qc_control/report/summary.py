@@ -76,7 +76,7 @@ def _carried(cmp, steps: int) -> int:
     return fine  # the comparison's own grid always fits
 
 
-def _error_at(cmp, method: str, steps: int, body: str) -> float:
+def _error_at(cmp, method, steps: int, body: str) -> float:
     """Largest |body error| of ``method`` in ``steps`` steps against the exact response.
 
     The method sees the input only at its own steps, as a run at that step
@@ -102,6 +102,14 @@ def _error_at(cmp, method: str, steps: int, body: str) -> float:
         return float(np.max(np.abs(output_signal(run, body) - exact)))
 
 
+def _tableau(cmp, name: str):
+    """The comparison's own tableau of that name (a custom one is in no catalogue)."""
+    for tab in getattr(cmp, "methods", ()):
+        if getattr(tab, "name", None) == name:
+            return tab
+    return get_method(name)
+
+
 def checked_step(cmp, method: str, cost: float, tol: float = SUMMARY_TOLERANCE):
     """Check an estimated cost by running ``method`` at the step it implies.
 
@@ -114,11 +122,11 @@ def checked_step(cmp, method: str, cost: float, tol: float = SUMMARY_TOLERANCE):
     """
     if not isinstance(cmp.system, control.StateSpace):
         return None, math.nan, 0
-    tab = get_method(method)
+    tab = _tableau(cmp, method)
     body = body_wheel_road(cmp)[0]
     steps = _carried(cmp, max(2, math.ceil(cost / tab.stages)))
     for run in range(1, _CHECK_RUNS + 1):
-        error = _error_at(cmp, method, steps, body)
+        error = _error_at(cmp, tab, steps, body)
         if error <= tol or not math.isfinite(error) or run == _CHECK_RUNS:
             return steps, error, run
         steps = _carried(cmp, math.ceil(steps * (error / tol) ** (1 / tab.order) * 1.02))
@@ -133,7 +141,7 @@ def _cheapest(cmp, body: str, tol: float) -> list[str]:
         return [f"No method reaches {fmt(tol * 1e3)} mm in {body} at a step it can run."]
     best, cost = costs.index[0], float(costs.iloc[0])
     span = float(cmp.T[-1] - cmp.T[0])
-    tab = get_method(best)
+    tab = _tableau(cmp, best)
     h_est = span / math.ceil(cost / tab.stages)
     kind = cmp.cost_kind.loc[tol, best]
     how = (
