@@ -28,7 +28,7 @@ from ..models.modal import modal_analysis
 from ..models.quarter import QuarterCarParams
 from ..models.registry import MODELS, ModelOption, get_model, parameter_help, parameter_keys
 from ..report import ReportError, check_target, report_lock, write_report
-from ..report.control import write_control_report
+from ..report.control import unavailable_designs, write_control_report
 from ..studies.compare import ReferenceBudgetError
 from ..studies.control_study import DESIGNS, compare_controllers
 from .scenario import (
@@ -542,6 +542,8 @@ def _cmd_control_report(args) -> int:
 
 def _control_report(args, params: QuarterCarParams, designs: list[str], out: Path) -> int:
     """Compare the designs and write the report into ``out`` (its lock held)."""
+    for design, why in unavailable_designs(designs).items():  # listed, not silently dropped
+        print(f"{_PROG}: warning: {design} {why}", file=sys.stderr, flush=True)
     if not args.quiet:
         _progress(f"qc-control control-report: {len(designs)} designs, bump and road runs")
     try:
