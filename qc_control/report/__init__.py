@@ -102,10 +102,28 @@ def _versions() -> dict[str, str]:
     }
 
 
+#: The widest line of a printed matrix [characters]: what the PDF's code font
+#: (7.5 pt) holds across the page, so that a row is never wrapped mid-way.
+_MATRIX_WIDTH = 96
+
+
 def _matrix(name, M) -> str:
-    return f"{name} =\n" + np.array2string(
-        np.asarray(M), precision=6, suppress_small=True, max_line_width=100
-    )
+    """``M`` as aligned text, in blocks of whole columns that each fit
+    `_MATRIX_WIDTH`: a 14-state A is two blocks of rows, never a row broken
+    across lines (where its columns would no longer line up)."""
+    M = np.atleast_2d(np.asarray(M, dtype=float))
+    scale = float(np.max(np.abs(M))) if M.size else 0.0
+    small = np.abs(M) <= 1e-12 * scale  # rounding residue of a zero entry
+    cells = [["0" if z else f"{v:.6g}" for v, z in zip(row, zrow)] for row, zrow in zip(M, small)]
+    width = max((len(c) for row in cells for c in row), default=1)
+    per_block = max(1, (_MATRIX_WIDTH - 2) // (width + 2))
+    blocks = []
+    for start in range(0, M.shape[1], per_block):
+        stop = min(start + per_block, M.shape[1])
+        head = f"{name} =" if per_block >= M.shape[1] else f"{name}, columns {start + 1}–{stop} ="
+        rows = ["  ".join(c.rjust(width) for c in row[start:stop]) for row in cells]
+        blocks.append(head + "\n" + "\n".join("  " + r for r in rows))
+    return "\n\n".join(blocks)
 
 
 def _slug(name: str) -> str:
@@ -332,7 +350,10 @@ def _system_blocks(cmp) -> list:
             )
         )
     linear = cmp.system if study is None else study.linearization
-    blocks.append(Code(_matrix("A", linear.A) + "\n\n" + _matrix("B", linear.B)))
+    B = np.asarray(linear.B)
+    # a free response has no input: no "B = []"
+    text = _matrix("A", linear.A) + ("\n\n" + _matrix("B", B) if B.size else "")
+    blocks.append(Code(text))
     blocks.append(
         Table(
             cmp.modes.to_frame(),

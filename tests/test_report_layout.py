@@ -1,0 +1,54 @@
+"""Report layout a lecturer would print: matrices that stay aligned on paper
+and on a phone, and no empty "B = []" on a free response."""
+
+import re
+
+import numpy as np
+import pytest
+
+from qc_control.cli.scenario import Scenario
+from qc_control.report import _matrix, _system_blocks
+from qc_control.report.document import _CSS, Code
+
+
+def parse(text: str, shape) -> np.ndarray:
+    """The matrix back from its printed blocks of columns."""
+    out = np.full(shape, np.nan)
+    start = 0
+    for block in text.split("\n\n"):
+        head, *rows = block.splitlines()
+        cols = re.search(r"columns (\d+)–(\d+)", head)
+        start, stop = (int(cols[1]) - 1, int(cols[2])) if cols else (0, shape[1])
+        for i, row in enumerate(rows):
+            out[i, start:stop] = [float(v) for v in row.split()]
+    return out
+
+
+@pytest.mark.parametrize("model", ["quarter", "half", "full"])
+def test_a_matrix_prints_in_aligned_blocks_that_fit_the_page(model):
+    sc = Scenario(model=model, road={"kind": "bump", "speed": 10.0})
+    A = np.asarray(sc.entry.model(sc.vehicle, road=True).system.A)
+    text = _matrix("A", A)
+    for block in text.split("\n\n"):
+        rows = block.splitlines()[1:]
+        assert len(rows) == A.shape[0]  # one line per row: never wrapped
+        assert len({len(r) for r in rows}) == 1  # right-aligned columns
+        assert all(len(line) <= 96 for line in block.splitlines())  # the PDF's code width
+    # six significant digits: the printed entries are A's to 5e-6 relative
+    np.testing.assert_allclose(parse(text, A.shape), A, rtol=5e-6, atol=1e-12 * abs(A).max())
+
+
+def test_a_free_response_shows_no_empty_b():
+    cmp = Scenario(t_end=1.0).run()
+    (code,) = [b for b in _system_blocks(cmp) if isinstance(b, Code)]
+    assert "A =" in code.text and "B" not in code.text
+
+
+def test_a_forced_response_shows_b():
+    cmp = Scenario(road={"kind": "bump"}, t_end=1.0, methods=["rk4"]).run()
+    (code,) = [b for b in _system_blocks(cmp) if isinstance(b, Code)]
+    assert "\nB =\n" in code.text
+
+
+def test_preformatted_text_scrolls_rather_than_wraps_a_row():
+    assert re.search(r"pre \{[^}]*white-space: pre;", _CSS)
