@@ -52,3 +52,28 @@ def test_a_forced_response_shows_b():
 
 def test_preformatted_text_scrolls_rather_than_wraps_a_row():
     assert re.search(r"pre \{[^}]*white-space: pre;", _CSS)
+
+
+def test_a_wide_table_in_the_pdf_splits_into_column_groups_not_below_7_pt(tmp_path, monkeypatch):
+    import pandas as pd
+
+    from qc_control.report import pdf
+    from qc_control.report.document import Table
+
+    sizes, parts = [], []
+    original = pdf._Writer._table_part
+
+    def spy(self, caption, cols, head, body, numeric, widths, headers, font, bold):
+        sizes.append(font.size)
+        parts.append(caption)
+        return original(self, caption, cols, head, body, numeric, widths, headers, font, bold)
+
+    monkeypatch.setattr(pdf._Writer, "_table_part", spy)
+    # 24 columns of 9-digit numbers: wider than an A4 page at any legible size
+    frame = pd.DataFrame(
+        np.arange(72 * 24, dtype=float).reshape(72, 24) * 1234.56789,
+        columns=[f"column {j} [m]" for j in range(24)],
+    )
+    pdf.to_pdf("wide", [Table(frame, "A wide table")], tmp_path, tmp_path / "w.pdf")
+    assert len(parts) > 1 and all(p.startswith("A wide table (columns") for p in parts)
+    assert min(sizes) >= 7.0
