@@ -61,3 +61,22 @@ def test_an_example_run_in_a_kernel_writes_its_default_folder(tmp_path, monkeypa
     exec(compile(script.read_text(encoding="utf-8"), str(script), "exec"), {"__name__": "__main__"})
     assert [p.name for p in tmp_path.iterdir()] == ["modal_analysis_output"]
     assert any(p.suffix == ".png" for p in (tmp_path / "modal_analysis_output").iterdir())
+
+
+def test_show_inline_publishes_a_figure_in_a_kernel_and_is_silent_elsewhere(monkeypatch):
+    import sys
+    from types import SimpleNamespace
+
+    from qc_control.report.outputs import show_inline
+
+    published = []
+    shell = SimpleNamespace(
+        display_formatter=SimpleNamespace(format=lambda obj: ({"image/png": b"png"}, {})),
+        display_pub=SimpleNamespace(publish=lambda data, metadata: published.append(data)),
+    )
+    monkeypatch.setitem(sys.modules, "IPython", SimpleNamespace(get_ipython=lambda: None))
+    show_inline(object())
+    assert published == []  # IPython imported, but no kernel: nothing shown
+    monkeypatch.setitem(sys.modules, "IPython", SimpleNamespace(get_ipython=lambda: shell))
+    show_inline(object())
+    assert published == [{"image/png": b"png"}]

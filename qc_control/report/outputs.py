@@ -61,10 +61,11 @@ def output_folder(name: str, out=None, argv: list[str] | None = None) -> Path:
 def show_inline(fig) -> None:
     """Display ``fig`` in a notebook (a `matplotlib.figure.Figure` has no window
     of its own); outside one, the saved file is the figure, and this does nothing."""
-    if "IPython" not in sys.modules:
+    ipython = sys.modules.get("IPython")  # imported by any kernel; never by us
+    shell = ipython.get_ipython() if ipython is not None else None
+    if shell is None:
         return
-    from IPython import get_ipython
-    from IPython.display import display
-
-    if get_ipython() is not None:
-        display(fig)
+    # what IPython.display.display does: format with the kernel's formatters
+    # (the inline backend's PNG for a Figure) and publish the result
+    data, metadata = shell.display_formatter.format(fig)
+    shell.display_pub.publish(data=data, metadata=metadata)

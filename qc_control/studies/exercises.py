@@ -85,10 +85,10 @@ def _upper_modes() -> tuple[complex, complex]:
 def _number(answer, form: str = "one number (a float)") -> float:
     if isinstance(answer, bool) or not isinstance(answer, Real | np.number | np.ndarray):
         raise _WrongType(f"give {form}, not a {type(answer).__name__}.")
-    value = np.asarray(answer, dtype=float)
-    if value.size != 1:
-        raise _WrongType(f"give {form}, not an array of {value.size} values.")
-    value = float(value.reshape(()))
+    array = np.asarray(answer, dtype=float)
+    if array.size != 1:
+        raise _WrongType(f"give {form}, not an array of {array.size} values.")
+    value = float(array.reshape(()))
     if not math.isfinite(value):
         raise _WrongType(f"give a finite number, not {value}.")
     return value
@@ -96,6 +96,13 @@ def _number(answer, form: str = "one number (a float)") -> float:
 
 def _near(value: float, target: float, rel: float) -> bool:
     return abs(value - target) <= rel * abs(target)
+
+
+def _nominal_zeta() -> float:
+    """The seed's nominal damping ratio cs / (2·√(ks·ms)), which assumes a rigid tire."""
+    p = QuarterCarParams()
+    cs = float(p.cs) if p.cs is not None else math.nan  # resolved from ζ when made
+    return cs / (2 * math.sqrt(p.ks * p.ms))
 
 
 def _first_hint(value: float, wrong: list[tuple[float, float, str]]) -> str | None:
@@ -216,7 +223,7 @@ def _judge_4(answer) -> str | None:
             "that is the exact modal ζ; asked is the ζ_h Euler's step gives.",
         ),
         (
-            QuarterCarParams().zeta,
+            _nominal_zeta(),
             1e-2,
             "that is the nominal ζ of the parameters; asked is Euler's ζ_h.",
         ),
@@ -242,7 +249,7 @@ def _judge_5(answer) -> str | None:
         return f"give one of the ratios {_ZETAS[0]:.2f}, {_ZETAS[1]:.2f}, …, {_ZETAS[-1]:.2f}."
     if _wk_rms(value) <= _lowest_wk_rms() * (1 + _COMFORT_PLATEAU):
         return None
-    if _near(value, QuarterCarParams().zeta, 1e-3):
+    if _near(value, _nominal_zeta(), 1e-3):
         return "that is the seed's own damping ratio; find the lowest point of Section 5's curve."
     if _near(value, 1 / math.sqrt(2), 1e-2):
         return "1/√2 is the textbook optimum of a one-mass system; this car's curve says otherwise."
