@@ -77,3 +77,13 @@ def test_a_wide_table_in_the_pdf_splits_into_column_groups_not_below_7_pt(tmp_pa
     pdf.to_pdf("wide", [Table(frame, "A wide table")], tmp_path, tmp_path / "w.pdf")
     assert len(parts) > 1 and all(p.startswith("A wide table (columns") for p in parts)
     assert min(sizes) >= 7.0
+
+
+def test_coinciding_methods_are_described_in_words_not_symbols():
+    from qc_control.report.findings import _coincidence
+
+    (text,) = _coincidence(Scenario(t_end=1.0).run())
+    # the wording: "largest state difference 0 m, which is rounding" and "T_2(hA)"
+    assert "which is rounding" not in text and "T_2" not in text
+    assert "identical to the last bit" in text  # Midpoint and Heun: bit for bit on a free response
+    assert "x ← (I + hA + (hA)^2/2)·x" in text
