@@ -15,18 +15,15 @@ Run: ``python examples/active_suspension.py [OUT_DIR]`` (default
 ``pareto.png``. The full comparison is ``qc-control control-report``.
 """
 
-import sys
-from pathlib import Path
-
 import pandas as pd
 
 import qc_control as qc
 from qc_control.models.controllers import HINF_AVAILABLE
 from qc_control.report.control import transmissibility_chart
+from qc_control.report.outputs import output_folder, show_inline
 from qc_control.studies.control_study import compare_controllers
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
+out = output_folder("active_suspension")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
 params = qc.QuarterCarParams()
 
@@ -57,7 +54,9 @@ with pd.option_context("display.width", 200, "display.max_columns", 20):
         ].round(4)
     )
 for signal in ("body_acc", "tire_defl"):
-    transmissibility_chart(cmp, signal).savefig(out / f"transmissibility_{signal}.png", dpi=100)
+    fig = transmissibility_chart(cmp, signal)
+    fig.savefig(out / f"transmissibility_{signal}.png", dpi=100)
+    show_inline(fig)
 
 # the passive comfort / road-holding front, with the linear controllers marked
 front = qc.pareto_front(
@@ -67,4 +66,5 @@ front = qc.pareto_front(
     controllers={"skyhook": qc.closed_loop(car, qc.skyhook(3000.0)), "LQR": lqr},
 )
 front.figure.savefig(out / "pareto.png", dpi=100)
+show_inline(front.figure)
 print(f"{len(front.designs)} non-dominated passive designs of {len(front.all_designs)}")

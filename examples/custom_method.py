@@ -11,16 +11,13 @@ Run: ``python examples/custom_method.py [OUT_DIR]`` (default
 ``OUT_DIR/custom_report/``.
 """
 
-import sys
-from pathlib import Path
-
 import numpy as np
 
 import qc_control as qc
 from qc_control.report import write_report
+from qc_control.report.outputs import output_folder
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
+out = output_folder("custom_method")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
 
 # Ralston's second-order method: the 2-stage method of least error bound.

@@ -13,16 +13,13 @@ Run: ``python examples/design_sweep.py [OUT_DIR]`` (default
 ``design_sweep.csv``.
 """
 
-import sys
-from pathlib import Path
-
 import numpy as np
 from matplotlib.figure import Figure
 
 import qc_control as qc
+from qc_control.report.outputs import output_folder, show_inline
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
+out = output_folder("design_sweep")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
 T = np.linspace(0.0, 10.0, 10001)  # h = 1 ms
 grid = {"ks": np.linspace(15e3, 45e3, 40), "zeta": np.linspace(0.1, 0.6, 25)}
@@ -52,6 +49,7 @@ ax.set(
 fig.legend(fontsize="small", loc="outside right upper")  # outside: never over a curve
 ax.grid(alpha=0.3)
 fig.savefig(out / "design_sweep.png", dpi=110)
+show_inline(fig)
 
 best = table.loc[table["rms_body_acc [m/s²]"].idxmin()]
 print(

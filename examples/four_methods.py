@@ -14,17 +14,14 @@ and its error) and ``four_methods_body_acc.png`` (body acceleration),
 and prints each method's largest error.
 """
 
-import sys
-from pathlib import Path
-
 import control
 import numpy as np
 
 import qc_control as qc
+from qc_control.report.outputs import output_folder, show_inline
 from qc_control.report.plotting import output_signal, plot_outputs
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
+out = output_folder("four_methods")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
 
 sys_ = qc.quarter_car()
@@ -43,9 +40,11 @@ for method, resp in runs.items():
 # the figure draws Heun dashed over Midpoint and says so in the legend.
 fig = plot_outputs(runs, "xs", reference=exact, reference_label="exact (control)")
 fig.savefig(out / "four_methods.png", dpi=120)
+show_inline(fig)
 
 # %%
 # Any output by its label: the body acceleration, in m/s².
 fig = plot_outputs(runs, "body_acc", reference=exact, reference_label="exact (control)")
 fig.savefig(out / "four_methods_body_acc.png", dpi=120)
+show_inline(fig)
 print(f"wrote {out / 'four_methods.png'} and {out / 'four_methods_body_acc.png'}")

@@ -18,16 +18,14 @@ Run: ``python examples/full_car_roll.py [OUT_DIR]`` (default
 """
 
 import dataclasses
-import sys
-from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
 
 import qc_control as qc
+from qc_control.report.outputs import output_folder, show_inline
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
+out = output_folder("full_car_roll")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
 
 plain = qc.FullCarParams()
@@ -62,4 +60,5 @@ for ax in (roll_ax, acc_ax):
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")
 fig.savefig(out / "full_car_roll.png", dpi=110)
+show_inline(fig)
 print(f"wrote {out / 'full_car_roll.png'}")

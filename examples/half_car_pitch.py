@@ -19,16 +19,13 @@ Run: ``python examples/half_car_pitch.py [OUT_DIR]`` (default
 ``half_car_wheelbase_filtering.png``.
 """
 
-import sys
-from pathlib import Path
-
 import numpy as np
 from matplotlib.figure import Figure
 
 import qc_control as qc
+from qc_control.report.outputs import output_folder, show_inline
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
+out = output_folder("half_car_pitch")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
 car = qc.HalfCarParams(seat_x=0.3)  # the driver's seat 0.3 m ahead of the CG
 L = car.a + car.b
@@ -60,6 +57,7 @@ for ax in (heave_ax, pitch_ax):
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")
 fig.savefig(out / "half_car_bump.png", dpi=110)
+show_inline(fig)
 
 # %%
 # Wheelbase filtering at 15 m/s: the notches of heave and pitch.
@@ -78,6 +76,7 @@ ax.set(xlabel="frequency [Hz]", title=f"One road under both axles at {speed:g} m
 ax.grid(alpha=0.3, which="both")
 ax.legend(fontsize="small", loc="lower left")
 fig.savefig(out / "half_car_wheelbase_filtering.png", dpi=110)
+show_inline(fig)
 print(f"\nwheelbase {L:.3f} m at {speed:g} m/s, V/(a+b) = {speed / L:.3f} Hz")
 for signal, label in (("heave", "heave_acc"), ("pitch", "pitch_acc")):
     gain = np.abs(tr.response[label])

@@ -18,16 +18,14 @@ Run: ``python examples/lift_off.py [OUT_DIR]`` (default ``./lift_off_output``).
 """
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
 
 import qc_control as qc
+from qc_control.report.outputs import output_folder, show_inline
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
+out = output_folder("lift_off")  # OUT_DIR from the command line, if any
 
 HEIGHT, LENGTH, SPEED, T0, T_END = 0.20, 8.0, 20.0, 0.1, 0.8
 DURATION = LENGTH / SPEED
@@ -78,4 +76,5 @@ for ax in (ax1, ax2):
         ax.axvline(t, color="grey", lw=0.8, ls="--")
     ax.legend()
 fig.savefig(out / "lift_off.png", dpi=100)
+show_inline(fig)
 print(f"wrote {out / 'lift_off.png'}")

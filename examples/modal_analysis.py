@@ -10,16 +10,13 @@ Run: ``python examples/modal_analysis.py [OUT_DIR]`` (default
 ``./modal_analysis_output``). Writes ``modal_tire_stiffness.png``.
 """
 
-import sys
-from pathlib import Path
-
 import numpy as np
 from matplotlib.figure import Figure
 
 import qc_control as qc
+from qc_control.report.outputs import output_folder, show_inline
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
+out = output_folder("modal_analysis")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
 print(qc.modal_analysis())  # the seed's Table 1
 
@@ -43,6 +40,7 @@ bottom.axhline(
 bottom.set(xlabel="tire stiffness / suspension stiffness, ku/ks [-]", ylabel="body frequency [Hz]")
 bottom.legend(fontsize="small", loc="lower right")
 fig.savefig(out / "modal_tire_stiffness.png", dpi=110)
+show_inline(fig)
 print(
     f"\nAt ku/ks = 1000 the body's ζ is {body[-1].zeta:.4f} (nominal {seed.zeta}); "
     f"wrote {out / 'modal_tire_stiffness.png'}"

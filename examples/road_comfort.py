@@ -13,19 +13,16 @@ Run: ``python examples/road_comfort.py [OUT_DIR]`` (default
 ``road_comfort.csv``.
 """
 
-import sys
-from pathlib import Path
-
 import control
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
 import qc_control as qc
+from qc_control.report.outputs import output_folder, show_inline
 from qc_control.ride import road
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
+out = output_folder("road_comfort")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
 params = qc.QuarterCarParams()
 classes, speeds = "ABCD", (10.0, 20.0, 30.0)
@@ -84,4 +81,5 @@ for ax in (left, right):
 # outside the axes: inside, class D's line ran under the legend
 fig.legend(*left.get_legend_handles_labels(), fontsize="small", loc="outside right upper")
 fig.savefig(out / "road_comfort.png", dpi=110)
+show_inline(fig)
 print(f"wrote {out / 'road_comfort.png'}")

@@ -11,17 +11,14 @@ Run: ``python examples/seed_paper.py [OUT_DIR]`` (default
 ``seed_figure_6_heun.png``.
 """
 
-import sys
-from pathlib import Path
-
 import numpy as np
 
 import qc_control as qc
 from qc_control.report import SEED_FIGURES
 from qc_control.report.figures import method_figure
+from qc_control.report.outputs import output_folder, show_inline
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
+out = output_folder("seed_paper")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
 
 T = np.linspace(0.0, 10.0, 1001)  # h = 0.01 s, as in the default scenario
@@ -29,7 +26,9 @@ cmp = qc.compare_methods(qc.QuarterCarParams(), T, [0.0, 0.0, 0.05, 0.0], repeat
 
 for method, number in SEED_FIGURES.items():  # Euler 3, Midpoint 4, RK4 5, Heun 6
     path = out / f"seed_figure_{number}_{method}.png"
-    method_figure(cmp, method).savefig(path, dpi=110)
+    fig = method_figure(cmp, method)
+    fig.savefig(path, dpi=110)
+    show_inline(fig)
     print(f"Figure {number}: {path}")
 
 # %%

@@ -6,8 +6,9 @@ it (the ``course_run`` fixture of ``conftest.py``): the notebook as shipped
 exercise's answer followed by its check (every check says "correct") and a
 wrong answer (refused). The docs build renders the shipped cells of this
 same run (tests/test_docs.py), so the notebook is executed once, not three
-times. The checks compute their expected values independently of
-qc_control (eigenvalues of a matrix assembled from M, C, K; closed forms).
+times. The checks live in `qc_control.studies.exercises` (tested against
+independent references in ``tests/test_exercises.py``); the answers in
+``conftest.SOLUTIONS`` are computed with qc_control as a student would.
 """
 
 import nbformat

@@ -28,7 +28,7 @@ from ..models.modal import modal_analysis
 from ..models.quarter import QuarterCarParams
 from ..models.registry import MODELS, ModelOption, get_model, parameter_help, parameter_keys
 from ..report import ReportError, check_target, report_lock, write_report
-from ..report.control import write_control_report
+from ..report.control import unavailable_designs, write_control_report
 from ..studies.compare import ReferenceBudgetError
 from ..studies.control_study import DESIGNS, compare_controllers
 from .measured import CommandTools as _CommandTools
@@ -486,6 +486,10 @@ def _report(args, scenario: Scenario, out: Path) -> int:
     """Run the scenario and write its report into ``out`` (its lock held)."""
 
     say = (lambda message: None) if args.quiet else _progress
+    for line in beyond_limit_warnings(scenario):  # before the work, even when quiet
+        print(f"{_PROG}: warning: {line}", file=sys.stderr, flush=True)
+    if args.h is None and scenario.step_note():
+        say(f"{_PROG}: note: {scenario.step_note()}")
     road = scenario.road.describe()
     say(
         f"qc-control report: {', '.join(scenario.methods)} at h = {scenario.h:g} s over "
@@ -566,6 +570,8 @@ def _cmd_control_report(args) -> int:
 
 def _control_report(args, params: QuarterCarParams, designs: list[str], out: Path) -> int:
     """Compare the designs and write the report into ``out`` (its lock held)."""
+    for design, why in unavailable_designs(designs).items():  # listed, not silently dropped
+        print(f"{_PROG}: warning: {design} {why}", file=sys.stderr, flush=True)
     if not args.quiet:
         _progress(f"qc-control control-report: {len(designs)} designs, bump and road runs")
     try:
@@ -592,6 +598,31 @@ def _control_report(args, params: QuarterCarParams, designs: list[str], out: Pat
         print(cmp.table)
     print(f"\nwrote {path / 'report.html'}, report.pdf, report.md, the CSV tables and figures")
     return 0
+
+
+def beyond_limit_warnings(scenario: Scenario) -> list[str]:
+    """One line per requested method whose stability limit the step exceeds.
+
+    Each names the method, the step and the limit h_max, and what to change:
+    such a method's response grows, so its errors measure the growth, not
+    the method's accuracy.
+    """
+    lines = []
+    for method, h_max in scenario.beyond_limits().items():
+        if h_max > 0:
+            lines.append(
+                f"h = {scenario.h:g} s is beyond {method}'s stability limit h_max = {h_max:.3g} s "
+                f"on this car ({100 * scenario.h / h_max:.0f}% of it): its response grows and "
+                f"its errors mean nothing; give --h {h_max:.2g} or less, or leave {method} out "
+                "of --methods"
+            )
+        else:  # an undamped mode on a method whose region holds no stretch of the imaginary axis
+            lines.append(
+                f"h = {scenario.h:g} s: {method} has no stable step on this car (h_max = 0 s, "
+                f"an undamped mode): its response grows at every h; leave {method} out of "
+                "--methods"
+            )
+    return lines
 
 
 def _progress(message: str) -> None:

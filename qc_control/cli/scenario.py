@@ -57,6 +57,7 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, ClassVar, cast
 
+import control
 import numpy as np
 
 from ..models.quarter import QuarterCarParams
@@ -64,6 +65,7 @@ from ..models.registry import MODELS, ModelEntry, get_model, model_for_params, p
 from ..models.vehicle import VehicleModel
 from ..numerics import methods as catalogue
 from ..numerics.methods import METHODS, get_method
+from ..numerics.stability import max_stable_step
 from ..ride import road as roads
 from ..ride.spectral import ISO8608Road, road_parameter
 from ..studies.compare import DEFAULT_METHODS, MethodComparison, compare_methods
@@ -247,6 +249,17 @@ class StepRoad(Road):
 _SPEED = _default(roads.iso8608, "speed")
 
 
+#: The fewest steps a bump may span: a 1 − cos pulse over fewer falls between
+#: the samples (0.05 m at 30 m/s lasts 1.7 ms: at h = 10 ms every method saw
+#: no bump at all). Four steps put three samples on it.
+BUMP_STEPS = 4
+#: The fewest steps per period of a sine road: ten, a fifth of the Nyquist
+#: frequency 1/(2h). At the Nyquist frequency itself the samples can all be
+#: zero; at a fifth of it linear interpolation between them is within 5 % of
+#: the amplitude (1 − cos(π/10)), where the methods' stages read the input.
+SINE_STEPS = 10
+
+
 @dataclass(frozen=True)
 class BumpRoad(Road):
     """A 1 − cos bump, `qc_control.ride.road.bump`.
@@ -272,6 +285,16 @@ class BumpRoad(Road):
             f"met at t = {self.t0:g} s at {self.speed:g} m/s"
         )
 
+    def largest_step(self) -> float:
+        """The bump's duration length/speed over `BUMP_STEPS`."""
+        return self.length / self.speed / BUMP_STEPS
+
+    def sampled(self) -> str:
+        return (
+            f"a {self.length:g} m bump at {self.speed:g} m/s, which lasts "
+            f"{1e3 * self.length / self.speed:.3g} ms and needs {BUMP_STEPS} steps across it"
+        )
+
 
 @dataclass(frozen=True)
 class SineRoad(Road):
@@ -291,6 +314,16 @@ class SineRoad(Road):
 
     def describe(self) -> str:
         return f"a sinusoidal road, {_length(self.amplitude)} amplitude at {self.frequency:g} Hz"
+
+    def largest_step(self) -> float:
+        """One period over `SINE_STEPS`: a fifth of the Nyquist frequency 1/(2h)."""
+        return 1.0 / (self.frequency * SINE_STEPS)
+
+    def sampled(self) -> str:
+        return (
+            f"a {self.frequency:g} Hz sine road, which needs {SINE_STEPS} steps per period "
+            f"(at most a fifth of the Nyquist frequency 1/(2h))"
+        )
 
 
 #: Every kind of road, by its ``kind``. The ISO 8608 road is the ride layer's
@@ -449,6 +482,20 @@ def _culprit(values: Mapping, cls: type) -> str | None:
         except (TypeError, ValueError):
             return key
     return None
+
+
+#: The default step is lowered below a method's stability limit by at most
+#: this factor (10 ms to 1 ms); a limit further down is warned about instead.
+_STABLE_DEFAULT_SPAN = 10.0
+
+
+def _coarse_remedy(road) -> str:
+    """What to change besides h when the road is too fine for the grid."""
+    if isinstance(road, BumpRoad):
+        return "a longer bump or a lower speed"
+    if isinstance(road, SineRoad):
+        return "a lower frequency"
+    return "narrow the band"
 
 
 def _iso_step(limit: float) -> float:
@@ -613,7 +660,7 @@ class Scenario:
         limit = road.largest_step()
         chosen = self.h is None
         if chosen:
-            put("h", defaults.h if defaults.h <= limit else _iso_step(limit))
+            put("h", self._default_step(defaults.h, limit))
         else:
             put("h", _number("scenario", "h", self.h, "s", positive=True))
         m = self.max_steps
@@ -626,7 +673,7 @@ class Scenario:
         if self.h > limit * (1 + 1e-12):
             raise ScenarioError(
                 f"h = {self.h!r} s is too coarse for {road.sampled()}: it must be <= "
-                f"{limit:.4g} s (give a smaller h, or narrow the band)",
+                f"{limit:.4g} s (give a smaller h, or {_coarse_remedy(road)})",
                 "scenario",
                 "h",
             )
@@ -721,6 +768,56 @@ class Scenario:
             for o in self.entry.options
             if o.target == target
         }
+
+    def _default_step(self, h: float, road_limit: float) -> float:
+        """The model's default step, lowered to the 1-2-5 series below the road's
+        limit and below every requested method's stability limit.
+
+        A default beyond a method's limit would report growth, not accuracy.
+        A limit more than `_STABLE_DEFAULT_SPAN` times below the default (a
+        nearly undamped mode, a featherweight design) would make the
+        convergence study's refinements too long a run: it is left to the
+        warning (`beyond_limits`) instead.
+        """
+        if h > road_limit:
+            h = _iso_step(road_limit)
+        stable = [limit for limit in self.step_limits().values() if 0 < limit < h]
+        if not stable:
+            return h
+        step = _iso_step(min(stable))
+        return step if step * _STABLE_DEFAULT_SPAN >= h else h
+
+    def step_note(self) -> str:
+        """Why the default step was lowered, in words; '' when it was not (or h was given)."""
+        default = self.entry.defaults.h
+        if self.h >= default or self.h != self._default_step(default, self.road.largest_step()):
+            return ""
+        if self.h <= self.road.largest_step() < default:
+            return (
+                f"h = {self.h:g} s, below the default {default:g} s, to sample "
+                f"{self.road.sampled()}"
+            )
+        slowest = min(self.step_limits().items(), key=lambda item: item[1])
+        return (
+            f"h = {self.h:g} s, below the default {default:g} s, to stay within "
+            f"{slowest[0]}'s stability limit h_max = {slowest[1]:.3g} s on this car"
+        )
+
+    def step_limits(self) -> dict[str, float]:
+        """Each method's stability limit h_max [s] on this scenario's car.
+
+        `qc_control.max_stable_step` of the car's state matrix, by method
+        name; empty for a model without one (the nonlinear car, whose
+        comparison reports the limits of its linearisation).
+        """
+        system = self.entry.model(self.vehicle).system
+        if not isinstance(system, control.StateSpace):
+            return {}
+        return {m: max_stable_step(m, system) for m in self.methods}
+
+    def beyond_limits(self) -> dict[str, float]:
+        """The methods whose limit h_max [s] this scenario's step exceeds, with it."""
+        return {m: h for m, h in self.step_limits().items() if self.h > h * (1 + 1e-12)}
 
     def _check_speed(self) -> None:
         if getattr(self.road, "speed", None) is None:

@@ -47,6 +47,7 @@ from .findings import findings
 from .nonlinear import nonlinear_blocks, nonlinear_figures, nonlinear_tables, reference_text
 from .pdf import to_pdf
 from .peers import peer_blocks, peer_figures, peer_tables
+from .summary import summary
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -103,10 +104,28 @@ def _versions() -> dict[str, str]:
     }
 
 
+#: The widest line of a printed matrix [characters]: what the PDF's code font
+#: (7.5 pt) holds across the page, so that a row is never wrapped mid-way.
+_MATRIX_WIDTH = 96
+
+
 def _matrix(name, M) -> str:
-    return f"{name} =\n" + np.array2string(
-        np.asarray(M), precision=6, suppress_small=True, max_line_width=100
-    )
+    """``M`` as aligned text, in blocks of whole columns that each fit
+    `_MATRIX_WIDTH`: a 14-state A is two blocks of rows, never a row broken
+    across lines (where its columns would no longer line up)."""
+    M = np.atleast_2d(np.asarray(M, dtype=float))
+    scale = float(np.max(np.abs(M))) if M.size else 0.0
+    small = np.abs(M) <= 1e-12 * scale  # rounding residue of a zero entry
+    cells = [["0" if z else f"{v:.6g}" for v, z in zip(row, zrow)] for row, zrow in zip(M, small)]
+    width = max((len(c) for row in cells for c in row), default=1)
+    per_block = max(1, (_MATRIX_WIDTH - 2) // (width + 2))
+    blocks = []
+    for start in range(0, M.shape[1], per_block):
+        stop = min(start + per_block, M.shape[1])
+        head = f"{name} =" if per_block >= M.shape[1] else f"{name}, columns {start + 1}–{stop} ="
+        rows = ["  ".join(c.rjust(width) for c in row[start:stop]) for row in cells]
+        blocks.append(head + "\n" + "\n".join("  " + r for r in rows))
+    return "\n\n".join(blocks)
 
 
 def _slug(name: str) -> str:
@@ -165,7 +184,8 @@ def _response_figures(cmp) -> list[_FigureDraft]:
         _FigureDraft("reference.png", _reference_caption(cmp), lambda: reference_figure(cmp)),
         _FigureDraft(
             "overlay.png",
-            "All methods' body displacement over the exact response",
+            "All methods' body displacement over the "
+            + ("exact response" if getattr(cmp, "nonlinear", None) is None else "reference"),
             lambda: overlay_figure(cmp),
         ),
     ]
@@ -263,12 +283,15 @@ def figure_specs(cmp) -> list[FigureSpec]:
 def _scenario_text(cmp) -> str:
     t0, t1 = cmp.T[0], cmp.T[-1]
     x0 = ", ".join(fmt(v) for v in cmp.X0)
-    kind = (
-        "free response (no input)"
-        if cmp.U is None
-        else f"forced response to the input(s) {', '.join(cmp.system.input_labels)}"
-        + (f" ({cmp.input_description})" if getattr(cmp, "input_description", "") else "")
-    )
+    described = getattr(cmp, "input_description", "")
+    if cmp.U is None:
+        # a road the model evaluates as a function of time is an input all the
+        # same, though the system has no input signal: name it
+        kind = f"response to {described}" if described else "free response (no input)"
+    else:
+        kind = f"forced response to the input(s) {', '.join(cmp.system.input_labels)}" + (
+            f" ({described})" if described else ""
+        )
     model = getattr(cmp, "model", None)
     # the states' units in order of first use: "m/s and m" on a quarter car
     units = (
@@ -330,7 +353,10 @@ def _system_blocks(cmp) -> list:
             )
         )
     linear = cmp.system if study is None else study.linearization
-    blocks.append(Code(_matrix("A", linear.A) + "\n\n" + _matrix("B", linear.B)))
+    B = np.asarray(linear.B)
+    # a free response has no input: no "B = []"
+    text = _matrix("A", linear.A) + ("\n\n" + _matrix("B", B) if B.size else "")
+    blocks.append(Code(text))
     blocks.append(
         Table(
             cmp.modes.to_frame(),
@@ -508,6 +534,8 @@ def build_blocks(cmp, command: str | None = None) -> list:
     figs = {spec.name: Image(spec.name, spec.caption, spec.label) for spec in figure_specs(cmp)}
     return _numbered(
         [
+            Heading("Summary"),
+            *(Paragraph(text) for text in summary(cmp)),
             *_problem_card(cmp, figs),
             *_response_blocks(cmp, figs),
             *_accuracy_blocks(cmp, figs),

@@ -10,10 +10,12 @@ on each.
 from __future__ import annotations
 
 import functools
+from collections.abc import Iterable
 from typing import TYPE_CHECKING
 
 import pandas as pd
 
+from ..models.controllers import HINF_AVAILABLE
 from . import FORMATS, FigureSpec, write_document
 from .document import Code, Heading, Image, Paragraph, Table
 
@@ -79,10 +81,18 @@ def control_figures(cmp) -> list[FigureSpec]:
     return specs
 
 
+def unavailable_designs(run: Iterable[str] = ()) -> dict[str, str]:
+    """The designs not in ``run`` that need an optional extra not installed,
+    each with the install hint: a report lists them rather than drop them."""
+    if HINF_AVAILABLE or "H∞" in run:
+        return {}
+    return {"H∞": "not run: it needs slycot, pip install 'qc-control[robust]'"}
+
+
 def _design_table(cmp) -> pd.DataFrame:
-    return pd.DataFrame(
-        {"what": list(cmp.designs.values())}, index=pd.Index(list(cmp.designs), name="design")
-    )
+    missing = unavailable_designs(cmp.designs)
+    what = {**cmp.designs, **missing}
+    return pd.DataFrame({"what": list(what.values())}, index=pd.Index(list(what), name="design"))
 
 
 def _ecu_blocks(cmp, table: pd.DataFrame) -> list:

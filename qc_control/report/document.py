@@ -161,7 +161,7 @@ td { white-space: nowrap; }
 figure { margin: 1em 0 2em; } figure img { max-width: 100%; height: auto; }
 figcaption, caption { font-style: italic; color: #555; text-align: left; }
 caption { caption-side: top; padding-bottom: 0.3em; }
-pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; white-space: pre-wrap; }
+pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; white-space: pre; }
 @media print { .table { overflow: visible; } }
 """
 

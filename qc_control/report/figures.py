@@ -17,6 +17,8 @@ Conventions, so that a projected figure reads at a glance:
 
 from __future__ import annotations
 
+import math
+import textwrap
 from typing import Any
 
 import numpy as np
@@ -121,6 +123,17 @@ def body_wheel_road(cmp) -> tuple[str, str | None, str | None]:
     return body, wheel, road
 
 
+def reference_word(cmp) -> str:
+    """What the methods are measured against: 'exact' on a linear car; on a
+    nonlinear one, which has no exact solution, 'reference (solve_ivp)'."""
+    return "exact" if getattr(cmp, "nonlinear", None) is None else "reference (solve_ivp)"
+
+
+def _title(text: str, width: int = 60) -> str:
+    """A figure title wrapped so that it never runs into the legend beside the axes."""
+    return textwrap.fill(text, width)
+
+
 def reference_figure(cmp) -> Figure:
     """The exact response the methods are measured against (and the road, if any)."""
     ref = cmp.reference
@@ -130,16 +143,14 @@ def reference_figure(cmp) -> Figure:
     if cmp.U is not None and road is not None:
         zr = np.asarray(cmp.U)[list(cmp.system.input_labels).index(road)]
         ax.plot(cmp.T, zr * _MM, color="tab:brown", lw=0.9, label=f"road {road}")
-    ax.plot(ref.time, output_signal(ref, body) * _MM, "r-", lw=1.3, label=f"body {body} (exact)")
+    word = reference_word(cmp)
+    ax.plot(ref.time, output_signal(ref, body) * _MM, "r-", lw=1.3, label=f"body {body} ({word})")
     if wheel is not None:
-        ax.plot(
-            ref.time, output_signal(ref, wheel) * _MM, "b--", lw=1.1, label=f"wheel {wheel} (exact)"
-        )
-    ax.set(
-        xlabel="time [s]",
-        ylabel="displacement [mm]",
-        title=cmp.input_description or "Free response: the exact solution",
-    )
+        wheel_mm = output_signal(ref, wheel) * _MM
+        ax.plot(ref.time, wheel_mm, "b--", lw=1.1, label=f"wheel {wheel} ({word})")
+    free = "Free response: the " + ("exact solution" if word == "exact" else word)
+    ax.set(xlabel="time [s]", ylabel="displacement [mm]")
+    ax.set_title(_title(cmp.input_description or free), fontsize="medium")
     ax.grid(alpha=0.3)
     _legend(fig)
     return fig
@@ -161,9 +172,17 @@ def method_figure(cmp, method: str) -> Figure:
     if wheel is not None:
         drawn.append((wheel, "wheel", "b--", "wheel"))
     for name, style, _, _ in drawn:
-        ax.plot(ref.time, output_signal(ref, name) * _MM, label=f"exact {name}", **_EXACT[style])
+        ax.plot(
+            ref.time,
+            output_signal(ref, name) * _MM,
+            label=f"{reference_word(cmp)} {name}",
+            **_EXACT[style],
+        )
     for name, _, line, what in drawn:
-        ax.plot(resp.time, output_signal(resp, name) * _MM, line, lw=1.2, label=f"{what} {name}")
+        color, ls = line[0], line[1:]
+        exact = output_signal(ref, name) * _MM
+        values = output_signal(resp, name) * _MM
+        _plot_cut(ax, resp.time, values, exact, f"{what} {name}", color=color, ls=ls, lw=1.2)
     title = f"{method}, h = {cmp.h:g} s"
     same = [g for g in coincidence_groups(cmp) if method in g]
     if same:
@@ -175,6 +194,44 @@ def method_figure(cmp, method: str) -> Figure:
     return fig
 
 
+#: A method's curve is cut where it leaves this multiple of the exact
+#: response's range (its largest magnitude): past it the method has diverged,
+#: and drawing on would scale the axis so that every other curve is flat.
+DIVERGED_RANGE = 10.0
+
+
+def diverged_at(time, values, exact) -> int | None:
+    """The index where ``values`` first leave `DIVERGED_RANGE` times the
+    range of ``exact`` (or become inf or NaN); None if they never do."""
+    span = float(np.max(np.abs(exact))) if np.size(exact) else 0.0
+    if not span > 0 or not math.isfinite(span):
+        return None
+    with np.errstate(invalid="ignore"):
+        outside = ~(np.abs(np.asarray(values)) <= DIVERGED_RANGE * span)
+    return int(np.argmax(outside)) if outside.any() else None
+
+
+def _plot_cut(ax, time, values, exact, label: str, **style) -> None:
+    """Plot ``values`` against ``time``, cut and marked where they diverge."""
+    cut = diverged_at(time, values, exact)
+    if cut is None:
+        ax.plot(time, values, label=label, **style)
+        return
+    kept = max(cut, 1)
+    (line,) = ax.plot(
+        time[:kept], values[:kept], label=f"{label}: diverged at t = {time[cut]:.3g} s", **style
+    )
+    ax.plot(time[kept - 1], values[kept - 1], "x", color=line.get_color(), ms=8, mew=2)
+    ax.annotate(
+        f"diverged at t = {time[cut]:.3g} s",
+        (time[kept - 1], values[kept - 1]),
+        xytext=(4, 4),
+        textcoords="offset points",
+        fontsize="small",
+        color=line.get_color(),
+    )
+
+
 def overlay_figure(cmp) -> Figure:
     """Every method's body displacement over the exact response."""
     colors, rank = _colors(cmp.responses), _rank(cmp)
@@ -182,20 +239,24 @@ def overlay_figure(cmp) -> Figure:
     ax = fig.subplots()
     ref = cmp.reference
     body = body_wheel_road(cmp)[0]
-    ax.plot(ref.time, output_signal(ref, body) * _MM, color="k", lw=4, alpha=0.25, label="exact")
+    word = reference_word(cmp)
+    ax.plot(ref.time, output_signal(ref, body) * _MM, color="k", lw=4, alpha=0.25, label=word)
+    exact = output_signal(ref, body) * _MM
     for name, resp in cmp.responses.items():
-        ax.plot(
+        _plot_cut(
+            ax,
             resp.time,
             output_signal(resp, body) * _MM,
+            exact,
+            name,
             color=colors[name],
             lw=1.2,
-            label=name,
             **_style(cmp, name, rank),
         )
     ax.set(
         xlabel="time [s]",
         ylabel=f"body displacement {body} [mm]",
-        title=f"All methods against the exact response, h = {cmp.h:g} s",
+        title=f"All methods against the {word.split(' ')[0]} response, h = {cmp.h:g} s",
     )
     ax.grid(alpha=0.3)
     _legend(fig, coincidence_note(cmp))

@@ -88,10 +88,17 @@ def _coincidence(cmp) -> list[str]:
         gap = max(v for k, v in cmp.coincident.items() if set(k) <= set(group))
         names = ", ".join(group[:-1]) + " and " + group[-1]
         p = int(orders[group[0]])
+        apart = (
+            "identical to the last bit"
+            if gap == 0
+            else f"at most {fmt(gap)} m apart in any state, rounding error"
+        )
+        powers = [f"(hA)^{k}/{math.factorial(k)}" for k in range(2, p + 1)]
+        taylor = " + ".join(["I", "hA", *powers])
         out.append(
-            f"{names} give the same trajectory (largest state difference {fmt(gap)} m, which "
-            f"is rounding). On a linear system the free step of every method with as many "
-            f"stages as its order p is the Taylor polynomial T_{p}(hA)·x"
+            f"{names} give the same trajectory ({apart}). On a linear system the free step "
+            f"of every method of order {p} with {p} stages is the same polynomial of hA, "
+            f"the first terms of exp(hA): x ← ({taylor})·x"
             + (
                 ", and an input linear within each step enters them alike (Midpoint's "
                 "u(t + h/2) is Heun's (u(t) + u(t + h))/2)"

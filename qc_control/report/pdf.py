@@ -33,7 +33,8 @@ _WIDTH = _PAGE_W - _LEFT - _RIGHT
 _PT = 1 / 72  # inch per point
 
 _BODY, _SMALL, _CODE = 9.5, 8.5, 7.5  # font sizes [pt]
-_TABLE_SIZES = (8.0, 7.5, 7.0, 6.5, 6.0)  # tried in turn until a table fits
+_TABLE_SIZES = (8.0, 7.5, 7.0)  # tried in turn; a table wider still splits into column groups,
+# never below 7 pt, the smallest size legible on a printed page
 _CELL_PAD = 3.0  # [pt] either side of a cell's text
 
 

@@ -1,0 +1,89 @@
+"""Report layout a lecturer would print: matrices that stay aligned on paper
+and on a phone, and no empty "B = []" on a free response."""
+
+import re
+
+import numpy as np
+import pytest
+
+from qc_control.cli.scenario import Scenario
+from qc_control.report import _matrix, _system_blocks
+from qc_control.report.document import _CSS, Code
+
+
+def parse(text: str, shape) -> np.ndarray:
+    """The matrix back from its printed blocks of columns."""
+    out = np.full(shape, np.nan)
+    start = 0
+    for block in text.split("\n\n"):
+        head, *rows = block.splitlines()
+        cols = re.search(r"columns (\d+)–(\d+)", head)
+        start, stop = (int(cols[1]) - 1, int(cols[2])) if cols else (0, shape[1])
+        for i, row in enumerate(rows):
+            out[i, start:stop] = [float(v) for v in row.split()]
+    return out
+
+
+@pytest.mark.parametrize("model", ["quarter", "half", "full"])
+def test_a_matrix_prints_in_aligned_blocks_that_fit_the_page(model):
+    sc = Scenario(model=model, road={"kind": "bump", "speed": 10.0})
+    A = np.asarray(sc.entry.model(sc.vehicle, road=True).system.A)
+    text = _matrix("A", A)
+    for block in text.split("\n\n"):
+        rows = block.splitlines()[1:]
+        assert len(rows) == A.shape[0]  # one line per row: never wrapped
+        assert len({len(r) for r in rows}) == 1  # right-aligned columns
+        assert all(len(line) <= 96 for line in block.splitlines())  # the PDF's code width
+    # six significant digits: the printed entries are A's to 5e-6 relative
+    np.testing.assert_allclose(parse(text, A.shape), A, rtol=5e-6, atol=1e-12 * abs(A).max())
+
+
+def test_a_free_response_shows_no_empty_b():
+    cmp = Scenario(t_end=1.0).run()
+    (code,) = [b for b in _system_blocks(cmp) if isinstance(b, Code)]
+    assert "A =" in code.text and "B" not in code.text
+
+
+def test_a_forced_response_shows_b():
+    cmp = Scenario(road={"kind": "bump"}, t_end=1.0, methods=["rk4"]).run()
+    (code,) = [b for b in _system_blocks(cmp) if isinstance(b, Code)]
+    assert "\nB =\n" in code.text
+
+
+def test_preformatted_text_scrolls_rather_than_wraps_a_row():
+    assert re.search(r"pre \{[^}]*white-space: pre;", _CSS)
+
+
+def test_a_wide_table_in_the_pdf_splits_into_column_groups_not_below_7_pt(tmp_path, monkeypatch):
+    import pandas as pd
+
+    from qc_control.report import pdf
+    from qc_control.report.document import Table
+
+    sizes, parts = [], []
+    original = pdf._Writer._table_part
+
+    def spy(self, caption, cols, head, body, numeric, widths, headers, font, bold):
+        sizes.append(font.size)
+        parts.append(caption)
+        return original(self, caption, cols, head, body, numeric, widths, headers, font, bold)
+
+    monkeypatch.setattr(pdf._Writer, "_table_part", spy)
+    # 24 columns of 9-digit numbers: wider than an A4 page at any legible size
+    frame = pd.DataFrame(
+        np.arange(72 * 24, dtype=float).reshape(72, 24) * 1234.56789,
+        columns=[f"column {j} [m]" for j in range(24)],
+    )
+    pdf.to_pdf("wide", [Table(frame, "A wide table")], tmp_path, tmp_path / "w.pdf")
+    assert len(parts) > 1 and all(p.startswith("A wide table (columns") for p in parts)
+    assert min(sizes) >= 7.0
+
+
+def test_coinciding_methods_are_described_in_words_not_symbols():
+    from qc_control.report.findings import _coincidence
+
+    (text,) = _coincidence(Scenario(t_end=1.0).run())
+    # the issue's wording: "largest state difference 0 m, which is rounding" and "T_2(hA)"
+    assert "which is rounding" not in text and "T_2" not in text
+    assert "identical to the last bit" in text  # Midpoint and Heun: bit for bit on a free response
+    assert "x ← (I + hA + (hA)^2/2)·x" in text
