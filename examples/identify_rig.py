@@ -17,15 +17,14 @@ Run: ``python examples/identify_rig.py [OUT_DIR]`` (default
 ``report.html``, figures and CSV tables).
 """
 
-import sys
 from pathlib import Path
 
 import qc_control as qc
 from qc_control.report.identification import write_identification_report
+from qc_control.report.outputs import output_folder
 from qc_control.studies.measurement import RIG_COLUMNS
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.parent.mkdir(parents=True, exist_ok=True)
+out = output_folder("identify_rig")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
 
 # %%
@@ -62,6 +61,6 @@ write_identification_report(
     record,
     out,
     validation=held_out,
-    command="python examples/identify_rig.py " + " ".join(sys.argv[1:]),
+    command=f"python examples/identify_rig.py {out}",
 )
 print(f"wrote {out / 'report.md'}")

@@ -16,14 +16,11 @@ Prints each run's peaks and the work–precision findings; writes
 Run: ``python examples/pothole.py [OUT_DIR]`` (default ``./pothole_output``).
 """
 
-import sys
-from pathlib import Path
-
+from qc_control.report.outputs import output_folder
 from qc_control.report.peers import peer_findings, peers_figure
 from qc_control.studies.scenarios import peak_table, pothole_comparison
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
+out = output_folder("pothole")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
 
 cmp = pothole_comparison(rtols=(1e-3, 1e-6, 1e-9), repeats=1)

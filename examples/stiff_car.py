@@ -18,14 +18,14 @@ Run: ``python examples/stiff_car.py [OUT_DIR] [T_END]`` (default
 """
 
 import sys
-from pathlib import Path
 
+from qc_control.report.outputs import in_notebook, output_folder
 from qc_control.report.peers import peer_findings, peers_figure
 from qc_control.studies.scenarios import StiffCar, stiff_car_comparison
 
-out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-out.mkdir(parents=True, exist_ok=True)
-t_end = float(sys.argv[2]) if len(sys.argv) > 2 else 10.0
+args = [] if in_notebook(sys.argv) else sys.argv[1:]  # [OUT_DIR [T_END]]
+out = output_folder("stiff_car", out=args[0] if args else None, argv=sys.argv[:1])
+t_end = float(args[1]) if len(args) > 1 else 10.0
 print(f"writing into {out.resolve()}")
 
 cmp = stiff_car_comparison(
