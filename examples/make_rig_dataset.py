@@ -19,14 +19,12 @@ Run: ``python examples/make_rig_dataset.py [OUT_DIR]`` (default
 files, which are the same to the byte: every random draw is seeded).
 """
 
-import sys
-from pathlib import Path
-
 import control
 import numpy as np
 import scipy.signal
 
 import qc_control as qc
+from qc_control.report.outputs import output_folder
 
 #: The car the records come from (the answer the identification should find).
 TRUE_CAR = dict(ms=320.0, mu=45.0, ks=22000.0, ku=190000.0, cs=1800.0, cu=150.0)
@@ -92,8 +90,7 @@ def record(duration: float, seed: int) -> str:
 
 
 if __name__ == "__main__":
-    out = Path(sys.argv[1] if len(sys.argv) > 1 else f"{Path(sys.argv[0]).stem}_output")
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_folder("make_rig_dataset")  # OUT_DIR from the command line, if any
     for name, duration, seed in (("rig_identification", 15.0, 2026), ("rig_validation", 8.0, 2027)):
         path = out / f"{name}.csv"
         path.write_text(record(duration, seed), encoding="utf-8", newline="\n")
