@@ -24,7 +24,7 @@ LABELS = ("xs", "xu", "susp_travel", "tire_defl", "body_acc", "wheel_acc")
 
 def _system(car):
     """The car as a python-control system, inputs (zr, fa), outputs `LABELS`; the wheel's
-    acceleration is the second row of ``A x + B u`` (no tire damping)."""
+    acceleration is the second row of ``A x + B u``, right without tire damping only."""
     A, B, C, D = quarter_car_abcd(**car, road=True, actuator=True)
     return control.ss(A, B, np.vstack([C, A[1]]), np.vstack([D, B[1]]))
 
@@ -90,6 +90,8 @@ def test_recovers_the_car_without_noise(force):
     outputs = ("susp_travel", "body_acc", "wheel_acc")
     m = _record(CAR, 400.0, seed=2, force=force, outputs=outputs)
     ident = qc.identify(m, domain="frequency", resolution=0.1)
+    # 2 %, the brief's bar; measured: 0.22 % at worst (ks) with the force, 0.02 % from the
+    # road alone; what remains is Welch's leakage at the body mode, not noise
     if force:  # the known force fixes the scale: absolute values
         assert ident.undetermined == ()
         for name in ("ms", "mu", "ks", "ku", "cs"):
@@ -103,6 +105,17 @@ def test_recovers_the_car_without_noise(force):
     assert (table.ci_low <= table.estimate).all() and (table.estimate <= table.ci_high).all()
     assert ident.transmissibility is not None
     assert any("frequency domain" in n for n in ident.notes)
+
+
+@pytest.mark.slow
+def test_recovers_a_tire_damped_car_without_noise():
+    car = dict(ms=250.0, mu=35.0, ks=16000.0, ku=160000.0, cs=1200.0, cu=120.0)
+    m = _record(car, 300.0, seed=6, outputs=("susp_travel", "body_acc", "tire_defl"))
+    ident = qc.identify(m, domain="frequency", resolution=0.1, free=tuple(car))
+    # 2 %, the brief's bar; measured: 0.17 % at worst (cu), the rest 0.12 % or less
+    for name, value in car.items():
+        assert ident.table.loc[name, "estimate"] == pytest.approx(value, rel=0.02), name
+    assert ident.undetermined == ()
 
 
 @pytest.mark.slow
