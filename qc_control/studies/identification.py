@@ -19,6 +19,13 @@ intervals, and names the absolute values undetermined until a mass is fixed.
 A Jacobian that is rank deficient for any other reason is reported the same
 way.
 
+For a long sine-sweep or random rig test, ``domain="frequency"`` fits the
+car's exact response to the records' transmissibility instead (the
+multi-input H1 estimate, each frequency weighted by its coherence; see
+`qc_control.studies.frequency_identification`): the record's start then
+does not matter, at the price of records long enough to resolve the body's
+resonance (a few hundred seconds for 0.1 Hz bins).
+
 Uncertainty comes from the Jacobian at the optimum (Ljung, *System
 Identification*, 2nd ed., §9.3): the parameters' covariance is the sandwich
 ``(JᵀJ)⁻¹ (Σᵢ σᵢ² JᵢᵀJᵢ) (JᵀJ)⁻¹`` with ``σᵢ²`` the residual variance of
@@ -275,8 +282,8 @@ class Identification:
     success: bool
     nfev: int
     values: dict[str, float] = field(repr=False, default_factory=dict)
-    #: The estimated transmissibility a frequency-domain fit fitted (None in the time domain).
-    transmissibility: Any = field(repr=False, default=None)
+    #: The records' transmissibility a frequency-domain fit fitted (None in the time domain).
+    transmissibility: Transmissibility | None = field(repr=False, default=None)
 
     def simulate(self, measurement: Measurement, *, at_rest: bool = True) -> np.ndarray:
         """The identified car's outputs under ``measurement``'s inputs, ``(outputs, N)``.
@@ -377,7 +384,7 @@ def identify(
     resolution: float | None = None,
     band: tuple[float, float] | None = None,
 ) -> Identification:
-    """Fit the quarter car to measured records by output error.
+    """Fit the quarter car to measured records by output error, or to their transmissibility.
 
     Parameters
     ----------
