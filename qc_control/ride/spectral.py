@@ -495,11 +495,20 @@ class ISO8608Road:
         return road.iso8608(T, self.road_class, speed=self.speed, seed=self.seed, band=self.band)
 
     def describe(self) -> str:
-        """The road in words, from its actual parameters."""
+        """The road in words, from its actual parameters.
+
+        A class's road also states its expected International Roughness
+        Index (`qc_control.ride.road.iso8608_iri` over the road's band): the
+        road engineer's measure of the same roughness, independent of the
+        speed driven.
+        """
         lo, hi = self.band
+        roughness = ""
+        if isinstance(self.road_class, str):
+            roughness = f", expected IRI {road.iso8608_iri(self.road_class, self.band):.3g} m/km"
         return (
             f"an ISO 8608 class {self.road_class} road at {self.speed:g} m/s "
-            f"(seed {self.seed}, band {lo:g}–{hi:g} cycles/m)"
+            f"(seed {self.seed}, band {lo:g}–{hi:g} cycles/m{roughness})"
         )
 
     def largest_step(self) -> float:
