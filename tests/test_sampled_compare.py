@@ -9,16 +9,16 @@ ticks, and a fine-step RK4 run of the car alone between the ticks.
 
 from __future__ import annotations
 
-import control
 import numpy as np
 import pytest
 
+# the ECU's clock, the released body, the discrete LQR of the car's ZOH equivalent
+# and that equivalent closed with it at the ticks, as tests/test_sampled.py builds them
+from test_sampled import DT, X0, _dlqr_law, _exact_ticks
+
 import qc_control as qc
 from qc_control.numerics.clocked import exact_clocked
-
-DT = 0.01  # the ECU's period [s]
-X0 = [0.0, 0.0, 0.05, 0.0]  # the body 5 cm above equilibrium [vs, vu, xs, xu]
-Q = np.diag([1.0, 1.0, 1e4, 1e4])
+from qc_control.studies.compare import sampled_reference
 
 
 @pytest.fixture(scope="module")
@@ -26,34 +26,10 @@ def car():
     return qc.quarter_car_model(road=True, actuator=True)
 
 
-def _discrete(car):
-    """``(A_d, B_d)`` of the car's force held over ``DT``, by python-control."""
-    sys = car.system
-    j = sys.input_labels.index("fa")
-    d = control.c2d(control.ss(sys.A, sys.B[:, [j]], np.eye(sys.nstates), 0), DT, "zoh")
-    return np.asarray(d.A), np.asarray(d.B)
-
-
 @pytest.fixture(scope="module")
 def law(car):
     """A discrete LQR of the car's ZOH equivalent, and its gain."""
-    Ad, Bd = _discrete(car)
-    K, _, _ = control.dlqr(Ad, Bd, Q, 1e-6)
-    states = list(car.system.state_labels)
-    ss = control.ss([], [], [], -K, dt=DT, inputs=states, outputs=["fa"], name="dlqr")
-    return ss, np.asarray(K)
-
-
-def _c2d_ticks(car, K, ticks, delay=0):
-    """The states at the ticks of ``c2d(car, DT, 'zoh')`` closed with ``-K``."""
-    Ad, Bd = _discrete(car)
-    x, queue = np.array(X0, float), [0.0] * delay
-    out = np.empty((4, ticks))
-    for k in range(ticks):
-        out[:, k] = x
-        queue.append(float((-K @ x)[0]))
-        x = Ad @ x + Bd[:, 0] * queue.pop(0)
-    return out
+    return _dlqr_law(car)
 
 
 @pytest.mark.parametrize("delay", [0, 2])
@@ -66,7 +42,7 @@ def test_the_reference_is_the_zoh_equivalent_at_the_ticks(car, law, substeps, de
     loop = qc.closed_loop(car, ss, delay=delay).system
     T = np.arange(0, 201) * DT
     run = exact_clocked(loop, T, np.zeros((1, T.size)), [*X0, *[0.0] * (delay + 1)], substeps)
-    exact = _c2d_ticks(car, K, T.size, delay)
+    exact = _exact_ticks(car, K, T.size, delay)
     assert np.max(np.abs(run.x - exact)) < 1e-12
 
 
@@ -123,6 +99,8 @@ def test_compare_methods_takes_a_sampled_loop(comparison):
     so rounding only (1e-12 m leaves a factor ~100 over the ~1e-14 measured)."""
     assert comparison.reference_error < 1e-12
     assert "clock ticks" in comparison.reference_name
+    # on the road, the ride metrics of the reference and of each method, as for any car
+    assert list(comparison.ride.index) == ["reference", "heun", "rk4"]
 
 
 def test_rk4_and_heun_show_their_order_at_the_ticks(comparison):
@@ -145,3 +123,22 @@ def test_the_report_of_a_sampled_comparison_is_written(comparison, tmp_path):
     qc.write_report(comparison, tmp_path)
     text = "".join(p.read_text(encoding="utf-8") for p in tmp_path.rglob("*.md"))
     assert "clock ticks" in text and "sampled-data loop" in text
+
+
+def test_a_previewing_mpc_with_delay_is_compared_against_python_control_tick_by_tick(car):
+    """An MPC with 0.1 s of road preview, its force limited, one tick of delay, over
+    the bump: the reference agrees with control.forced_response run tick interval by
+    tick interval, its law fed the road ahead from the same signal (both exact:
+    1e-12 m is rounding with a margin of ~100; the limit makes the law nonlinear, so
+    a difference in the state would show as a different move)."""
+    mpc = qc.mpc_controller(car, DT, 10, preview=0.1, limits={"fa": 300.0})
+    loop = qc.closed_loop(car, mpc, delay=1)
+    T = np.arange(0, 51) * DT
+    zr = qc.road.bump(T, height=0.05)
+    x0 = [*X0, *[0.0] * (loop.system.nstates - 4)]
+    metres = [s for s in loop.system.output_labels if loop.unit(s) == "m"]
+    ref = sampled_reference(loop.system, T, x0, zr[None], substeps=2, outputs=metres)
+    assert ref.error < 1e-12
+    fa = np.asarray(ref.response.outputs)[loop.system.output_labels.index("fa")]
+    assert np.max(np.abs(fa)) <= 300.0 * (1 + 1e-6)  # the limit held (QP tolerance)
+    assert np.max(np.abs(fa)) > 100.0  # and the law did act

@@ -56,6 +56,7 @@ __all__ = [
     "compare_methods",
     "Reference",
     "exact_reference",
+    "sampled_reference",
     "method_responses",
     "error_table",
     "convergence_study",
