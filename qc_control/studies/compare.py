@@ -973,7 +973,8 @@ def compare_methods(
         `VehicleModel` whose ``system`` is a `control.NonlinearIOSystem`
         (`qc_control.nonlinear_quarter_car_model`, or `closed_loop` with a
         semi-active controller), or such a bare system, is compared against
-        a tight ``solve_ivp`` (see Notes).
+        a tight ``solve_ivp`` (see Notes); a sampled-data loop against its
+        exact response tick by tick.
     T : array_like, optional
         Uniform output grid [s]; default 0-10 s at 0.01 s.
     X0 : array_like, default ``(0, 0, 0.05, 0)``
@@ -1049,6 +1050,17 @@ def compare_methods(
     the linearisation at the static equilibrium (`control.linearize`).
     Wall times are one run each (no LTI engine); ``nonlinear`` holds the
     event times, the orders and where Midpoint and Heun part.
+
+    **Sampled-data loops** (`qc_control.closed_loop` with a discrete
+    controller). The reference is `sampled_reference`: between two ticks
+    the car is linear with its move held, so the exact loop is the car's
+    matrix-exponential step interval by interval, the law updated at each
+    tick from that exact state (its own accuracy: against
+    ``control.forced_response`` run tick interval by tick interval). The
+    car's step ``h`` must land on every tick. Modes, step limits and
+    numerical modes are the car's own (``sampled_car``): the controller
+    acts only at the ticks. Wall times are one run each (no LTI engine);
+    ``solvers``, ``events`` and ``levels`` do not apply.
     """
     sys, model, params = _as_model(sys, U, params)
     problem = _checked_problem(sys, model, params, T, X0, U, methods, h, repeats)
