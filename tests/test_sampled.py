@@ -213,12 +213,16 @@ def test_a_rebuilt_loop_closes_the_same_controller_with_its_delay(car):
     assert other.params.ks == 3e4
 
 
-def test_compare_methods_refuses_a_sampled_loop_saying_why(car):
-    """Its references know no ticks: a comparison against them would be wrong, not slow."""
+def test_compare_methods_refuses_peers_on_a_sampled_loop_saying_why(car):
+    """solve_ivp's peers know no ticks: a comparison against them would be wrong, not
+    slow. The methods themselves are compared against the tick-by-tick exact loop
+    (tests/test_sampled_compare.py)."""
     law, _ = _dlqr_law(car)
     loop = qc.closed_loop(car, law)
-    with pytest.raises(ValueError, match="sampled-data loop: the comparison's references"):
-        qc.compare_methods(loop, T=np.arange(0, 101) * DT, X0=[*X0, 0.0], timing=False)
+    with pytest.raises(ValueError, match="do not apply to a sampled-data loop"):
+        qc.compare_methods(
+            loop, T=np.arange(0, 101) * DT, X0=[*X0, 0.0], timing=False, solvers=["RK45"]
+        )
 
 
 def test_sweep_takes_a_sampled_loop(car):

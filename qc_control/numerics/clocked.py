@@ -46,6 +46,7 @@ import control
 import numpy as np
 
 from .. import compat
+from .exact import exact_step_matrices
 from .sampled import linear_input
 
 __all__ = [
@@ -56,6 +57,7 @@ __all__ = [
     "clock_ratio",
     "affine_step",
     "step_clocked",
+    "exact_clocked",
 ]
 
 #: Relative tolerance on ``dt / h`` being a whole number (rounding of the
@@ -343,14 +345,51 @@ def step_clocked(loop: ClockedLoop, tab, T, W, x0, substeps: int = 1) -> Clocked
     """
     T = np.asarray(T, dtype=float)
     h = _check_grid(T) / substeps
-    m = clock_ratio(loop.period, h)
-    n, nc, _ = loop.sizes
     steps = (T.size - 1) * substeps
     A, _, Bu = loop.plant_matrices[:3]
     Phi, M = affine_step(A, tab, h)
-    Mu = M @ np.kron(np.ones((np.asarray(tab.b).size, 1)), Bu)
+    s = np.asarray(tab.b).size
+    Mu = M @ np.kron(np.ones((s, 1)), Bu)
+    gw = _stage_forcing(loop, tab, T, W, h, steps, M)
+    return _affine_run(loop, T, W, x0, substeps, (Phi, Mu, gw), s)
+
+
+def exact_clocked(loop: ClockedLoop, T, W, x0, substeps: int = 1) -> ClockedRun:
+    """The exact response of ``loop`` on the uniform grid ``T``, tick by tick.
+
+    Between two ticks the plant is linear and time-invariant, its move
+    held and the road linear between its samples, so over each of the
+    steps ``h = ΔT / substeps`` (which land on every tick and every sample)
+    its state follows the exact step
+    ``x⁺ = e^{Ah} x + Γ₀ w_i + Γ₁ w_{i+1} + (Γ₀ + Γ₁) u`` (`exact_step_matrices`,
+    the matrix exponential python-control's ``forced_response`` uses). The
+    law is updated at the ticks from this exact state, with the same hold
+    and delay queue as `step_clocked`: what every method's run converges to.
+
+    Parameters and raises as `step_clocked` (without the tableau); the
+    run's ``steps`` count the exact steps and ``nfev`` is 0.
+    """
+    T = np.asarray(T, dtype=float)
+    h = _check_grid(T) / substeps
+    steps = (T.size - 1) * substeps
+    A, Bw, Bu = loop.plant_matrices[:3]
+    nw = Bw.shape[1]
+    Phi, G0, G1 = exact_step_matrices(A, np.hstack([Bw, Bu]), h)
+    fine = np.minimum(T[0] + h * np.arange(steps + 1), T[-1])
+    Wf = linear_input(T, W).at(fine)  # (steps + 1, nw): the road at every step's ends
+    gw = Wf[:-1] @ G0[:, :nw].T + Wf[1:] @ G1[:, :nw].T
+    return _affine_run(loop, T, W, x0, substeps, (Phi, G0[:, nw:] + G1[:, nw:], gw), 0)
+
+
+def _affine_run(loop: ClockedLoop, T, W, x0, substeps: int, step, stages: int) -> ClockedRun:
+    """The run of affine steps ``x⁺ = Φ x + g_w[i] + M_u u`` (``step = (Φ, M_u, g_w)``)
+    whose law acts at every tick, at the output samples of ``T``."""
+    Phi, Mu, gw = step
+    h = _check_grid(T) / substeps
+    m = clock_ratio(loop.period, h)
+    steps = gw.shape[0]
     intervals = -(-steps // m)
-    R = _road_within(_stage_forcing(loop, tab, T, W, h, steps, M), Phi, m, intervals)
+    R = _road_within(gw, Phi, m, intervals)
     P, S = _interval_maps(Phi, Mu, m)
     ticks = steps // m + 1
     tick_x, tick_xc, tick_q, moves = _tick_loop(loop, T, W, x0, (P[m], S[m], R[:, m]), ticks)
@@ -359,9 +398,8 @@ def step_clocked(loop: ClockedLoop, tab, T, W, x0, substeps: int = 1) -> Clocked
     k, r = i // m, i % m
     X = np.einsum("kij,kj->ik", P[r], tick_x[k]) + R[np.minimum(k, intervals - 1), r].T
     X += np.einsum("kij,kj->ik", S[r], tick_q[k, : loop.nu])
-    s = np.asarray(tab.b).size
     tick_times = T[0] + loop.period * np.arange(ticks)
-    return ClockedRun(X, tick_xc[k].T, tick_q[k].T, tick_times, moves, steps, steps * s)
+    return ClockedRun(X, tick_xc[k].T, tick_q[k].T, tick_times, moves, steps, steps * stages)
 
 
 def _tick_loop(loop: ClockedLoop, T, W, x0, interval, ticks: int):

@@ -169,6 +169,11 @@ def _reference_caption(cmp) -> str:
             "The reference the methods are measured against: solve_ivp (DOP853, rtol "
             "1e-12, restarted at every event)"
         )
+    elif getattr(cmp, "sampled_car", None) is not None:
+        what = (
+            "The exact response the methods are measured against: the car's matrix "
+            "exponential between clock ticks, the controller updated at each tick"
+        )
     else:
         what = (
             "The exact response the methods are measured against: python-control's "
@@ -352,7 +357,16 @@ def _system_blocks(cmp) -> list:
                 "linearisation at the static equilibrium (x = 0, u = 0)."
             )
         )
-    linear = cmp.system if study is None else study.linearization
+    car = getattr(cmp, "sampled_car", None)
+    if car is not None:
+        blocks.append(
+            Paragraph(
+                f"The system is a sampled-data loop ({cmp.system.name}): the controller "
+                f"acts every {fmt(cmp.system.period)} s and holds its move. A and B below "
+                "are the car's between the ticks, whose modes set the step limits."
+            )
+        )
+    linear = (car if car is not None else cmp.system) if study is None else study.linearization
     B = np.asarray(linear.B)
     # a free response has no input: no "B = []"
     text = _matrix("A", linear.A) + ("\n\n" + _matrix("B", B) if B.size else "")
