@@ -216,7 +216,7 @@ def stiff_car_comparison(
 
 
 def peak_table(cmp: MethodComparison) -> pd.DataFrame:
-    """Peak |body displacement| and |suspension travel| [m] of the reference, of each
+    """Peak absolute body displacement and suspension travel [m] of the reference, of each
     method at h and of each peer's loosest run (``control``: its defaults)."""
     model = cmp.model
     labels = list(cmp.system.output_labels)
