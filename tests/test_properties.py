@@ -257,5 +257,10 @@ def test_any_argument_vector_exits_0_or_2_with_one_line(words, fast_writer):
     if status == 0:
         return
     assert status == 2, (words, status, text)
-    lines = text.splitlines()
+    # a deprecated spelling (--bump-height) adds its one warning line before the error
+    lines = [
+        line
+        for line in text.splitlines()
+        if not (line.startswith("qc-control: warning: ") and "is deprecated" in line)
+    ]
     assert len(lines) == 1 and lines[0].startswith("qc-control: error: "), (words, text)

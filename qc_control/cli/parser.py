@@ -15,7 +15,7 @@ import os
 import sys
 import warnings
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import fields
 from importlib.metadata import version
 from pathlib import Path
@@ -41,17 +41,23 @@ from .scenario import (
     command_line,
     option_flag,
     option_name,
+    outside_level,
+    road_from_mapping,
     road_option,
     run_keys,
+    vehicle_config,
     vehicle_keys,
 )
 
 __all__ = ["run", "build_parser", "scenario_from_args", "summarise_warnings", "UsageError"]
 
 _PROG = "qc-control"
-#: ``--bump-height`` and ``--bump-length``: the nonlinear car's words for the bump road's
-#: ``--road-height`` and ``--road-length`` (the same fields of the Scenario's road).
+#: ``--bump-height`` and ``--bump-length``: the nonlinear car's words of earlier versions for
+#: the bump road's ``--road-height`` and ``--road-length`` (the same fields of the Scenario's
+#: road), read for one more release with a deprecation warning naming the new spelling.
 _BUMP_ALIASES = {"bump_height": "height", "bump_length": "length"}
+#: The models ``control-report`` compares controllers on: the quarter car's linear model.
+_CONTROL_MODELS = ("quarter",)
 
 
 class UsageError(Exception):
@@ -73,50 +79,97 @@ def _floats(text: str) -> list[float]:
         ) from None
 
 
-def _add_vehicle(parser: argparse.ArgumentParser, shown: str) -> None:
-    """``--model``, every registered model's parameters and ``--config``.
+def _add_vehicle(
+    parser: argparse.ArgumentParser, models: tuple[str, ...], scope: str = "runs"
+) -> None:
+    """``--model``, the ``models``' parameters and ``--config``.
 
-    Every parameter of every model is an option (``--config`` may choose
-    the model), but ``--help`` lists the ``shown`` model's only.
+    The parameters are listed in one argument group per set of models that
+    takes them (every car's ``--ms``; the quarter and nonlinear car's
+    ``--ks``; the full car's ``--track-front``), so a reader of ``--help``
+    sees which apply to their model; a command offers only the models it runs
+    (``scope`` says how, for the refusal of another: "compares controllers on").
     """
-    entry = get_model(shown)
-    group = parser.add_argument_group(
-        f"vehicle: the {shown} car's parameters (SI units; default: {entry.description}; "
-        "--model NAME --help lists another model's)"
-    )
+    group = parser.add_argument_group("vehicle")
     group.add_argument(
         "--model",
-        choices=list(MODELS),
+        type=_offered(f"{parser.prog.split()[-1]} {scope}", models),
+        metavar="{" + ",".join(models) + "}",
         help="the vehicle: "
-        + ", ".join(f"{name} ({kind.description})" for name, kind in MODELS.items())
+        + ", ".join(f"{name} ({get_model(name).description})" for name in models)
         + f"; default {DEFAULT_MODEL}",
     )
-    for key in parameter_keys():
-        group.add_argument(
-            option_name(key),  # one spelling for options: --ks-front, as --t-end
-            dest=key,
-            type=float,
-            metavar="X",
-            help=f"{parameter_help(entry, key)}, overrides the config file"
-            if key in entry.keys()
-            else argparse.SUPPRESS,
-        )
     group.add_argument(
         "--config",
         metavar="FILE.toml",
-        help="TOML file: the vehicle's parameters at the top level, and for 'report' a "
-        "[scenario] table (model = NAME ...) and a [scenario.road] table (a report's "
-        "scenario.toml)",
+        help="TOML file: the vehicle's parameters at the top level and [scenario] model = "
+        "NAME; for 'report' also the run's [scenario] keys and a [scenario.road] table (a "
+        "report's scenario.toml), which the other commands do not read",
     )
+    for users, keys in _by_models(
+        {key: [m for m in names if m in models] for key, names in parameter_keys().items()}
+    ).items():
+        entry = get_model(users[0])
+        title = "every car's" if len(users) == len(MODELS) > 1 else f"the {_cars(users)}'s"
+        box = parser.add_argument_group(f"vehicle: {title} parameters (SI units)")
+        for key in keys:
+            box.add_argument(
+                option_name(key),  # one spelling for options: --ks-front, as --t-end
+                dest=key,
+                type=float,
+                metavar="X",
+                help=f"{parameter_help(entry, key)}, overrides the config file",
+            )
+
+
+def _offered(command: str, models: tuple[str, ...]) -> Callable[[str], str]:
+    """The reader of ``--model``: one of the ``models`` the ``command`` (its name
+    and how it uses them) runs, else a complaint that says which it takes."""
+
+    def model(text: str) -> str:
+        if text in models:
+            return text
+        if text in MODELS:  # a model of the package that this command does not run
+            raise argparse.ArgumentTypeError(
+                f"{command} the {_cars(models)} only, got "
+                f"--model {text}; the {text} car takes the passive tools (report, modes)"
+            )
+        raise argparse.ArgumentTypeError(
+            f"invalid choice: {text!r} (choose from {', '.join(map(repr, models))})"
+        )
+
+    return model
+
+
+def _by_models(users: dict[str, list[str]]) -> dict[tuple[str, ...], list[str]]:
+    """Names grouped by the models that take them, in order of first appearance;
+    names no offered model takes are left out."""
+    groups: dict[tuple[str, ...], list[str]] = {}
+    for name, models in users.items():
+        if models:
+            groups.setdefault(tuple(models), []).append(name)
+    return groups
+
+
+def _cars(models) -> str:
+    """``'quarter and nonlinear car'``: models in a sentence."""
+    return " and ".join(models) + " car"
 
 
 def _add_road(parser: argparse.ArgumentParser) -> None:
-    """One option per road parameter, read from the road kinds' fields."""
-
+    """One option per road parameter, read from the road kinds' fields: the same
+    options for every model."""
+    roads = [
+        f"; the {name} car's: {road_from_mapping(entry.defaults.road or {}).describe()}"
+        for name, entry in MODELS.items()
+        if entry.defaults.road
+    ]
     group = parser.add_argument_group(
-        "road input (default: none, the free response from --x0)",
+        "road input, the same options for every model (default: none, the free response "
+        "from --x0" + "".join(roads) + ")",
         "Each road parameter defaults to its function's default in qc_control.ride.road, except "
-        "the speed, whose one default serves both bump and iso8608.",
+        "the speed, whose one default serves both bump and iso8608, and the parameters of a "
+        "model's own default road, which a road of the same kind takes when not given.",
     )
     group.add_argument(
         "--road",
@@ -147,6 +200,8 @@ def _add_road(parser: argparse.ArgumentParser) -> None:
             metavar=metavars.get(f.metadata["check"], "X"),
             help=f"{f.metadata['help']}{unit} (default: {defaults})",
         )
+    for alias in _BUMP_ALIASES:  # deprecated: listed nowhere, still read
+        group.add_argument(option_name(alias), type=float, help=argparse.SUPPRESS)
 
 
 def _parse(option: ModelOption) -> Callable[[str], Any]:
@@ -162,40 +217,36 @@ def _parse(option: ModelOption) -> Callable[[str], Any]:
     return read
 
 
-def _add_model_options(parser: argparse.ArgumentParser, shown: str) -> None:
-    """Each registered model's own options (`ModelOption`), listed for the ``shown`` model."""
-    entry = get_model(shown)
-    group = parser.add_argument_group(
-        f"the {shown} car's options",
-        "Default run: " + _default_run(shown),
-    )
-    added: set[str] = set()
-    for option in (o for e in MODELS.values() for o in e.options):
-        if option.name in added:
-            continue
-        added.add(option.name)
-        help = option.help if entry.option(option.name) is not None else argparse.SUPPRESS
-        if isinstance(option.default, bool):
-            group.add_argument(
-                option_flag(option.name, option.default),
-                dest=option.name,
-                action="store_false" if option.default else "store_true",
-                default=None,
-                help=help if help is argparse.SUPPRESS else f"not: {help}",
-            )
-            continue
-        group.add_argument(
-            option_name(option.name),
-            type=str if option.parse is None else _parse(option),
-            metavar=option.metavar,
-            help=help if help is argparse.SUPPRESS else f"{help} (default {option.default})",
+def _add_model_options(parser: argparse.ArgumentParser) -> None:
+    """Each registered model's own options (`ModelOption`), one group per set of
+    models that takes them, with each model's default run."""
+    users: dict[str, list[str]] = {}
+    found: dict[str, ModelOption] = {}
+    for entry in MODELS.values():
+        for option in entry.options:
+            users.setdefault(option.name, []).append(entry.name)
+            found.setdefault(option.name, option)
+    for models, names in _by_models(users).items():
+        group = parser.add_argument_group(
+            f"the {_cars(models)}'s options",
+            "; ".join(f"{m} car's default run: {_default_run(m)}" for m in models),
         )
-    group.add_argument(
-        "--bump-height", type=float, metavar="M", help="the bump's height [m], as --road-height"
-    )
-    group.add_argument(
-        "--bump-length", type=float, metavar="M", help="the bump's length [m], as --road-length"
-    )
+        for option in (found[n] for n in names):
+            if isinstance(option.default, bool):
+                group.add_argument(
+                    option_flag(option.name, option.default),
+                    dest=option.name,
+                    action="store_false" if option.default else "store_true",
+                    default=None,
+                    help=f"not: {option.help}",
+                )
+                continue
+            group.add_argument(
+                option_name(option.name),
+                type=str if option.parse is None else _parse(option),
+                metavar=option.metavar,
+                help=f"{option.help} (default {option.default})",
+            )
 
 
 def _default_run(name: str) -> str:
@@ -216,8 +267,9 @@ def build_parser(model: str | None = None) -> argparse.ArgumentParser:
     Parameters
     ----------
     model : str, optional
-        The model whose parameters and options ``--help`` lists (default
-        the quarter car); every registered model's are parsed regardless.
+        The model whose default run and state order ``report --help`` states
+        (default the quarter car); every model's parameters and options are
+        listed, grouped by the models that take them.
     """
     shown = model if model in MODELS else DEFAULT_MODEL
     parser = _Parser(
@@ -234,7 +286,7 @@ def build_parser(model: str | None = None) -> argparse.ArgumentParser:
     modes = sub.add_parser(
         "modes", help="print the modal table (frequencies, damping, shapes)", allow_abbrev=False
     )
-    _add_vehicle(modes, shown)
+    _add_vehicle(modes, tuple(MODELS))
     modes.set_defaults(run=_cmd_modes)
     _add_report(sub, shown)
     _add_control_report(sub, shown)
@@ -249,7 +301,7 @@ def _add_report(sub, shown: str) -> None:
         help="compare the methods against the exact response and write the report",
         allow_abbrev=False,
     )
-    _add_vehicle(report, shown)
+    _add_vehicle(report, tuple(MODELS))
     sc = report.add_argument_group(f"scenario (the {shown} car's default: {_default_run(shown)})")
     sc.add_argument(
         "--h",
@@ -288,7 +340,7 @@ def _add_report(sub, shown: str) -> None:
         help="refuse a run of more than N steps t_end/h per method (default 100000)",
     )
     _add_road(report)
-    _add_model_options(report, shown)
+    _add_model_options(report)
     report.add_argument(
         "--out",
         default="report",
@@ -320,7 +372,7 @@ def _add_control_report(sub, shown: str) -> None:
         "write the report",
         allow_abbrev=False,
     )
-    _add_vehicle(ctl, shown)
+    _add_vehicle(ctl, _CONTROL_MODELS, "compares controllers on")
     ctl.add_argument(
         "--designs",
         metavar="A,B,...",
@@ -335,57 +387,85 @@ def _add_control_report(sub, shown: str) -> None:
 
 
 def scenario_from_args(args: argparse.Namespace):
-    """The `qc_control.Scenario` of parsed arguments: ``--config``, then the options over it."""
+    """The `qc_control.Scenario` of parsed arguments: ``--config``, then the options over it.
+
+    ``report`` reads the whole config; the other commands run no scenario and
+    read only its vehicle (`vehicle_config`), so that a report's
+    ``scenario.toml`` serves them too and its run's keys cannot be refused there.
+    """
     doc: dict = {
         key: getattr(args, key) for key in vehicle_keys() if getattr(args, key, None) is not None
     }
     run = {k: getattr(args, k) for k in run_keys() if getattr(args, k, None) is not None}
-    road = {"kind": args.road_kind} if getattr(args, "road_kind", None) is not None else {}
-    for cls in ROADS.values():
-        for f in fields(cls):
-            value = getattr(args, f"road_{f.name}", None)
-            if value is not None:
-                road[f.name] = value
-    for alias, name in _BUMP_ALIASES.items():
-        value = getattr(args, alias, None)
-        if value is None:
-            continue
-        option = "--" + alias.replace("_", "-")
-        if name in road:
-            raise UsageError(f"{option} and --road-{name} are the same value: give one")
-        if road.get("kind", "bump") != "bump":
-            raise UsageError(f"{option} applies to a bump road, not --road {road['kind']}")
-        road[name] = value
-        road.setdefault("kind", "bump")
+    road, spelled = _road_options(args)
     if road:
         run["road"] = road
     if run:
         doc["scenario"] = run
     try:
-        if args.config:
+        if not args.config:
+            return Scenario.from_mapping({}, overrides=doc)
+        if getattr(args, "command", "report") == "report":
             return Scenario.from_toml(args.config, overrides=doc)
-        return Scenario.from_mapping({}, overrides=doc)
+        config = vehicle_config(args.config)
+        return Scenario.from_mapping(config, overrides=doc, source=str(args.config))
     except ScenarioError as exc:
-        raise UsageError(_in_options(exc, doc)) from None
+        raise UsageError(_in_options(exc, doc, spelled)) from None
 
 
-def _in_options(exc, doc: dict) -> str:
-    """The error in the words of the command line: '--h must be ...' for a bad --h."""
+def _road_options(args: argparse.Namespace) -> tuple[dict[str, Any], dict[str, str]]:
+    """The road of the options, and the option each road key was given by.
+
+    The deprecated ``--bump-height`` and ``--bump-length`` are read as
+    ``--road-height`` and ``--road-length`` of a bump road, with a
+    `DeprecationWarning` naming the new spelling.
+    """
+    road = {"kind": args.road_kind} if getattr(args, "road_kind", None) is not None else {}
+    spelled = {"kind": "--road"} if road else {}
+    for cls in ROADS.values():
+        for f in fields(cls):
+            value = getattr(args, f"road_{f.name}", None)
+            if value is not None:
+                road[f.name] = value
+                spelled[f.name] = road_option(f)
+    for alias, name in _BUMP_ALIASES.items():
+        value = getattr(args, alias, None)
+        if value is None:
+            continue
+        option, new = option_name(alias), option_name(f"road_{name}")
+        if name in road:
+            raise UsageError(f"{option} and {new} are the same value: give one")
+        if road.get("kind", "bump") != "bump":
+            raise UsageError(f"{option} applies to a bump road, not --road {road['kind']}")
+        warnings.warn(
+            f"{option} is deprecated and will be removed in the next release: use {new} "
+            "(with --road bump; the nonlinear car's road is a bump by default)",
+            DeprecationWarning,
+            stacklevel=outside_level(),
+        )
+        road[name] = value
+        road.setdefault("kind", "bump")
+        spelled[name] = option
+    return road, spelled
+
+
+def _in_options(exc, doc: dict, spelled: Mapping[str, str]) -> str:
+    """The error in the words of the command line: '--h must be ...' for a bad --h.
+
+    ``spelled`` holds the option each road key was given by (``--bump-height``
+    for ``height`` when the user wrote that).
+    """
 
     key, section = exc.key, exc.section
     run = doc.get("scenario", {})
+    if exc.source is not None:  # a value of the config file: its TOML key names it
+        return str(exc)
     if section is None and key in doc and key != "scenario":
-        option = f"--{key}"
+        option = option_name(key)
     elif section == "scenario" and key in run:
         option = _run_option(key)
-    elif section == "scenario.road" and key in run.get("road", {}):
-        option = (
-            "--road"
-            if key == "kind"
-            else next(
-                road_option(f) for cls in ROADS.values() for f in fields(cls) if f.name == key
-            )
-        )
+    elif section == "scenario.road" and key in spelled:
+        option = spelled[key]
     else:
         return str(exc)
     for lead in (f"{key} = ", f"{key}: ", f"{key} "):
@@ -556,11 +636,14 @@ def _control_command(args, designs: list[str]) -> str:
 
 
 def _cmd_control_report(args) -> int:
-    params = scenario_from_args(args).vehicle
-    if not isinstance(params, QuarterCarParams):
+    scenario = scenario_from_args(args)
+    params = scenario.vehicle
+    if scenario.model not in _CONTROL_MODELS or not isinstance(params, QuarterCarParams):
+        # --model offers the quarter car only; another model comes from the config file
         raise UsageError(
-            f"control-report compares controllers on the quarter car only, got --model "
-            f"{args.model}; the half and full car take the passive tools (report, modes)"
+            f"config file {args.config!r}: [scenario] model = {scenario.model!r}: "
+            f"control-report compares controllers on the quarter car only; the "
+            f"{scenario.model} car takes the passive tools (report, modes)"
         )
     designs = _designs(args.designs)
     out = _check_out(args.out)

@@ -39,8 +39,10 @@ lift-off case: a 1 − cos bump 20 cm high and 8 m long at 20 m/s, met at
 `NONLINEAR_H`); the road is then a function of time (a closed form at
 every stage), except an ISO 8608 road, which is sampled.
 
-The flat keys of earlier versions, ``road = "iso8608"``, ``road_class``,
-``speed`` and ``seed`` in ``[scenario]``, are still read.
+The flat keys of earlier versions in ``[scenario]`` (``road = "iso8608"``,
+``road_class``, ``speed``, ``seed``, and the nonlinear car's ``bump_height``
+and ``bump_length``) are read for one more release, each with a
+``DeprecationWarning`` naming its key in ``[scenario.road]``.
 """
 
 from __future__ import annotations
@@ -52,6 +54,7 @@ import math
 import re
 import shlex
 import sys
+import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -105,6 +108,7 @@ __all__ = [
     "run_keys",
     "option_name",
     "option_flag",
+    "vehicle_config",
 ]
 
 #: The default limit on ``t_end / h``, the steps each method takes at h. The
@@ -427,6 +431,8 @@ def run_keys() -> tuple[str, ...]:
 
 #: The flat road keys of the ``[scenario]`` table of earlier versions.
 _LEGACY_ROAD_KEYS = ("road", "road_class", "speed", "seed")
+#: The nonlinear car's bump keys of earlier versions in ``[scenario]``: a bump road's keys.
+_LEGACY_BUMP_KEYS = {"bump_height": "height", "bump_length": "length"}
 
 
 def _model_name(model, vehicle) -> str:
@@ -648,6 +654,7 @@ class Scenario:
 
     def __post_init__(self):
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
+        given_end = self.t_end is not None  # a grid error is then t_end's, else h's
         self._kind()
         put("model", _model_name(self.model, self.vehicle))
         put("vehicle", _vehicle(self.vehicle, self.model))
@@ -669,7 +676,7 @@ class Scenario:
                 f"max_steps must be an integer >= 2, got {m!r}", "scenario", "max_steps"
             )
         put("max_steps", int(m))
-        self._check_grid(chosen)
+        self._check_grid(chosen, given_end)
         if self.h > limit * (1 + 1e-12):
             raise ScenarioError(
                 f"h = {self.h!r} s is too coarse for {road.sampled()}: it must be <= "
@@ -852,26 +859,43 @@ class Scenario:
             )
         return canonical
 
-    def _check_grid(self, chosen: bool) -> None:
+    def _check_grid(self, chosen: bool, given_end: bool) -> None:
+        """Refuse a grid beyond ``max_steps`` or one that is not whole steps.
+
+        The error is the key the caller gave: ``t_end``, or ``h`` when only the
+        step was given (its end time the default), so that a message about a
+        given ``--h`` does not name a ``t_end`` nobody wrote.
+        """
         t_end, h, limit = self.t_end, self.h, self.max_steps
+        key = "h" if not chosen and not given_end else "t_end"
         ratio = t_end / h
         if not ratio <= limit + 0.5:
             count = f"{ratio:.3g}" if math.isfinite(ratio) else "more than 1.8e308"
+            grid = (
+                f"h = {h!r} s over the default end time {t_end:g} s"
+                if key == "h"
+                else f"t_end = {t_end:g} s at h = {h:g} s"
+            )
             raise ScenarioError(
-                f"t_end = {t_end:g} s at h = {h:g} s is {count} steps per method (and more "
-                f"for the refinements h/2, h/4, ...), above max_steps = {limit:,}; raise "
-                f"max_steps (--max-steps) only if the machine can hold such a run",
+                f"{grid} is {count} steps per method (and more for the refinements h/2, h/4, "
+                f"...), above max_steps = {limit:,}; raise max_steps (--max-steps) only if the "
+                f"machine can hold such a run",
                 "scenario",
-                "t_end",
+                key,
             )
         steps = round(ratio)
         if steps < 2 or abs(steps * h - t_end) > 1e-9 * t_end:
+            grid = (
+                f"h = {h!r} s does not fit the default end time {t_end!r} s: the end time"
+                if key == "h"
+                else f"t_end = {t_end!r} s"
+            )
             raise ScenarioError(
-                f"t_end = {t_end!r} s must be a whole number (at least 2) of steps "
+                f"{grid} must be a whole number (at least 2) of steps "
                 f"h = {h!r} s, got {ratio:.6g} steps"
                 + (" (the default step; give h to choose another)" if chosen else ""),
                 "scenario",
-                "t_end",
+                key,
             )
 
     def _x0(self, x0) -> tuple[float, ...]:
@@ -1025,7 +1049,7 @@ class Scenario:
         """
         over = _canonical(overrides or {})
         try:
-            base = _canonical(values)
+            base = _canonical(values, source)
         except ScenarioError as exc:
             raise ScenarioError(exc.detail, exc.section, exc.key, source) from None
         vehicle = dict(base["vehicle"])
@@ -1051,12 +1075,14 @@ class Scenario:
             )
         except ScenarioError as exc:
             from_overrides = exc.key is not None and exc.key in given.get(exc.section, {})
-            section = exc.section
+            section, key, detail = exc.section, exc.key, exc.detail
             if section == _ROAD_SECTION and not from_overrides:
                 section = base["road_section"]
-            raise ScenarioError(
-                exc.detail, section, exc.key, None if from_overrides else source
-            ) from None
+                written = base["road_keys"].get(key, key)  # as the file spells it
+                if written != key and detail.startswith(f"{key} "):
+                    detail = written + detail[len(key) :]
+                key = written
+            raise ScenarioError(detail, section, key, None if from_overrides else source) from None
 
     @classmethod
     def from_toml(cls, path, *, overrides: Mapping[str, Any] | None = None) -> Scenario:
@@ -1261,8 +1287,12 @@ def _toml_value(value) -> str:
     raise TypeError(f"cannot write {value!r} as TOML")  # pragma: no cover - a bug here
 
 
-def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
-    """``{'vehicle', 'run', 'road', 'road_section'}`` from any supported layout."""
+def _canonical(doc: Mapping[str, Any], source: str | None = None) -> dict[str, Any]:
+    """``{'vehicle', 'run', 'road', 'road_section', 'road_keys'}`` from any supported layout.
+
+    ``road_keys`` maps a road key to the key the document wrote it as (the
+    deprecated ``bump_height`` for ``height``), so that an error names it.
+    """
     if not isinstance(doc, Mapping):
         raise ScenarioError(f"a scenario must be a table (a mapping), got {doc!r}")
     vehicle, table = {}, {}
@@ -1283,7 +1313,7 @@ def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
                 key,
             )
     road, section = table.pop("road", None), _ROAD_SECTION
-    legacy = {k: table.pop(k) for k in _LEGACY_ROAD_KEYS[1:] if k in table}
+    legacy = {k: table.pop(k) for k in (*_LEGACY_ROAD_KEYS[1:], *_LEGACY_BUMP_KEYS) if k in table}
     unknown = sorted(set(table) - set(run_keys()))
     if unknown:
         raise ScenarioError(
@@ -1292,15 +1322,12 @@ def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
             None,
             unknown[0],
         )
+    _warn_legacy(road, legacy, source)
+    road_keys = {_LEGACY_BUMP_KEYS.get(k, k): k for k in legacy}
     if isinstance(road, Mapping):
-        if legacy:
-            key = next(iter(legacy))
-            raise ScenarioError(
-                f"{key} beside a [scenario.road] table: put it in the table", "scenario", key
-            )
-        road = dict(road)
+        road = _table_and_bump(dict(road), legacy)
     elif road is None or isinstance(road, str):  # the flat layout of earlier versions
-        road = {**({"kind": road} if road is not None else {}), **legacy}
+        road = _flat_road(road, legacy)
         section = "scenario"
     else:
         raise ScenarioError(
@@ -1308,7 +1335,95 @@ def _canonical(doc: Mapping[str, Any]) -> dict[str, Any]:
             "scenario",
             "road",
         )
-    return {"vehicle": vehicle, "run": table, "road": road, "road_section": section}
+    return {
+        "vehicle": vehicle,
+        "run": table,
+        "road": road,
+        "road_section": section,
+        "road_keys": road_keys,
+    }
+
+
+def _warn_legacy(road, legacy: Mapping[str, Any], source: str | None) -> None:
+    """A `DeprecationWarning` for each flat road key of ``[scenario]``, naming its new place."""
+    where = f"config file {source!r}: " if source else ""
+    written = ({"road": road} if isinstance(road, str) else {}) | dict(legacy)
+    for key, value in written.items():
+        new = {"road": "kind"}.get(key, _LEGACY_BUMP_KEYS.get(key, key))
+        kind = ' (with kind = "bump")' if key in _LEGACY_BUMP_KEYS else ""
+        warnings.warn(
+            f"{where}[scenario] {key} = {value!r} is deprecated and will be removed in the next "
+            f"release: write {new} = {value!r} in a [scenario.road] table{kind}",
+            DeprecationWarning,
+            stacklevel=outside_level(),
+        )
+
+
+def outside_level() -> int:
+    """The ``stacklevel`` of the first caller outside qc_control, for `warnings.warn`
+    called from the function calling this: a deprecation then points at the
+    user's line, however deep in the package the old spelling was read."""
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_globals.get("__name__", "").startswith("qc_control"):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
+def _table_and_bump(road: dict[str, Any], legacy: Mapping[str, Any]) -> dict[str, Any]:
+    """A ``[scenario.road]`` table with the deprecated bump keys beside it merged in;
+    any other flat road key beside a table is refused."""
+    for key, value in legacy.items():
+        name = _LEGACY_BUMP_KEYS.get(key)
+        if name is None:
+            raise ScenarioError(
+                f"{key} beside a [scenario.road] table: put it in the table", "scenario", key
+            )
+        if name in road:
+            raise ScenarioError(
+                f"{key} and [scenario.road] {name} are the same value: give one", "scenario", key
+            )
+        _bump_only(key, road)
+        road[name] = value
+    return road
+
+
+def _flat_road(kind: str | None, legacy: Mapping[str, Any]) -> dict[str, Any]:
+    """The road of the flat layout: ``road = KIND`` and its keys in ``[scenario]``;
+    ``bump_height`` and ``bump_length`` make it a bump road."""
+    road: dict[str, Any] = {"kind": kind} if kind is not None else {}
+    for key, value in legacy.items():
+        if key in _LEGACY_BUMP_KEYS:
+            _bump_only(key, road)
+            road.setdefault("kind", "bump")
+        road[_LEGACY_BUMP_KEYS.get(key, key)] = value
+    return road
+
+
+def _bump_only(key: str, road: Mapping[str, Any]) -> None:
+    """Refuse a deprecated bump key on a road of another kind."""
+    kind = road.get("kind", "bump")
+    if not isinstance(kind, str) or kind.lower() != "bump":
+        raise ScenarioError(
+            f"{key} applies to a bump road, not to the road of kind {kind!r}", "scenario", key
+        )
+
+
+def vehicle_config(path: str | Path) -> dict[str, Any]:
+    """A config file's vehicle: for commands that run no scenario (``modes``,
+    ``control-report``).
+
+    The top-level parameters and the ``[scenario]`` keys that choose and build
+    the model (``model`` and the models' options, such as ``mount_stiffness``);
+    the run's keys (``t_end``, ``h``, the road, ...) are left out, so that a
+    report's ``scenario.toml`` serves these commands and its run is not
+    checked where it does not apply. Errors name the file.
+    """
+    data = _parse_toml(config_text(path), f"config file {str(path)!r}")
+    table = data.get("scenario")
+    if isinstance(table, Mapping):
+        options = {o.name for e in MODELS.values() for o in e.options}
+        data["scenario"] = {k: v for k, v in table.items() if k == "model" or k in options}
+    return data
 
 
 def config_text(path: str | Path) -> str:
