@@ -100,3 +100,49 @@ def test_a_rear_wheel_delay_that_overflows_names_wheelbase_and_speed():
 def test_a_controller_run_shorter_than_one_step_names_its_duration(key, step):
     with pytest.raises(ValueError, match=rf"{key}=0.001 s is shorter than one {step * 1e3:g} ms"):
         qc.compare_controllers(**{key: 0.001})
+
+
+def test_a_semi_active_dampers_range_follows_the_responses_params():
+    # params={'cmax': ...} in a response is python-control's way to change a
+    # parameter of a system: the damper then saturates at the new cmax, so its
+    # force never exceeds cmax·|vrel| (checked on every sample)
+    car = qc.quarter_car_model(actuator=True, road=True)
+    loop = qc.closed_loop(car, qc.skyhook(2000.0, semi_active="on-off", cmax=3000.0))
+    T = np.linspace(0.0, 1.0, 201)
+    zr = 0.05 * (T > 0.1)
+    wide = qc.input_output_response(loop.system, T, zr)
+    narrow = qc.input_output_response(loop.system, T, zr, params={"cmax": 100.0})
+    labels = list(loop.system.output_labels)
+    states = list(loop.system.state_labels)
+
+    def force_bound(r, cmax):
+        vrel = r.states[states.index("vs")] - r.states[states.index("vu")]
+        return np.abs(r.outputs[labels.index("fa")]) <= cmax * np.abs(vrel) * (1 + 1e-12)
+
+    assert np.all(force_bound(narrow, 100.0)) and np.all(force_bound(wide, 3000.0))
+    assert not np.all(force_bound(wide, 100.0))  # the wide damper does use its range
+
+
+@pytest.mark.parametrize(
+    ("estimator", "words"),
+    [
+        ({"RN": [-1.0, 1e-3]}, "RN .* must be positive"),
+        ({"QN": -1.0}, "QN .* must be positive semi-definite"),
+        ({"outputs": []}, "at least one measured output"),
+    ],
+)
+def test_an_estimator_with_impossible_noise_is_refused(estimator, words):
+    car = qc.quarter_car_model(actuator=True, road=True)
+    with pytest.raises(ValueError, match=words):
+        qc.lqr_controller(car, estimator=estimator)
+
+
+def test_a_controller_named_car_is_refused_by_name():
+    import control
+
+    car = qc.quarter_car_model(actuator=True, road=True)
+    outs = list(car.system.output_labels)
+    law = control.ss([[0.0]], [[0.0] * len(outs)], [[0.0]], [[0.0] * len(outs)],
+                     inputs=outs, outputs=["fa"], name="car")  # fmt: skip
+    with pytest.raises(ValueError, match="controller name 'car'"):
+        qc.closed_loop(car, law)

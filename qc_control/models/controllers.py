@@ -131,6 +131,19 @@ def semi_active_coefficient(f_ideal, vrel, cmin: float, cmax: float, mode: str):
     return np.clip(c, cmin, cmax)
 
 
+def _damping(params, f_ideal, vrel, mode, cmin, cmax):
+    """`semi_active_coefficient` with the range and mode of ``params`` (a
+    response's ``params`` override the law's own, as python-control passes
+    them), the law's own where ``params`` does not name them."""
+    return semi_active_coefficient(
+        f_ideal,
+        vrel,
+        params.get("cmin", cmin),
+        params.get("cmax", cmax),
+        params.get("mode", mode),
+    )
+
+
 def _velocity_law(name: str, gain_vs: float, gain_vu: float, semi_active, cmin, cmax):
     """``fa = gain_vs·vs + gain_vu·vu``, ideal or clipped to a semi-active damper."""
     if semi_active not in SEMI_ACTIVE_MODES:
@@ -148,10 +161,12 @@ def _velocity_law(name: str, gain_vs: float, gain_vu: float, semi_active, cmin, 
     lo, hi = _limits(cmin, cmax)
 
     def output(t, x, u, params):
+        # the damper's range and mode from the system's parameters, so that
+        # params={'cmax': ...} in a response changes the damper it simulates
         vs, vu = u[0], u[1]
         vrel = vs - vu
-        c = semi_active_coefficient(gain_vs * vs + gain_vu * vu, vrel, lo, hi, semi_active)
-        return np.array([-c * vrel])
+        f_ideal = gain_vs * vs + gain_vu * vu
+        return np.array([-_damping(params, f_ideal, vrel, semi_active, lo, hi) * vrel])
 
     return _damper_law(None, output, name, {"cmin": lo, "cmax": hi, "mode": semi_active})
 
@@ -294,8 +309,7 @@ def add_damper(cmin: float, cmax: float, *, sensor_hz: float = 50.0, name: str =
     def output(t, x, u, params):
         acc, vrel = wc * (u[0] - x[0]), u[0] - u[1]
         # on-off toward the force -acc·(anything > 0): cmax when acc·vrel > 0
-        c = semi_active_coefficient(-acc, vrel, lo, hi, "on-off")
-        return np.array([-c * vrel])
+        return np.array([-_damping(params, -acc, vrel, "on-off", lo, hi) * vrel])
 
     params = {"cmin": lo, "cmax": hi, "sensor_hz": float(sensor_hz)}
     return _damper_law(update, output, name, params, states=["acc_filter"])
@@ -403,6 +417,21 @@ def relative_coordinates(car: VehicleModel):
     return labels, T, tr, Az, T @ B[:, [j]]
 
 
+def _check_covariances(QN: np.ndarray, RN: np.ndarray) -> None:
+    """Noise intensities: QN positive semi-definite, RN positive definite
+    (a Kalman filter's assumptions; ``control.lqe`` accepts others and
+    returns a filter with unstable poles)."""
+    if not np.all(np.isfinite(QN)) or np.min(np.linalg.eigvalsh((QN + QN.T) / 2)) < 0:
+        raise ValueError(
+            f"estimator QN (process noise intensity) must be positive semi-definite, "
+            f"got {QN.tolist()}"
+        )
+    if not np.all(np.isfinite(RN)) or np.min(np.diag(RN)) <= 0:
+        raise ValueError(
+            f"estimator RN (sensor noise intensities) must be positive, got {np.diag(RN).tolist()}"
+        )
+
+
 def lqr_controller(
     car: VehicleModel,
     weights: Mapping[str, float] | None = None,
@@ -472,7 +501,12 @@ def lqr_controller(
     est = dict(estimator)
     measured = list(est.pop("outputs", ["susp_travel", "body_acc"]))
     QN = np.atleast_2d(est.pop("QN", ROAD_VELOCITY_INTENSITY))
+    if not measured:
+        raise ValueError(
+            "estimator outputs must name at least one measured output of the car, got []"
+        )
     RN = np.diag(np.atleast_1d(np.asarray(est.pop("RN", _default_rn(measured)), float)))
+    _check_covariances(QN, RN)
     if est:
         raise ValueError(f"unknown estimator option(s) {sorted(est)}; expected outputs, QN, RN")
     rows = [car.output(label) for label in measured]
@@ -791,6 +825,11 @@ def closed_loop(
         raise ValueError(
             f"controller {controller.name!r} must have the one output 'fa', "
             f"has {list(controller.output_labels)}"
+        )
+    if controller.name == "car":  # the interconnection's own name for the car's block
+        raise ValueError(
+            "controller name 'car' is the car's block in the closed loop; name the "
+            "controller otherwise (e.g. controller.copy(name='my_law') or name= when built)"
         )
     measured = list(controller.input_labels)
     plant = _measured_plant(car, measured)
