@@ -146,3 +146,25 @@ def test_a_controller_named_car_is_refused_by_name():
                      inputs=outs, outputs=["fa"], name="car")  # fmt: skip
     with pytest.raises(ValueError, match="controller name 'car'"):
         qc.closed_loop(car, law)
+
+
+@pytest.mark.slow
+def test_a_nonlinear_car_at_rest_reports_without_warnings(tmp_path):
+    # every error is exactly 0 at rest: the log-scaled error figures have no
+    # curve to draw, which must not come out as a warning on the terminal
+    # (run as a user runs it: the command in a process of its own)
+    import os
+    import subprocess
+    import sys
+
+    argv = ["report", "--model", "nonlinear", "--road", "none", "--x0", "0,0,0,0"]
+    argv += ["--t-end", "1", "--out", str(tmp_path / "rest"), "--quiet"]
+    run = subprocess.run(
+        [sys.executable, "-m", "qc_control.cli.console", *argv],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={**os.environ, "MPLBACKEND": "Agg"},
+    )
+    assert run.returncode == 0, run.stderr
+    assert "warning" not in run.stderr, run.stderr

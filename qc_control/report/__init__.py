@@ -23,6 +23,7 @@ import shutil
 import signal
 import tempfile
 import threading
+import warnings
 from collections.abc import Callable
 from importlib.metadata import version
 from pathlib import Path
@@ -838,7 +839,11 @@ def _write(out: Path, title, blocks_of, figures, tables_of, formats, extra, comm
     moved: Path | None = None
     try:
         for spec in figures:
-            spec.make().savefig(tmp / spec.name, dpi=DPI)
+            with warnings.catch_warnings():
+                # errors of exactly 0 (a car at rest, an exact method) have no place
+                # on a log axis: the curve is left out, which is what the figure means
+                warnings.filterwarnings("ignore", "Data has no positive values", UserWarning)
+                spec.make().savefig(tmp / spec.name, dpi=DPI)
         blocks = blocks_of()
         if "md" in formats:
             (tmp / "report.md").write_text(to_markdown(title, blocks), encoding="utf-8")
