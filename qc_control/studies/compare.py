@@ -46,6 +46,7 @@ from ..responses.timeresp import (
 )
 from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
 from .peers import RTOLS, WorkPrecision, check_solvers, work_precision
+from .ride_cost import RideCost
 
 __all__ = [
     "ReferenceBudgetError",
@@ -196,6 +197,10 @@ class MethodComparison(ComparisonProblem):
         With ``solvers``: every run of the work–precision study (the
         fixed-step ladder, the peers and the adaptive pairs over the
         tolerances), `qc_control.studies.peers`.
+    ride_cost : RideCost or None
+        Set by the stiff car's run (`qc_control.studies.ride_cost`): each
+        method's and peer's cheapest setting whose ride metric is within a
+        target of the exact one, with its evaluations and time.
     """
 
     table: pd.DataFrame
@@ -219,6 +224,7 @@ class MethodComparison(ComparisonProblem):
     scenario: Provenance | None = None
     nonlinear: NonlinearStudy | None = None
     peers: WorkPrecision | None = None
+    ride_cost: RideCost | None = None
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""

@@ -55,6 +55,7 @@ __all__ = [
     "work_precision",
     "cheapest",
     "check_solvers",
+    "state_scale",
 ]
 
 #: The peers: scipy's solve_ivp methods and python-control's default call.
@@ -131,6 +132,14 @@ class _Counted:
         if self.calls > self.budget:
             raise _BudgetSpent()
         return self.f(t, x)
+
+
+def state_scale(states) -> np.ndarray:
+    """Each state's scale, ``max_t |x_i(t)|`` over a reference's ``states (n, N)``, for
+    ``atol = rtol · scale``; a state that never moves still needs an atol > 0: the
+    largest state's scale x 1e-6."""
+    scale = np.max(np.abs(np.asarray(states, dtype=float)), axis=1)
+    return np.maximum(scale, 1e-6 * max(float(scale.max()), 1e-12))
 
 
 def _atol(rtol: float, scale: np.ndarray) -> np.ndarray:
@@ -454,10 +463,7 @@ def work_precision(
         Each peer's time is the best of this many runs.
     """
     T = np.asarray(T, dtype=float)
-    states = np.asarray(reference.states, dtype=float).reshape(np.size(X0), -1)
-    # a state that never moves still needs an atol > 0: the largest state's scale x 1e-6
-    scale = np.max(np.abs(states), axis=1)
-    scale = np.maximum(scale, 1e-6 * max(float(scale.max()), 1e-12))
+    scale = state_scale(np.asarray(reference.states, dtype=float).reshape(np.size(X0), -1))
     ref_body = np.asarray(reference.outputs, dtype=float).reshape(sys.noutputs, -1)[body]
     problem = _Problem(sys, T, np.asarray(X0, dtype=float), U, body, ref_body, scale)
     peers, loosest = solver_runs(problem, solvers, rtols, repeats=repeats, progress=progress)
