@@ -34,7 +34,7 @@ _LINES = {"method": "-", "solver": "--", "adaptive": ":"}
 
 
 def peers_figure(cmp, by: str) -> Figure:
-    """Max |body error| against RHS evaluations (``by='evaluations'``) or wall time
+    """The largest absolute body error against RHS evaluations (``by='evaluations'``) or wall time
     (``by='time'``), log-log: each method over its steps, each peer over its tolerances."""
     study = cmp.peers
     runs = study.runs

@@ -371,7 +371,7 @@ class WorkPrecision:
         method at a step h of the convergence ladder; ``'solver'``: a peer
         at a tolerance; ``'adaptive'``: an embedded qc tableau at a
         tolerance), name, rtol, atol [largest per-state value], h [s],
-        error (max |body displacement error| [m]), evaluations (RHS, with
+        error (the largest absolute body-displacement error [m]), evaluations (RHS, with
         Jacobians counted as n each), nfev, njev, time [s], success,
         message, default (python-control's default call).
     reference_name : str

@@ -254,7 +254,7 @@ def stiff_car_ride_cost(cmp: MethodComparison, target: float = RIDE_TARGET, **op
 
 
 def peak_table(cmp: MethodComparison) -> pd.DataFrame:
-    """Peak |body displacement| and |suspension travel| [m] of the reference, of each
+    """The peak absolute body displacement and suspension travel [m] of the reference, of each
     method at h and of each peer's loosest run (``control``: its defaults)."""
     model = cmp.model
     labels = list(cmp.system.output_labels)
