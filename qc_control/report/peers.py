@@ -219,20 +219,11 @@ def ride_cost_blocks(cmp) -> list:
     cost = getattr(cmp, "ride_cost", None)
     if cost is None:
         return []
-    best = cost.cheapest()
-    frame = pd.DataFrame(
-        {
-            "kind": best["kind"],
-            "h [s]": best["h"],
-            "rtol": best["rtol"],
-            "atol": best["atol"],
-            "error [%]": best["error [%]"],
-            "RHS evals": best["evaluations"],
-            "wall time [ms]": 1e3 * best["time"].astype(float),
-            "reached": best["reached"],
-            "runs tried": best["runs"],
-        }
-    )
+    best = cost.cheapest().assign(time=lambda b: 1e3 * b["time"].astype(float))
+    names = {"h": "h [s]", "evaluations": "RHS evals", "time": "wall time [ms]"}
+    names["runs"] = "runs tried"
+    columns = ["kind", "h", "rtol", "atol", "error [%]", "evaluations", "time", "reached", "runs"]
+    frame = best[columns].rename(columns=names)
     return [
         Heading("The cost of a ride answer"),
         Table(

@@ -27,6 +27,7 @@ target is the cheapest on it.
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from collections.abc import Callable, Sequence
@@ -41,19 +42,7 @@ from ..numerics.integrate import DivergenceWarning
 from ..numerics.methods import ButcherTableau
 from ..responses.timeresp import forced_response
 from ..ride.comfort import ride_metrics
-from .peers import (
-    _CONTROL_DEFAULTS,
-    MAX_EVALUATIONS,
-    RTOLS,
-    _check_rtols,
-    _control_run,
-    _derivative,
-    _ivp_run,
-    _outputs_of,
-    _timed,
-    check_solvers,
-    state_scale,
-)
+from . import peers
 
 __all__ = ["RIDE_METRIC", "RIDE_TARGET", "RIDE_HALVINGS", "RideCost", "ride_cost"]
 
@@ -168,7 +157,7 @@ def _fixed_ladder(problem: _RideProblem, tab: ButcherTableau, substeps: int, h: 
                 warnings.simplefilter("ignore", DivergenceWarning)
                 return forced_response(sys, T, U, X0, method=tab, substeps=k)
 
-        resp, seconds = _timed(run, problem.repeats)
+        resp, seconds = peers.best_of(run, problem.repeats)
         value = _metric(resp, problem.model, problem.metric)
         rows.append(
             problem.row("method", tab.name, value, resp.nfev, seconds, resp.success, h=h / 2**level)
@@ -184,10 +173,11 @@ def _adaptive_ladder(problem: _RideProblem, tab: ButcherTableau, rtols, target) 
     rows = []
     for rtol in rtols:
         atol = rtol * problem.scale
-        resp, seconds = _timed(
-            lambda r=rtol, a=atol: forced_response(sys, T, U, X0, method=tab, rtol=r, atol=a),
-            problem.repeats,
-        )
+
+        def run(r: float = rtol, a: np.ndarray = atol):
+            return forced_response(sys, T, U, X0, method=tab, rtol=r, atol=a)
+
+        resp, seconds = peers.best_of(run, problem.repeats)
         value = _metric(resp, problem.model, problem.metric)
         row = problem.row("adaptive", tab.name, value, int(resp.nfev), seconds, resp.success,
                           rtol=rtol, atol=float(np.max(atol)))  # fmt: skip
@@ -200,18 +190,19 @@ def _adaptive_ladder(problem: _RideProblem, tab: ButcherTableau, rtols, target) 
 def _solver_ladder(problem: _RideProblem, solver: str, rtols, target, budget) -> list[dict]:
     """A peer over the tolerances (``'control'`` once, at its defaults) until within ``target``."""
     sys, T, X0, U = problem.model.system, problem.T, problem.X0, problem.U
-    f = _derivative(sys, T, U)
-    ladder = [_CONTROL_DEFAULTS[0]] if solver == "control" else list(rtols)
+    f = peers.peer_derivative(sys, T, U)
+    ladder = [peers.CONTROL_DEFAULTS[0]] if solver == "control" else list(rtols)
     rows = []
+    run: Callable[[], tuple]
     for rtol in ladder:
         if solver == "control":
-            atol = np.full(X0.size, _CONTROL_DEFAULTS[1])
-            run = lambda: _control_run(sys, f, T, X0, budget)  # noqa: E731
+            atol = np.full(X0.size, peers.CONTROL_DEFAULTS[1])
+            run = lambda: peers.control_run(sys, f, T, X0, budget)  # noqa: E731
         else:
             atol = rtol * problem.scale
-            run = lambda r=rtol, a=atol: _ivp_run(solver, f, T, X0, r, a, budget)  # noqa: E731
-        (x, evaluations, _, _, _, ok), seconds = _timed(run, problem.repeats)
-        resp = problem.response(_outputs_of(sys, x, T, U))
+            run = functools.partial(peers.ivp_run, solver, f, T, X0, rtol, atol, budget)
+        (x, evaluations, _, _, _, ok), seconds = peers.best_of(run, problem.repeats)
+        resp = problem.response(peers.outputs_of(sys, x, T, U))
         value = math.nan if resp is None else _metric(resp, problem.model, problem.metric)
         row = problem.row("solver", solver, value, evaluations, seconds, ok, rtol=rtol,
                           atol=float(np.max(atol)))  # fmt: skip
@@ -230,12 +221,12 @@ def ride_cost(
     X0=None,
     h: float | None = None,
     solvers: Sequence[str] = (),
-    rtols: Sequence[float] = RTOLS,
+    rtols: Sequence[float] = peers.RTOLS,
     metric: str = RIDE_METRIC,
     target: float = RIDE_TARGET,
     halvings: int = RIDE_HALVINGS,
     repeats: int = 1,
-    budget: int = MAX_EVALUATIONS,
+    budget: int = peers.MAX_EVALUATIONS,
     progress: Callable[[str], None] | None = None,
 ) -> RideCost:
     """The cheapest setting of each integrator whose ride metric is within ``target`` %.
@@ -281,7 +272,7 @@ def ride_cost(
         raise ValueError(f"target must be a percentage > 0, got {target!r}")
     if isinstance(halvings, bool) or not isinstance(halvings, int) or not 0 <= halvings <= 12:
         raise ValueError(f"halvings must be an integer in 0..12, got {halvings!r}")
-    rtols, peers = _check_rtols(rtols), check_solvers(solvers)
+    rtols, names = peers.check_rtols(rtols), peers.check_solvers(solvers)
     rows: list[dict] = []
     for tab in methods:
         if progress:
@@ -289,7 +280,7 @@ def ride_cost(
         rows += _fixed_ladder(problem, tab, substeps, h, halvings, target)
         if tab.embedded:
             rows += _adaptive_ladder(problem, tab, rtols, target)
-    for solver in peers:
+    for solver in names:
         if progress:
             progress(f"{solver}: rtol from {rtols[0]:g} until {metric} is within {target:g} %")
         rows += _solver_ladder(problem, solver, rtols, target, budget)
@@ -316,5 +307,5 @@ def _ride_problem(model, T, U, X0, h, metric, repeats) -> tuple[_RideProblem, in
     value = _metric(exact, model, metric)
     if not (math.isfinite(value) and value != 0):
         raise ValueError(f"the exact {metric} is {value!r}: no percentage error is defined")
-    problem = _RideProblem(model, T, X0, U, metric, value, state_scale(exact.states), repeats)
+    problem = _RideProblem(model, T, X0, U, metric, value, peers.state_scale(exact.states), repeats)
     return problem, substeps, dt / substeps
