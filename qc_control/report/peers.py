@@ -1,7 +1,8 @@
 """The peers' section of a method comparison: work–precision in evaluations and in time.
 
 Presentation only: every number comes from ``cmp.peers`` (a
-`qc_control.studies.peers.WorkPrecision`). The figures use
+`qc_control.studies.peers.WorkPrecision`) and ``cmp.ride_cost`` (a
+`qc_control.studies.ride_cost.RideCost`). The figures use
 `matplotlib.figure.Figure` directly (no pyplot state, no show()).
 """
 
@@ -17,15 +18,8 @@ from matplotlib.figure import Figure
 from ..studies.scenarios import peak_table
 from .document import Heading, Image, Paragraph, Table, fmt
 
-__all__ = [
-    "peer_figures",
-    "peer_blocks",
-    "peer_tables",
-    "peer_findings",
-    "peers_figure",
-    "ride_cost_blocks",
-    "ride_cost_findings",
-]
+__all__ = ["peer_figures", "peer_blocks", "peer_tables", "peer_findings", "peers_figure"]
+__all__ += ["ride_cost_blocks", "ride_cost_findings"]
 
 #: Marker per kind of run: fixed-step methods (a step ladder), peers and adaptive pairs
 #: (a tolerance ladder).
