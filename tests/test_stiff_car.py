@@ -107,6 +107,8 @@ def test_stiff_scenario_kind_and_the_command_line(tmp_path):
     text = (out / "report.md").read_text(encoding="utf-8")
     assert "The solvers people use" in text and "top mount" in text
     assert (out / "work_precision.csv").exists()
+    # the scenario's run carries the cost of a ride answer within 1 %
+    assert "The cost of a ride answer" in text and (out / "ride_cost.csv").exists()
 
 
 def test_a_bare_mounted_system_is_not_taken_for_the_seed_car():

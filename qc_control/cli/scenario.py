@@ -73,7 +73,7 @@ from ..ride import road as roads
 from ..ride.spectral import ISO8608Road, road_parameter
 from ..studies.compare import DEFAULT_METHODS, MethodComparison, compare_methods
 from ..studies.peers import check_solvers
-from ..studies.scenarios import POTHOLE, STIFF_CAR, stiff_car_methods
+from ..studies.scenarios import POTHOLE, STIFF_CAR, stiff_car_methods, stiff_car_ride_cost
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -1011,6 +1011,8 @@ class Scenario:
             solvers=self.solvers or None,
             **self.option_arguments("compare"),
         )
+        if self.kind == "stiff" and cmp.ride is not None:  # on the road: a ride answer
+            cmp.ride_cost = stiff_car_ride_cost(cmp, progress=progress)
         cmp.scenario = self
         return cmp
 

@@ -1,7 +1,8 @@
 """The peers' section of a method comparison: work–precision in evaluations and in time.
 
 Presentation only: every number comes from ``cmp.peers`` (a
-`qc_control.studies.peers.WorkPrecision`). The figures use
+`qc_control.studies.peers.WorkPrecision`) and ``cmp.ride_cost`` (a
+`qc_control.studies.ride_cost.RideCost`). The figures use
 `matplotlib.figure.Figure` directly (no pyplot state, no show()).
 """
 
@@ -18,6 +19,7 @@ from ..studies.scenarios import peak_table
 from .document import Heading, Image, Paragraph, Table, fmt
 
 __all__ = ["peer_figures", "peer_blocks", "peer_tables", "peer_findings", "peers_figure"]
+__all__ += ["ride_cost_blocks", "ride_cost_findings"]
 
 #: Marker per kind of run: fixed-step methods (a step ladder), peers and adaptive pairs
 #: (a tolerance ladder).
@@ -159,10 +161,84 @@ def _best_table(cmp) -> Table:
     )
 
 
-def peer_blocks(cmp, figs: dict[str, Image]) -> list:
-    """The section: both figures, the cheapest run per name, the findings."""
-    if getattr(cmp, "peers", None) is None:
+def _ride_setting(name: str, row: pd.Series) -> str:
+    """One ride-cost run in words: 'rk4 at h = 0.0003125 s' or 'BDF at rtol 0.001'."""
+    if row["kind"] == "method":
+        return f"{name} at h = {fmt(row['h'])} s"
+    if row["kind"] == "solver" and name == "control":
+        return "python-control's default call"
+    label = f"{name} (step-size control)" if row["kind"] == "adaptive" else name
+    return f"{label} at rtol {fmt(row['rtol'])}"
+
+
+def ride_cost_findings(cmp) -> list[str]:
+    """The cost of each method and peer to bring the ride metric within the target."""
+    cost = getattr(cmp, "ride_cost", None)
+    if cost is None:
         return []
+    best = cost.cheapest()
+    reached = best[best["reached"]].sort_values("evaluations")
+    missed = best[~best["reached"]]
+    metric = cost.metric.split(" [")[0]
+    parts = [
+        f"{_ride_setting(name, row)}: {fmt(row['evaluations'])} evaluations, "
+        f"{fmt(1e3 * row['time'])} ms ({row['error [%]']:+.2g} %)"
+        for name, row in reached.iterrows()
+    ]
+    out = [
+        f"Cost to bring the {metric} within {fmt(cost.target)} % of the exact "
+        f"{fmt(cost.exact)} {cost.metric.split(' ')[-1].strip('[]')}, cheapest first: "
+        + ("; ".join(parts) if parts else "no run reached it")
+        + "."
+    ]
+    if not missed.empty:
+        out.append(
+            "Not within it on their ladders: "
+            + "; ".join(
+                f"{_ride_setting(name, row)} (the last tried"
+                + (
+                    f", {row['error [%]']:+.2g} %)"
+                    if np.isfinite(row["error [%]"])
+                    else ", diverged)"
+                )
+                for name, row in missed.iterrows()
+            )
+            + "."
+        )
+    return out
+
+
+def ride_cost_blocks(cmp) -> list:
+    """The ride-cost table and its findings (with ``cmp.ride_cost``)."""
+    cost = getattr(cmp, "ride_cost", None)
+    if cost is None:
+        return []
+    best = cost.cheapest().assign(time=lambda b: 1e3 * b["time"].astype(float))
+    names = {"h": "h [s]", "evaluations": "RHS evals", "time": "wall time [ms]"}
+    names["runs"] = "runs tried"
+    columns = ["kind", "h", "rtol", "atol", "error [%]", "evaluations", "time", "reached", "runs"]
+    frame = best[columns].rename(columns=names)
+    return [
+        Heading("The cost of a ride answer"),
+        Table(
+            frame,
+            f"The cheapest setting of each method and peer whose {cost.metric} is within "
+            f"{fmt(cost.target)} % of the exact {fmt(cost.exact)} (control.forced_response on "
+            "the same sampled road): each fixed-step method over h, h/2, ... (at most h/64), "
+            "each peer and adaptive pair over rtol 1e-3, 1e-4, ..., stopped at the first "
+            "setting within the target (atol = rtol · max|x_i| per state; python-control's "
+            "default call keeps its own). A linear car's fixed-step time is qc's default "
+            "engine's, which gives the same trajectory as stepping.",
+        ),
+        *(Paragraph(text) for text in ride_cost_findings(cmp)),
+    ]
+
+
+def peer_blocks(cmp, figs: dict[str, Image]) -> list:
+    """The section: both figures, the cheapest run per name, the findings; then the
+    cost of a ride answer when the comparison holds one."""
+    if getattr(cmp, "peers", None) is None:
+        return ride_cost_blocks(cmp)
     return [
         Heading("The solvers people use"),
         Paragraph(
@@ -184,12 +260,14 @@ def peer_blocks(cmp, figs: dict[str, Image]) -> list:
             "its defaults)",
         ),
         *(Paragraph(text) for text in peer_findings(cmp)),
+        *ride_cost_blocks(cmp),
     ]
 
 
 def peer_tables(cmp) -> dict[str, pd.DataFrame]:
-    """The CSV file of the section: every run."""
-    study = getattr(cmp, "peers", None)
-    if study is None:
-        return {}
-    return {"work_precision.csv": study.runs.set_index("name")}
+    """The CSV files of the section: every run, and every run of the ride cost."""
+    study, cost = getattr(cmp, "peers", None), getattr(cmp, "ride_cost", None)
+    tables = {} if study is None else {"work_precision.csv": study.runs.set_index("name")}
+    if cost is not None:
+        tables["ride_cost.csv"] = cost.runs.set_index("name")
+    return tables

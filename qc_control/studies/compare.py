@@ -47,6 +47,7 @@ from ..responses.timeresp import (
 )
 from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
 from .peers import RTOLS, WorkPrecision, check_solvers, work_precision
+from .ride_cost import RideCost
 
 __all__ = [
     "ReferenceBudgetError",
@@ -202,6 +203,10 @@ class MethodComparison(ComparisonProblem):
         On a sampled-data loop: the car between the ticks, whose modes and
         step limits the comparison reports (the controller acts only at the
         ticks); the reference is then `sampled_reference`.
+    ride_cost : RideCost or None
+        Set by the stiff car's run (`qc_control.studies.ride_cost`): each
+        method's and peer's cheapest setting whose ride metric is within a
+        target of the exact one, with its evaluations and time.
     """
 
     table: pd.DataFrame
@@ -226,6 +231,7 @@ class MethodComparison(ComparisonProblem):
     nonlinear: NonlinearStudy | None = None
     peers: WorkPrecision | None = None
     sampled_car: control.StateSpace | None = None
+    ride_cost: RideCost | None = None
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""

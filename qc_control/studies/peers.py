@@ -28,11 +28,13 @@ embedded qc tableau (``tab.embedded``) runs over the same tolerances through
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import control
 import numpy as np
@@ -55,6 +57,7 @@ __all__ = [
     "work_precision",
     "cheapest",
     "check_solvers",
+    "state_scale",
 ]
 
 #: The peers: scipy's solve_ivp methods and python-control's default call.
@@ -66,7 +69,7 @@ PEER_TOLERANCE = 1e-6
 #: solve_ivp methods whose finite-difference Jacobian is evaluated outside ``nfev``.
 _JACOBIAN_APART = ("Radau", "BDF")
 #: python-control's defaults for input_output_response: solve_ivp RK45 at scipy's defaults.
-_CONTROL_DEFAULTS = (1e-3, 1e-6)
+CONTROL_DEFAULTS = (1e-3, 1e-6)
 #: The evaluations one run may spend before it is stopped and recorded as unfinished:
 #: RK45 on the stiff car needs 1.4e5 per 10 s at rtol 1e-6, bounded by stability
 #: not accuracy, so a 60 s road at any rtol is ~1e6; a run far past that is stalled.
@@ -96,7 +99,8 @@ def check_solvers(solvers) -> tuple[str, ...]:
     return tuple(names)
 
 
-def _check_rtols(rtols) -> tuple[float, ...]:
+def check_rtols(rtols) -> tuple[float, ...]:
+    """The tolerance ladder as floats in ``[1e-14, 1)``; ValueError names a bad one."""
     values = tuple(rtols)
     ok = values and all(
         isinstance(r, (int, float)) and not isinstance(r, bool) and 1e-14 <= r < 1 for r in values
@@ -106,7 +110,7 @@ def _check_rtols(rtols) -> tuple[float, ...]:
     return tuple(float(r) for r in values)
 
 
-def _derivative(sys, T, U) -> Callable[[float, np.ndarray], np.ndarray]:
+def peer_derivative(sys, T, U) -> Callable[[float, np.ndarray], np.ndarray]:
     """The state derivative ``f(t, x)`` on the comparison's input, linear between samples."""
     ninputs = sys.ninputs
     u_of_t = linear_input(T, U) if U is not None else (lambda t: np.zeros(ninputs))
@@ -133,13 +137,21 @@ class _Counted:
         return self.f(t, x)
 
 
+def state_scale(states) -> np.ndarray:
+    """Each state's scale, ``max_t |x_i(t)|`` over a reference's ``states (n, N)``, for
+    ``atol = rtol · scale``; a state that never moves still needs an atol > 0: the
+    largest state's scale x 1e-6."""
+    scale = np.max(np.abs(np.asarray(states, dtype=float)), axis=1)
+    return np.maximum(scale, 1e-6 * max(float(scale.max()), 1e-12))
+
+
 def _atol(rtol: float, scale: np.ndarray) -> np.ndarray:
     """``atol = rtol · max|x_i|`` per state, the states' scale read off the reference
     (so a tolerance means the same relative accuracy for a state in m and one in m/s)."""
     return rtol * scale
 
 
-def _ivp_run(solver, f, T, x0, rtol, atol, budget):
+def ivp_run(solver, f, T, x0, rtol, atol, budget):
     """One solve_ivp run: (states on T, evaluations, nfev, njev, message, ok)."""
     counted = _Counted(f, budget)
     try:
@@ -161,7 +173,7 @@ def _ivp_run(solver, f, T, x0, rtol, atol, budget):
     return x, counted.calls, int(sol.nfev), njev, sol.message, bool(sol.success)
 
 
-def _control_run(sys, f, T, x0, budget):
+def control_run(sys, f, T, x0, budget):
     """``control.input_output_response`` at its defaults on the same right-hand side."""
     counted = _Counted(f, budget)
     n = x0.size
@@ -180,7 +192,7 @@ def _control_run(sys, f, T, x0, budget):
     return x, counted.calls, counted.calls, 0, "control.input_output_response defaults", True
 
 
-def _outputs_of(sys, x: np.ndarray | None, T, U) -> np.ndarray | None:
+def outputs_of(sys, x: np.ndarray | None, T, U) -> np.ndarray | None:
     """The outputs ``(noutputs, N)`` along the states ``x (n, N)``: a linear car's ``C x + D u``."""
     if x is None:
         return None
@@ -203,7 +215,7 @@ def _error(y: np.ndarray | None, reference: np.ndarray) -> float:
 class _Problem:
     """What every peer solves: the system, its grid, start and input, and the reference."""
 
-    sys: object
+    sys: Any
     T: np.ndarray
     X0: np.ndarray
     U: np.ndarray | None
@@ -212,14 +224,14 @@ class _Problem:
     scale: np.ndarray  # max |x_i| of the reference per state, for atol
 
 
-def _timed(run: Callable[[], tuple], repeats: int) -> tuple[tuple, float]:
+def best_of(run: Callable[[], Any], repeats: int) -> tuple[Any, float]:
     """The run's result and its best wall time [s] over ``repeats`` runs."""
     best, result = math.inf, None
     for _ in range(max(repeats, 1)):
         start = time.perf_counter()
         result = run()
         best = min(best, time.perf_counter() - start)
-    return result, best  # type: ignore[return-value]
+    return result, best
 
 
 def solver_runs(
@@ -239,23 +251,25 @@ def solver_runs(
     and per peer the outputs ``(noutputs, N)`` of its loosest run (None
     where it did not finish).
     """
-    f = _derivative(problem.sys, problem.T, problem.U)
-    rows, loosest = [], {}
+    f = peer_derivative(problem.sys, problem.T, problem.U)
+    rows: list[dict] = []
+    loosest: dict[str, np.ndarray | None] = {}
+    run: Callable[[], tuple]
     for solver in check_solvers(solvers):
-        ladder = [_CONTROL_DEFAULTS[0]] if solver == "control" else list(_check_rtols(rtols))
+        ladder = [CONTROL_DEFAULTS[0]] if solver == "control" else list(check_rtols(rtols))
         for rtol in ladder:
             if progress:
                 progress(f"{solver}: rtol {rtol:g}")
             if solver == "control":
-                atol = np.full(problem.X0.size, _CONTROL_DEFAULTS[1])
-                run = lambda: _control_run(problem.sys, f, problem.T, problem.X0, budget)  # noqa: E731
+                atol = np.full(problem.X0.size, CONTROL_DEFAULTS[1])
+                run = lambda: control_run(problem.sys, f, problem.T, problem.X0, budget)  # noqa: E731
             else:
                 atol = _atol(rtol, problem.scale)
-                run = lambda s=solver, r=rtol, a=atol: _ivp_run(  # noqa: E731
-                    s, f, problem.T, problem.X0, r, a, budget
+                run = functools.partial(
+                    ivp_run, solver, f, problem.T, problem.X0, rtol, atol, budget
                 )
-            (x, evaluations, nfev, njev, message, ok), seconds = _timed(run, repeats)
-            y = _outputs_of(problem.sys, x, problem.T, problem.U)
+            (x, evaluations, nfev, njev, message, ok), seconds = best_of(run, repeats)
+            y = outputs_of(problem.sys, x, problem.T, problem.U)
             loosest.setdefault(solver, y)
             rows.append(
                 {
@@ -297,7 +311,7 @@ def adaptive_runs(
     for tab in methods:
         if not getattr(tab, "embedded", False):
             continue
-        for rtol in _check_rtols(rtols):
+        for rtol in check_rtols(rtols):
             if progress:
                 progress(f"{tab.name}: rtol {rtol:g} (step-size control)")
             atol = _atol(rtol, problem.scale)
@@ -307,7 +321,7 @@ def adaptive_runs(
                     return initial_response(sys, T, X0, method=tab, rtol=rtol, atol=atol)
                 return forced_response(sys, T, U, X0, method=tab, rtol=rtol, atol=atol)
 
-            resp, seconds = _timed(run, repeats)
+            resp, seconds = best_of(run, repeats)
             y = np.asarray(resp.outputs).reshape(sys.noutputs, -1)[problem.body]
             rows.append(
                 {
@@ -454,10 +468,7 @@ def work_precision(
         Each peer's time is the best of this many runs.
     """
     T = np.asarray(T, dtype=float)
-    states = np.asarray(reference.states, dtype=float).reshape(np.size(X0), -1)
-    # a state that never moves still needs an atol > 0: the largest state's scale x 1e-6
-    scale = np.max(np.abs(states), axis=1)
-    scale = np.maximum(scale, 1e-6 * max(float(scale.max()), 1e-12))
+    scale = state_scale(np.asarray(reference.states, dtype=float).reshape(np.size(X0), -1))
     ref_body = np.asarray(reference.outputs, dtype=float).reshape(sys.noutputs, -1)[body]
     problem = _Problem(sys, T, np.asarray(X0, dtype=float), U, body, ref_body, scale)
     peers, loosest = solver_runs(problem, solvers, rtols, repeats=repeats, progress=progress)
