@@ -58,6 +58,7 @@ import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
+from types import FrameType
 from typing import Any, ClassVar, cast
 
 import control
@@ -721,7 +722,7 @@ class Scenario:
         )
         if self.kind == "stiff":
             options = dict(self.model_options or {})
-            options.setdefault("mount_stiffness", run.mount_stiffness)
+            options.setdefault("mount_stiffness", STIFF_CAR.mount_stiffness)
             put("model_options", options)
             if tuple(self.methods) == DEFAULT_METHODS:
                 put("methods", stiff_car_methods())
@@ -1081,7 +1082,7 @@ class Scenario:
             if section == _ROAD_SECTION and not from_overrides:
                 section = base["road_section"]
                 written = base["road_keys"].get(key, key)  # as the file spells it
-                if written != key and detail.startswith(f"{key} "):
+                if key is not None and written != key and detail.startswith(f"{key} "):
                     detail = written + detail[len(key) :]
                 key = written
             raise ScenarioError(detail, section, key, None if from_overrides else source) from None
@@ -1365,7 +1366,8 @@ def outside_level() -> int:
     """The ``stacklevel`` of the first caller outside qc_control, for `warnings.warn`
     called from the function calling this: a deprecation then points at the
     user's line, however deep in the package the old spelling was read."""
-    frame, level = sys._getframe(1), 1
+    frame: FrameType | None = sys._getframe(1)
+    level = 1
     while frame is not None and frame.f_globals.get("__name__", "").startswith("qc_control"):
         frame, level = frame.f_back, level + 1
     return level

@@ -272,11 +272,11 @@ def _coefficients(method) -> np.ndarray:
     if tab.implicit:
         # R's Taylor series 1 + Σ z^{k+1} bᵀA^k 1 through z^{2s+1}: past the
         # order (at most 2s) by one, enough for the error constant
-        coef, v = [1.0], np.ones(tab.stages)
+        terms, v = [1.0], np.ones(tab.stages)
         for _ in range(2 * tab.stages + 1):
-            coef.append(float(tab.b @ v))
+            terms.append(float(tab.b @ v))
             v = tab.a @ v
-        coef = np.array(coef)
+        coef = np.array(terms)
     else:
         coef = stability_function(method).coef
     coef.flags.writeable = False
@@ -450,10 +450,10 @@ def _step_limit(tab, lam: complex) -> float:
     num, den, _ = _rational(tab)
     width = max(num.size, den.size)
     u = lam / size  # exactly 1j on the axis, so odd powers stay purely imaginary
-    powers = [1.0 + 0j]
+    terms = [1.0 + 0j]
     for _ in range(width - 1):
-        powers.append(powers[-1] * u)
-    powers = np.array(powers)
+        terms.append(terms[-1] * u)
+    powers = np.array(terms)
     p, bound = np.zeros(2 * width - 1), np.zeros(2 * width - 1)
     for poly, sign in ((num, 1.0), (den, -1.0)):
         r = poly * powers[: poly.size]

@@ -395,7 +395,8 @@ class ImplicitSteps:
         self.tab, self.t, self.substeps, self.dt, self.jac = tab, t, substeps, dt, jac
         self.nfev = self.jacobians = self.iterations = 0
         self._J: np.ndarray | None = None  # the Jacobian in use, and its factorisation at _lu_h
-        self._lu, self._lu_h = None, None
+        self._lu: tuple[np.ndarray, np.ndarray] | None = None
+        self._lu_h: float | None = None
         self._c, self._b = tab.c.tolist(), tab.b
         # d = A^-T b when A is safely invertible: the step's end without s more calls of f
         cond = np.linalg.cond(tab.a)
@@ -450,11 +451,14 @@ class ImplicitSteps:
         s, n = self.tab.stages, x.size
         times = [t + h * c for c in self._c]  # stage_times' operations: exact input look-ups
         ha = h * self.tab.a
-        if self._lu_h != h:  # one factorisation per Jacobian and step size
-            self._lu = lu_factor(np.eye(s * n) - np.kron(ha, self._J))
+        J = self._J
+        if J is None:  # _step makes one before the first iteration
+            raise ValueError("the Newton iteration needs a Jacobian: _refresh first")
+        if self._lu is None or self._lu_h != h:  # one factorisation per Jacobian and step size
+            self._lu = lu_factor(np.eye(s * n) - np.kron(ha, J))
             self._lu_h = h
         lu = self._lu
-        Z = np.zeros((s, n), dtype=self._J.dtype)
+        Z = np.zeros((s, n), dtype=J.dtype)
         scale, previous, slowest = float(np.max(np.abs(x), initial=0.0)), math.inf, 0.0
         for k in range(NEWTON_MAXITER):
             F = np.array([f(times[j], x + Z[j]) for j in range(s)])

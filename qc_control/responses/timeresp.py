@@ -1633,7 +1633,7 @@ def _io_static(prob: _IOProblem, grid, at, computed: _Computed) -> _IOTrajectory
 def _io_integrate(sys, prob: _IOProblem, grid, at, n_sub, computed: _Computed, io, u_of_t):
     """Step the states over ``grid``: the fused interconnection, the compiled
     right-hand side or ``sys._rhs``; with events, each kink stepped to exactly."""
-    tab, T, u_samples, x0 = computed.method, prob.T, prob.u_samples, prob.x0
+    tab, T, u_samples, x0 = _method_of(computed), prob.T, prob.u_samples, prob.x0
     if io.opts.adaptive:
         return _io_adaptive(sys, prob, grid, at, computed, io, u_of_t)
     t_events: np.ndarray = np.empty(0)
@@ -1812,7 +1812,7 @@ def _stage_points(rhs, traj: _IOTrajectory, u_of_t, h: float):
     x = traj.x
     finite = np.all(np.isfinite(x), axis=0)
     last = int(np.flatnonzero(finite)[-1]) if np.any(finite) else 0
-    if last < 1 or traj.computed.method.implicit:  # an A-stable method has no limit
+    if last < 1 or _method_of(traj.computed).implicit:  # an A-stable method has no limit
         return None
     after = fastest_changes(x[:, : last + 1])
     starts = np.unique(np.concatenate([after - 1, np.minimum(after, last - 1)]))
@@ -1917,6 +1917,13 @@ def _growth_beyond(rhs, traj: _IOTrajectory, u: np.ndarray, J0: np.ndarray) -> s
     )
 
 
+def _method_of(computed: _Computed) -> ButcherTableau:
+    """The tableau of a stepped run (a difference equation has none)."""
+    if computed.method is None:
+        raise ValueError("this run is a difference equation: no method stepped it")
+    return computed.method
+
+
 def _beyond_stability_along(sys, traj: _IOTrajectory, u: np.ndarray, u_of_t, h) -> str:
     """The warning's words when the step ``h`` exceeds the method's stability
     limit of the Jacobian somewhere along the trajectory, or the state grew
@@ -1926,7 +1933,7 @@ def _beyond_stability_along(sys, traj: _IOTrajectory, u: np.ndarray, u_of_t, h) 
     verdict, `_beyond_stability`); any other system's Jacobian is differenced
     at the points `_check_points` picks (`qc_control.numerics.trajectory_stability`).
     """
-    tab = traj.computed.method
+    tab = _method_of(traj.computed)
     if not h or traj.t.size == 0 or not np.all(np.isfinite(traj.x[:, 0])):
         return ""
     if isinstance(sys, control.StateSpace):

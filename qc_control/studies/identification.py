@@ -660,7 +660,7 @@ def _identify_frequency(measurement, arguments, resolution, band) -> Identificat
     )
     if not solution.success:
         notes.append(f"the optimiser stopped: {solution.message}")
-    covariance = _covariance(len(outs), solution.jac, solution.fun)
+    covariance = _covariance(len(outs), np.asarray(solution.jac), solution.fun)
     result = _result(problem, solution, pinned, notes, covariance=covariance)
     result.transmissibility = estimate
     width = _body_mode_width(result.values)
