@@ -95,3 +95,24 @@ if __name__ == "__main__":
         path = out / f"{name}.csv"
         path.write_text(record(duration, seed), encoding="utf-8", newline="\n")
         print(f"wrote {path} ({path.stat().st_size / 1024:.0f} kB)")
+
+    # %%
+    # The first seconds of the identification record, as the rig's channels say
+    # them: the base plate, the force (opposite sign to the model's fa) and the
+    # suspension travel, with their noise.
+    import matplotlib.pyplot as plt
+
+    rec = qc.Measurement.from_csv(
+        out / "rig_identification.csv",
+        time="time_s",
+        columns={"zr": "base_mm", "fa": "force_N", "susp_travel": "travel_mm"},
+        units={"zr": "mm", "susp_travel": "mm"},
+    )
+    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 6), layout="constrained")
+    shown = rec.t <= 5.0
+    for ax, (label, unit) in zip(axes, [("zr", "m"), ("fa", "N"), ("susp_travel", "m")]):
+        ax.plot(rec.t[shown], rec[label][shown], lw=0.8)
+        ax.set_ylabel(f"{label} [{unit}]")
+    axes[-1].set_xlabel("time [s]")
+    axes[0].set_title("Simulated rig record (not a measurement)")
+    fig.savefig(out / "rig_record.png", dpi=100)
