@@ -168,3 +168,18 @@ def test_a_nonlinear_car_at_rest_reports_without_warnings(tmp_path):
     )
     assert run.returncode == 0, run.stderr
     assert "warning" not in run.stderr, run.stderr
+
+
+@pytest.mark.parametrize(
+    ("method", "events"),
+    [("rk4", lambda t, x: x - 0.5), ("radau3", None)],
+    ids=["events", "implicit"],
+)
+def test_a_run_of_more_steps_than_hours_allow_is_refused_before_it_starts(events, method):
+    # 10 intervals x 1e9 substeps = 1e10 steps: refused at once on the event and
+    # implicit paths, which hold no per-step table for the memory check to count
+    with pytest.raises(ValueError, match=r"10000000000 steps \(substeps = 1000000000 in each of"):
+        qc.integrate(
+            lambda t, x: -x, np.linspace(0.0, 1.0, 11), [1.0], method, substeps=10**9,
+            events=events,
+        )  # fmt: skip

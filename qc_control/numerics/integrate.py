@@ -49,6 +49,10 @@ __all__ = [
 #: every step would cost about as much as a stage; a blow-up is still cut at its
 #: first bad sample). A block's step times and states are held at once.
 STEP_BLOCK = 128
+#: The most steps one `integrate` run takes: at the Python stage loop's few
+#: microseconds a step, 1e9 steps are hours. Past it a run is refused before it
+#: starts (the event and implicit paths hold no per-step table to count).
+MAX_RUN_STEPS = 10**9
 
 #: `uniform_step`'s tolerance, in units of ``eps·max|T|``: a grid point may
 #: sit this far from ``T[0] + k·dt`` and the grid still counts as uniform.
@@ -335,6 +339,17 @@ def check_step_memory(
     )
 
 
+def check_run_steps(intervals: int, substeps: int) -> None:
+    """Refuse a run of more than `MAX_RUN_STEPS` steps before it starts, naming the count."""
+    steps = intervals * substeps
+    if steps > MAX_RUN_STEPS:
+        raise ValueError(
+            f"a run of {steps} steps (substeps = {substeps} in each of {intervals} "
+            f"intervals) is more than one run takes ({MAX_RUN_STEPS:.0e}, hours of "
+            "stepping); use fewer substeps or a larger max_step"
+        )
+
+
 def check_substeps(substeps) -> int:
     """``substeps`` as an int >= 1, or a ValueError naming it."""
     if isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
@@ -482,8 +497,10 @@ def integrate(
             raise TypeError(f"events must be callable as events(t, x), got {show(events)}")
         if x.ndim != 1:
             raise ValueError(f"events need a single initial state of shape (n,), got {x.shape}")
+        check_run_steps(t.size - 1, substeps)  # no per-step table bounds these two paths
         return _integrate_events(f, t, x, tab, substeps, events, jac)
     if tab.implicit:
+        check_run_steps(t.size - 1, substeps)
         implicit = ImplicitSteps(tab, t.tolist(), substeps, uniform_step(t), jac)
 
         def newton_run(x, out, start, stop):
