@@ -22,9 +22,10 @@ files, which are the same to the byte: every random draw is seeded).
 import control
 import numpy as np
 import scipy.signal
+from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.report.outputs import output_folder
+from qc_control.report.outputs import output_folder, show_inline
 
 #: The car the records come from (the answer the identification should find).
 TRUE_CAR = dict(ms=320.0, mu=45.0, ks=22000.0, ku=190000.0, cs=1800.0, cu=150.0)
@@ -100,15 +101,14 @@ if __name__ == "__main__":
     # The first seconds of the identification record, as the rig's channels say
     # them: the base plate, the force (opposite sign to the model's fa) and the
     # suspension travel, with their noise.
-    import matplotlib.pyplot as plt
-
     rec = qc.Measurement.from_csv(
         out / "rig_identification.csv",
         time="time_s",
         columns={"zr": "base_mm", "fa": "force_N", "susp_travel": "travel_mm"},
         units={"zr": "mm", "susp_travel": "mm"},
     )
-    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 6), layout="constrained")
+    fig = Figure(figsize=(7, 6), layout="constrained")
+    axes = fig.subplots(3, 1, sharex=True)
     shown = rec.t <= 5.0
     for ax, (label, unit) in zip(axes, [("zr", "m"), ("fa", "N"), ("susp_travel", "m")]):
         ax.plot(rec.t[shown], rec[label][shown], lw=0.8)
@@ -116,3 +116,4 @@ if __name__ == "__main__":
     axes[-1].set_xlabel("time [s]")
     axes[0].set_title("Simulated rig record (not a measurement)")
     fig.savefig(out / "rig_record.png", dpi=100)
+    show_inline(fig)
