@@ -162,6 +162,22 @@ def docs_build(tmp_path_factory, course_run):
     )
 
 
+def run_example(name: str, out, **env) -> subprocess.CompletedProcess:
+    """``python examples/NAME.py OUT`` in a process of its own, as a user runs
+    it (no plotting window, nothing from the caller's environment but ``env``);
+    the example must succeed."""
+    script = Path(__file__).parent.parent / "examples" / f"{name}.py"
+    run = subprocess.run(
+        [sys.executable, str(script), str(out)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={"MPLBACKEND": "Agg", "PATH": "", **env},
+    )
+    assert run.returncode == 0, run.stderr
+    return run
+
+
 @pytest.fixture
 def seed_params():
     return QuarterCarParams()

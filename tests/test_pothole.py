@@ -6,6 +6,7 @@ The exact peaks are python-control's forced_response on the same samples.
 import control
 import numpy as np
 import pytest
+from conftest import run_example
 
 from qc_control.cli.scenario import Scenario
 from qc_control.models.quarter import quarter_car
@@ -73,19 +74,7 @@ def test_pothole_scenario_kind():
 
 @pytest.mark.slow
 def test_the_example_prints_the_peaks_and_draws_both_figures(tmp_path):
-    import subprocess
-    import sys
-    from pathlib import Path
-
-    script = Path(__file__).parent.parent / "examples" / "pothole.py"
-    out = subprocess.run(
-        [sys.executable, str(script), str(tmp_path)],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        env={"MPLBACKEND": "Agg", "PATH": ""},
-    )
-    assert out.returncode == 0, out.stderr
+    out = run_example("pothole", tmp_path)
     exact = control.forced_response(quarter_car(road=True), T, pothole_road(T), np.zeros(4))
     peak = np.max(np.abs(exact.outputs[0]))
     # printed to 4 decimals in mm: the exact peak, and the default call's 0

@@ -9,6 +9,7 @@ import math
 import control
 import numpy as np
 import pytest
+from conftest import run_example
 
 import qc_control as qc
 from qc_control.cli.parser import run
@@ -121,19 +122,7 @@ def test_a_bare_mounted_system_is_not_taken_for_the_seed_car():
 
 @pytest.mark.slow
 def test_the_example_shows_the_mount_mode(tmp_path):
-    import subprocess
-    import sys
-    from pathlib import Path
-
-    script = Path(__file__).parent.parent / "examples" / "stiff_car.py"
-    out = subprocess.run(
-        [sys.executable, str(script), str(tmp_path)],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        env={"MPLBACKEND": "Agg", "PATH": "", "QC_STIFF_CAR_T_END": "1.0"},
-    )
-    assert out.returncode == 0, out.stderr
+    out = run_example("stiff_car", tmp_path, QC_STIFF_CAR_T_END="1.0")
     fast = min(np.linalg.eigvals(_maxwell_matrix(QuarterCarParams(), 1e7)).real)
     import re
 
