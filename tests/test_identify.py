@@ -41,16 +41,8 @@ def _inputs(duration: float, seed: int):
 def _records(car, t, zr, fa, outputs, noise=0.0, seed=0):
     """The car's outputs by python-control's exact response, at rest at t = 0, plus noise
     of ``noise`` times each output's RMS."""
-    A, B, C, D = quarter_car_abcd(
-        car["ms"],
-        car["mu"],
-        car["ks"],
-        car["ku"],
-        car["cs"],
-        road=True,
-        actuator=True,
-        cu=car["cu"],
-    )
+    car_sys = qc.quarter_car(qc.QuarterCarParams(**car), road=True, actuator=True)
+    A, B, C, D = (np.asarray(m) for m in (car_sys.A, car_sys.B, car_sys.C, car_sys.D))
     labels = ["xs", "xu", "susp_travel", "tire_defl", "body_acc"]
     # the wheel's acceleration from the force balance on the wheel (its own closed form)
     sys = control.ss(A, B, np.vstack([C, np.eye(4)]), np.vstack([D, np.zeros((4, 2))]))
