@@ -132,7 +132,12 @@ def test_reference_of_a_tire_of_1e9():
     ref = nonlinear_reference(car, T, events=True)
     events = assert_matches_hand(ref.x, T, p=p)
     assert events.size >= 2
-    np.testing.assert_allclose(ref.t_events, events, rtol=0, atol=1e-9)
+    # At ku = 1e9 the later contacts graze: the wheel closes on the road at only
+    # 6.5e-4 to 1.5e-3 m/s (measured from the hand solve). Two solves whose states
+    # agree to ~1e-11 m place such a root up to ~1e-11 / 6.5e-4 = 1.5e-8 s apart
+    # (measured 9.5e-9 s on one CPU, 2e-11 s on another); 1e-7 s leaves a margin
+    # of ~6x for that rounding (the first three contacts agree to 2e-11 s).
+    np.testing.assert_allclose(ref.t_events, events, rtol=0, atol=1e-7)
 
 
 def test_two_samples_hold_all_events():
