@@ -57,6 +57,7 @@ __all__ = [
     "check_target",
     "report_lock",
     "write_report",
+    "report_title",
     "write_document",
     "build_blocks",
     "figure_specs",
@@ -71,6 +72,8 @@ __all__ = [
 MARKER = ".qc-control-report"
 FORMATS = ("md", "html", "pdf", "csv")
 TITLE = "Quarter car: fixed-step methods against the exact response"
+#: The vehicle a title names, by its number of wheels (`VehicleModel.corners`).
+_VEHICLES = {1: "Quarter car", 2: "Half car", 4: "Full car"}
 #: The seed paper's figure numbers of its four methods (and their order there).
 SEED_FIGURES = {"euler": 3, "midpoint": 4, "rk4": 5, "heun": 6}
 #: Resolution of the PNG figures (the HTML and the PDF embed them).
@@ -79,6 +82,21 @@ DPI = 150
 
 class ReportError(ValueError):
     """The report cannot be written where it was asked to go."""
+
+
+def report_title(cmp) -> str:
+    """The report's title: the vehicle it ran, and what the methods are measured against.
+
+    A nonlinear run is measured against solve_ivp at tight tolerance, not an
+    exact response; a car closed by a clocked controller is named as such.
+    """
+    model = getattr(cmp, "model", None)
+    vehicle = _VEHICLES.get(len(model.corners), "Vehicle") if model is not None else "Quarter car"
+    if getattr(cmp, "nonlinear", None) is not None:
+        return f"Nonlinear {vehicle.lower()}: fixed-step methods against a solve_ivp reference"
+    if getattr(cmp, "sampled_car", None) is not None:
+        vehicle += " under a sampled-data controller"
+    return f"{vehicle}: fixed-step methods against the exact response"
 
 
 def _body(cmp) -> str:
@@ -322,10 +340,10 @@ def _reproduce(cmp, command: str | None) -> list:
                 "report, holds its whole scenario (vehicle, initial state, road, time "
                 "span, step and methods):"
             ),
-            Code(scenario.command()),
+            Code(scenario.command(), wrap=True),
         ]
     if command:
-        return [Code(command)]
+        return [Code(command, wrap=True)]
     return [
         Paragraph(
             "This report was written from Python without a Scenario, so no command can "
@@ -431,11 +449,14 @@ def _response_blocks(cmp, figs: dict[str, Image]) -> list:
 def _accuracy_blocks(cmp, figs: dict[str, Image]) -> list:
     table = cmp.table
     accuracy = [c for c in table.columns if "err" in c and "freq" not in c and "zeta" not in c]
-    return [
-        Heading("Accuracy"),
-        figs["error.png"],
-        Table(table[accuracy], "Errors against the reference over the whole run"),
-    ]
+    errors = table[accuracy]
+    caption = "Errors against the reference over the whole run"
+    if errors.shape[1] > errors.shape[0]:
+        # one row per error measure, one column per method: a half car's 25
+        # measures read down a page instead of running off it (or off a screen)
+        errors = errors.T.rename_axis("error")
+        caption += ", one row per measure"
+    return [Heading("Accuracy"), figs["error.png"], Table(errors, caption)]
 
 
 def _convergence_blocks(cmp, figs: dict[str, Image]) -> list:
@@ -786,7 +807,7 @@ def write_report(
     scenario = getattr(cmp, "scenario", None)
     return write_document(
         out_dir,
-        TITLE,
+        report_title(cmp),
         lambda: build_blocks(cmp, command),
         figure_specs(cmp),
         lambda: _csv_tables(cmp),
