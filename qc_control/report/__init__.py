@@ -446,17 +446,24 @@ def _response_blocks(cmp, figs: dict[str, Image]) -> list:
     return blocks + [figs[f"method_{_slug(name)}.png"] for name in _method_order(cmp)]
 
 
+def _by_measure(frame: pd.DataFrame, name: str) -> pd.DataFrame:
+    """One row per measure and one column per method, when there are more measures
+    than methods: a half car's 25 error measures then read down the page instead
+    of running off it (or off a 1280 px screen), four or five columns wide."""
+    return frame.T.rename_axis(name) if frame.shape[1] > frame.shape[0] else frame
+
+
 def _accuracy_blocks(cmp, figs: dict[str, Image]) -> list:
     table = cmp.table
     accuracy = [c for c in table.columns if "err" in c and "freq" not in c and "zeta" not in c]
-    errors = table[accuracy]
-    caption = "Errors against the reference over the whole run"
-    if errors.shape[1] > errors.shape[0]:
-        # one row per error measure, one column per method: a half car's 25
-        # measures read down a page instead of running off it (or off a screen)
-        errors = errors.T.rename_axis("error")
-        caption += ", one row per measure"
-    return [Heading("Accuracy"), figs["error.png"], Table(errors, caption)]
+    return [
+        Heading("Accuracy"),
+        figs["error.png"],
+        Table(
+            _by_measure(table[accuracy], "error"),
+            "Errors against the reference over the whole run",
+        ),
+    ]
 
 
 def _convergence_blocks(cmp, figs: dict[str, Image]) -> list:
@@ -529,7 +536,7 @@ def _stability_blocks(cmp, figs: dict[str, Image]) -> list:
         Heading("Stability and numerical modes"),
         figs["stability.png"],
         Table(
-            table[columns],
+            _by_measure(table[columns], "measure"),
             f"Step limit and each mode as the method sees it at h = {fmt(cmp.h)} s "
             "(frequency error of the damped frequency; zeta err = ζ_h − ζ)",
         ),
@@ -545,12 +552,15 @@ def _ride_blocks(cmp, figs: dict[str, Image]) -> list:
         blocks.append(figs["transmissibility.png"])
     return blocks + [
         Table(
-            cmp.ride,
+            _by_measure(cmp.ride, "metric"),
             "Ride metrics of each method and of the exact reference "
             "(ISO 2631-1 Wk weighting; tire load over the static "
             "wheel load (ms + mu)·g)",
         ),
-        Table(cmp.ride_error, "Each method's ride metrics against the reference [%]"),
+        Table(
+            _by_measure(cmp.ride_error, "metric"),
+            "Each method's ride metrics against the reference [%]",
+        ),
     ]
 
 

@@ -115,10 +115,11 @@ def table_cells(frame: pd.DataFrame) -> tuple[list[str], list[list[str]], list[b
     Each column is formatted from its own values (``Series.tolist`` keeps
     each column's dtype), never from ``frame.values``, which upcasts a table
     with one complex column to complex throughout. A column is numeric, and
-    right-aligned, when every value in it is a number.
+    right-aligned, when most values in it are numbers (a method's column of a
+    table with one row per measure holds a "yes" or a mode's name among them).
     """
     columns = [frame.index.tolist()] + [frame.iloc[:, j].tolist() for j in range(frame.shape[1])]
-    numeric = [bool(col) and all(_is_number(v) for v in col) for col in columns]
+    numeric = [2 * sum(_is_number(v) for v in col) > len(col) for col in columns]
     head = [str(frame.index.name or "")] + [str(c) for c in frame.columns]
     body = [[fmt(col[i]) for col in columns] for i in range(len(frame))]
     return head, body, numeric
@@ -174,6 +175,7 @@ pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; white-space: pre; }
 pre.wrap { white-space: pre-wrap; }
 @media (max-width: 48em) {
   figure .scroll img { max-width: none; width: var(--design-width); }
+  td.long { white-space: normal; overflow-wrap: normal; min-width: 10em; }
 }
 @media print { .scroll { overflow: visible; } figure .scroll img { max-width: 100%; } }
 """
@@ -193,6 +195,16 @@ def _anchor(label: str) -> str:
 def _header_cell(text: str) -> str:
     """A column title that may break after '_' (``susp_travel_front``), never mid-word."""
     return html.escape(text).replace("_", "_<wbr>")
+
+
+#: Characters from which a text cell (a description) may wrap on a narrow screen.
+_LONG_TEXT = 24
+
+
+def _cell_class(kind: str, text: str) -> str:
+    """A cell's class: numbers never wrap; a long description may, on a phone."""
+    long = kind == "text" and len(text) >= _LONG_TEXT and " " in text
+    return f' class="{kind} long"' if long else f' class="{kind}"'
 
 
 def _html_table(b: Table, caption: str) -> list[str]:
@@ -216,10 +228,9 @@ def _html_table(b: Table, caption: str) -> list[str]:
         + "".join(f'<th class="{k}">{_header_cell(c)}</th>' for k, c in zip(cls, head))
         + "</tr>"
     )
-    out += [
-        "<tr>" + "".join(f'<td class="{k}">{esc(c)}</td>' for k, c in zip(cls, row)) + "</tr>"
-        for row in body
-    ]
+    for row in body:
+        cells = "".join(f"<td{_cell_class(k, c)}>{esc(c)}</td>" for k, c in zip(cls, row))
+        out.append(f"<tr>{cells}</tr>")
     out.append("</table></div></div>")
     return out
 

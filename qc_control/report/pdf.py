@@ -46,6 +46,7 @@ _MIN_FIGURE_SCALE = 0.8
 _FIGURE_PAD = 0.08 + 0.06 + 10 * _PT  # [in] above the image, above and below its caption
 _SHORT_INTRO = 4  # lines: a paragraph this short introduces what follows it
 _KEEP_CODE = 30  # lines: a matrix this long is never split across pages
+_KEEP_ROWS = 12  # a table this long is never split across pages
 
 
 @dataclass(frozen=True)
@@ -456,8 +457,11 @@ class _Writer:
         head_h = (n_head * 1.25 * bold.size + 2 * _CELL_PAD) * _PT
         cap_font = _Font(_SMALL, style="italic")
         cap_lines = self.m.wrap(caption, cap_font, _WIDTH / _PT) if caption else []
-        # the caption never ends a page without its table's header and first rows
-        p.room(self._start_height(caption, headers, cols, len(body), font, bold))
+        # the caption never ends a page without its table's header and first rows;
+        # a short table is never split (a last row alone under a repeated header)
+        start = self._start_height(caption, headers, cols, len(body), font, bold)
+        whole = start + max(0, len(body) - 3) * row_h
+        p.room(whole if len(body) <= _KEEP_ROWS and whole < _TEXT_H else start)
         for line in cap_lines:
             p.text(_LEFT, p.y, line, cap_font, va="top", color="0.3")
             p.y -= 1.35 * _SMALL * _PT
