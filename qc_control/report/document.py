@@ -14,6 +14,7 @@ from numbers import Integral, Real
 from pathlib import Path
 
 import pandas as pd
+from PIL import Image as PILImage  # matplotlib's own dependency
 
 __all__ = [
     "Heading",
@@ -252,8 +253,6 @@ def _html_figure(b: Image, path: Path | None, caption: str) -> str:
     if path is None:
         img = f'<img src="{esc(b.path)}" alt="{esc(caption_text(b))}">'
     else:
-        from PIL import Image as PILImage  # matplotlib's own dependency
-
         with PILImage.open(path) as png:
             (w, h), dpi = png.size, png.info.get("dpi", (_FIGURE_CSS_PX,))[0]
         design = round(w * _FIGURE_CSS_PX / float(dpi or _FIGURE_CSS_PX))
