@@ -87,8 +87,19 @@ class ReportError(ValueError):
 def report_title(cmp) -> str:
     """The report's title: the vehicle it ran, and what the methods are measured against.
 
-    A nonlinear run is measured against solve_ivp at tight tolerance, not an
-    exact response; a car closed by a clocked controller is named as such.
+    The vehicle is named by its number of wheels (one: quarter, two: half,
+    four: full car). A nonlinear run is measured against solve_ivp at tight
+    tolerance, not an exact response; a car closed by a clocked controller is
+    named as such.
+
+    Parameters
+    ----------
+    cmp : MethodComparison
+
+    Returns
+    -------
+    str
+        For example ``"Half car: fixed-step methods against the exact response"``.
     """
     model = getattr(cmp, "model", None)
     vehicle = _VEHICLES.get(len(model.corners), "Vehicle") if model is not None else "Quarter car"

@@ -7,6 +7,13 @@ and wrapped greedily; tables are drawn as ruled grids, split across pages
 (header repeated) and, when too wide, across column groups (index
 repeated); figures are the report's PNGs, embedded at their own
 resolution. The text stays text: it can be searched and copied.
+
+Pages are filled as a typesetter would: a heading stays with the start of
+its section; a figure that does not fit the rest of a page is drawn a little
+smaller there, or floats to the top of the next page while the text and
+tables of its section fill the space (never past the section's end); a short
+table or matrix is not split. `_render` records each page's decisions
+(`PageRecord`) for the tests.
 """
 
 from __future__ import annotations
