@@ -177,6 +177,7 @@ pre.wrap { white-space: pre-wrap; }
 @media (max-width: 48em) {
   figure .scroll img { max-width: none; width: var(--design-width); }
   td.long { white-space: normal; overflow-wrap: normal; min-width: 10em; }
+  table { font-size: 0.8em; } th, td { padding: 0.2em 0.3em; }
 }
 @media print { .scroll { overflow: visible; } figure .scroll img { max-width: 100%; } }
 """
