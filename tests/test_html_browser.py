@@ -5,7 +5,10 @@ with every request that leaves 127.0.0.1 aborted and recorded. Once it has
 loaded, a script reads the verdict: every image decoded
 (``naturalWidth > 0``), nothing wider than the page
 (``scrollWidth <= clientWidth``), and no resource fetched from anywhere.
-It runs at a laptop's width and at a phone's.
+It runs at a laptop's width and at a phone's. A second script reads the
+layout a lecturer looks at: every table's caption in view, no table or
+matrix scrolling at 1280 px, a matrix's rows never wrapped, and each
+figure's drawn size against its pixels (its text's size on screen).
 
 Chromium comes from Debian (``apt-get install chromium``; Playwright's own
 browser download needs the internet): the fixture installs it when it is
@@ -52,6 +55,37 @@ VERDICT = """() => {
 }"""
 
 
+#: What a reader sees of tables, figures and preformatted blocks.
+LAYOUT = """() => {
+  const view = document.documentElement.clientWidth;
+  const box = r => [Math.round(r.left), Math.round(r.right)];
+  const tables = Array.from(document.querySelectorAll("div.table")).map(d => {
+    const scroll = d.querySelector(".scroll") || d, cap = d.querySelector(".caption, caption");
+    return {id: d.id, caption: cap ? box(cap.getBoundingClientRect()) : null,
+            scrollWidth: scroll.scrollWidth, clientWidth: scroll.clientWidth};
+  });
+  const figures = Array.from(document.querySelectorAll("figure")).map(f => {
+    const img = f.querySelector("img");
+    return {alt: img.alt.slice(0, 40), ratio: img.getBoundingClientRect().width / img.naturalWidth,
+            caption: box(f.querySelector("figcaption").getBoundingClientRect())};
+  });
+  const pres = Array.from(document.querySelectorAll("pre")).map(p => {
+    const style = getComputedStyle(p), code = p.querySelector("code");
+    return {wrap: p.classList.contains("wrap"), whiteSpace: style.whiteSpace,
+            lines: code.textContent.split("\\n").length,
+            drawn: Math.round(code.getBoundingClientRect().height / parseFloat(style.lineHeight)),
+            scrollWidth: p.scrollWidth, clientWidth: p.clientWidth};
+  });
+  return {view, tables, figures, pres};
+}"""
+
+#: The smallest text in a report figure: matplotlib's "small" (8.33 pt) at the
+#: report's 150 dpi is 17.4 px of the PNG. Drawn at `FIGURE_RATIO` of its pixels
+#: or more, it is 10.4 CSS px or more on a phone: legible (the HTML aims at
+#: 96/150 = 0.64, the figure's design size; 0.6 leaves room for rounding).
+FIGURE_RATIO = 0.6
+
+
 def _find_chromium() -> str | None:
     return next((shutil.which(c) for c in CANDIDATES if shutil.which(c)), None)
 
@@ -89,10 +123,11 @@ def _local(url: str) -> bool:
     return parsed.scheme in ("file", "data", "blob") or local_host
 
 
-def check_in_browser(browser, page: Path, tmp: Path, width: int) -> dict:
-    """Open ``page`` alone at ``width`` px with no network; the verdict, and what was blocked."""
+def check_in_browser(browser, page: Path, tmp: Path, width: int, probe: str = VERDICT) -> dict:
+    """Open ``page`` alone at ``width`` px with no network; the verdict (what
+    ``probe`` reads), and what was blocked."""
     folder = tmp / f"alone-{width}"
-    folder.mkdir()
+    folder.mkdir(exist_ok=True)
     alone = folder / page.name
     shutil.copyfile(page, alone)
     blocked: list[str] = []
@@ -109,7 +144,7 @@ def check_in_browser(browser, page: Path, tmp: Path, width: int) -> dict:
         context.route("**/*", only_local)
         tab = context.new_page()
         tab.goto(alone.as_uri(), wait_until="load")
-        verdict = tab.evaluate(VERDICT)
+        verdict = tab.evaluate(probe)
     finally:
         context.close()
     verdict["blocked"] = blocked
@@ -144,6 +179,57 @@ def test_report_html_renders_every_image_and_fits_the_page(browser, road_report,
     assert verdict["blocked"] == []
 
 
+@pytest.fixture(scope="module")
+def half_car_report(tmp_path_factory):
+    """The half car on a bump: the widest tables (25 error measures, 4 wheels'
+    modes, 14 ride metrics) and a 8-state A, as ``qc-control report --model half``."""
+    from qc_control.cli.scenario import Scenario
+
+    cmp = Scenario(model="half", road={"kind": "bump", "speed": 10.0}, t_end=2.0).run()
+    out = tmp_path_factory.mktemp("browser-half") / "report"
+    return write_report(cmp, out, formats=("html",))
+
+
+@pytest.fixture(scope="module", params=["quarter", "half"])
+def report_page(request, road_report, half_car_report) -> Path:
+    return (road_report if request.param == "quarter" else half_car_report) / "report.html"
+
+
+@pytest.mark.parametrize("width", [420, 1280])
+def test_every_caption_is_in_view_and_no_matrix_row_wraps(browser, report_page, tmp_path, width):
+    """The issue's 420 px defects: tables scrolled with their captions cut, and
+    A wrapped mid-row. A table may scroll in its own box; its caption stays put."""
+    seen = check_in_browser(browser, report_page, tmp_path, width, LAYOUT)
+    assert seen["tables"] and seen["pres"]
+    for table in seen["tables"]:
+        left, right = table["caption"]
+        assert 0 <= left and right <= seen["view"], table
+    for figure in seen["figures"]:
+        left, right = figure["caption"]
+        assert 0 <= left and right <= seen["view"], figure
+    for pre in seen["pres"]:
+        if not pre["wrap"]:  # a matrix: one drawn line per line of text, whatever the width
+            assert pre["whiteSpace"] == "pre" and pre["drawn"] == pre["lines"], pre
+
+
+def test_at_1280_px_no_table_or_matrix_scrolls(browser, report_page, tmp_path):
+    """The issue's Table 3 scrolled at 1280 px (1059 px in a 960 px column)."""
+    seen = check_in_browser(browser, report_page, tmp_path, 1280, LAYOUT)
+    for box in seen["tables"] + seen["pres"]:
+        assert box["scrollWidth"] <= box["clientWidth"], box
+
+
+def test_at_420_px_figures_keep_legible_text(browser, report_page, tmp_path):
+    """The issue measured figure text of about 4 px at 420 px (each figure
+    shrunk to 0.25-0.35 of its pixels); each now keeps `FIGURE_RATIO` or more,
+    in a box of its own that scrolls, and the page itself does not."""
+    seen = check_in_browser(browser, report_page, tmp_path, 420, LAYOUT)
+    assert seen["figures"]
+    for figure in seen["figures"]:
+        assert figure["ratio"] >= FIGURE_RATIO, figure
+    assert check_in_browser(browser, report_page, tmp_path, 420)["scrollWidth"] <= 420
+
+
 def _page(folder: Path, body: str) -> Path:
     """A small page with ``body``, written into ``folder``."""
     page = folder / "page.html"
@@ -157,6 +243,23 @@ def test_the_probe_sees_broken_images_and_overflow(browser, tmp_path):
     verdict = check_in_browser(browser, _page(tmp_path, body), tmp_path, 800)
     assert verdict["broken"] == ["missing"]
     assert verdict["scrollWidth"] > verdict["clientWidth"]
+
+
+def test_the_layout_probe_sees_a_cut_caption_and_a_wrapped_matrix(browser, tmp_path):
+    """The layout check is checked: a caption inside a table that scrolls away,
+    and a matrix whose rows wrap, are both seen."""
+    wide = "".join(f"<td>{'9' * 12}</td>" for _ in range(40))
+    body = (
+        '<div class="table"><div class="scroll" style="overflow-x: auto"><table>'
+        f"<caption>{'A long caption ' * 20}</caption><tr>{wide}</tr></table></div></div>"
+        '<pre style="white-space: pre-wrap; line-height: 1.3; width: 100px"><code>'
+        "A =\n  1.000000  2.000000  3.000000  4.000000</code></pre>"
+    )
+    seen = check_in_browser(browser, _page(tmp_path, body), tmp_path, 420, LAYOUT)
+    (table,) = seen["tables"]
+    assert table["caption"][1] > seen["view"] and table["scrollWidth"] > table["clientWidth"]
+    (pre,) = seen["pres"]
+    assert pre["whiteSpace"] != "pre" and pre["drawn"] > pre["lines"]
 
 
 def test_requests_off_the_machine_are_blocked(browser, tmp_path):

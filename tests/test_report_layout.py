@@ -87,3 +87,25 @@ def test_coinciding_methods_are_described_in_words_not_symbols():
     assert "which is rounding" not in text and "T_2" not in text
     assert "identical to the last bit" in text  # Midpoint and Heun: bit for bit on a free response
     assert "x ← (I + hA + (hA)^2/2)·x" in text
+
+
+@pytest.mark.parametrize(
+    "model, title",
+    [
+        ("quarter", "Quarter car: fixed-step methods against the exact response"),
+        ("half", "Half car: fixed-step methods against the exact response"),
+        ("full", "Full car: fixed-step methods against the exact response"),
+        ("nonlinear", "Nonlinear quarter car: fixed-step methods against a solve_ivp reference"),
+    ],
+)
+def test_the_title_names_the_vehicle_and_its_reference(model, title):
+    """The issue: a half-car report was titled "Quarter car"; a nonlinear run,
+    measured against solve_ivp, was said to be against "the exact response"."""
+    from types import SimpleNamespace
+
+    from qc_control.report import report_title
+
+    sc = Scenario(model=model, road={"kind": "bump", "speed": 10.0})
+    vehicle = sc.entry.model(sc.vehicle, road=True)
+    study = object() if model == "nonlinear" else None  # what a nonlinear comparison carries
+    assert report_title(SimpleNamespace(model=vehicle, nonlinear=study)) == title

@@ -57,6 +57,7 @@ __all__ = [
     "check_target",
     "report_lock",
     "write_report",
+    "report_title",
     "write_document",
     "build_blocks",
     "figure_specs",
@@ -71,6 +72,8 @@ __all__ = [
 MARKER = ".qc-control-report"
 FORMATS = ("md", "html", "pdf", "csv")
 TITLE = "Quarter car: fixed-step methods against the exact response"
+#: The vehicle a title names, by its number of wheels (`VehicleModel.corners`).
+_VEHICLES = {1: "Quarter car", 2: "Half car", 4: "Full car"}
 #: The seed paper's figure numbers of its four methods (and their order there).
 SEED_FIGURES = {"euler": 3, "midpoint": 4, "rk4": 5, "heun": 6}
 #: Resolution of the PNG figures (the HTML and the PDF embed them).
@@ -79,6 +82,32 @@ DPI = 150
 
 class ReportError(ValueError):
     """The report cannot be written where it was asked to go."""
+
+
+def report_title(cmp) -> str:
+    """The report's title: the vehicle it ran, and what the methods are measured against.
+
+    The vehicle is named by its number of wheels (one: quarter, two: half,
+    four: full car). A nonlinear run is measured against solve_ivp at tight
+    tolerance, not an exact response; a car closed by a clocked controller is
+    named as such.
+
+    Parameters
+    ----------
+    cmp : MethodComparison
+
+    Returns
+    -------
+    str
+        For example ``"Half car: fixed-step methods against the exact response"``.
+    """
+    model = getattr(cmp, "model", None)
+    vehicle = _VEHICLES.get(len(model.corners), "Vehicle") if model is not None else "Quarter car"
+    if getattr(cmp, "nonlinear", None) is not None:
+        return f"Nonlinear {vehicle.lower()}: fixed-step methods against a solve_ivp reference"
+    if getattr(cmp, "sampled_car", None) is not None:
+        vehicle += " under a sampled-data controller"
+    return f"{vehicle}: fixed-step methods against the exact response"
 
 
 def _body(cmp) -> str:
@@ -322,10 +351,10 @@ def _reproduce(cmp, command: str | None) -> list:
                 "report, holds its whole scenario (vehicle, initial state, road, time "
                 "span, step and methods):"
             ),
-            Code(scenario.command()),
+            Code(scenario.command(), wrap=True),
         ]
     if command:
-        return [Code(command)]
+        return [Code(command, wrap=True)]
     return [
         Paragraph(
             "This report was written from Python without a Scenario, so no command can "
@@ -428,13 +457,23 @@ def _response_blocks(cmp, figs: dict[str, Image]) -> list:
     return blocks + [figs[f"method_{_slug(name)}.png"] for name in _method_order(cmp)]
 
 
+def _by_measure(frame: pd.DataFrame, name: str) -> pd.DataFrame:
+    """One row per measure and one column per method, when there are more measures
+    than methods: a half car's 25 error measures then read down the page instead
+    of running off it (or off a 1280 px screen), four or five columns wide."""
+    return frame.T.rename_axis(name) if frame.shape[1] > frame.shape[0] else frame
+
+
 def _accuracy_blocks(cmp, figs: dict[str, Image]) -> list:
     table = cmp.table
     accuracy = [c for c in table.columns if "err" in c and "freq" not in c and "zeta" not in c]
     return [
         Heading("Accuracy"),
         figs["error.png"],
-        Table(table[accuracy], "Errors against the reference over the whole run"),
+        Table(
+            _by_measure(table[accuracy], "error"),
+            "Errors against the reference over the whole run",
+        ),
     ]
 
 
@@ -508,7 +547,7 @@ def _stability_blocks(cmp, figs: dict[str, Image]) -> list:
         Heading("Stability and numerical modes"),
         figs["stability.png"],
         Table(
-            table[columns],
+            _by_measure(table[columns], "measure"),
             f"Step limit and each mode as the method sees it at h = {fmt(cmp.h)} s "
             "(frequency error of the damped frequency; zeta err = ζ_h − ζ)",
         ),
@@ -524,12 +563,15 @@ def _ride_blocks(cmp, figs: dict[str, Image]) -> list:
         blocks.append(figs["transmissibility.png"])
     return blocks + [
         Table(
-            cmp.ride,
+            _by_measure(cmp.ride, "metric"),
             "Ride metrics of each method and of the exact reference "
             "(ISO 2631-1 Wk weighting; tire load over the static "
             "wheel load (ms + mu)·g)",
         ),
-        Table(cmp.ride_error, "Each method's ride metrics against the reference [%]"),
+        Table(
+            _by_measure(cmp.ride_error, "metric"),
+            "Each method's ride metrics against the reference [%]",
+        ),
     ]
 
 
@@ -786,7 +828,7 @@ def write_report(
     scenario = getattr(cmp, "scenario", None)
     return write_document(
         out_dir,
-        TITLE,
+        report_title(cmp),
         lambda: build_blocks(cmp, command),
         figure_specs(cmp),
         lambda: _csv_tables(cmp),

@@ -182,7 +182,7 @@ def control_blocks(cmp, command: str | None = None) -> list:
         blocks.append(Heading("Notes"))
         blocks += [Paragraph(note) for note in cmp.notes]
     if command:
-        blocks += [Heading("Reproduce"), Code(command)]
+        blocks += [Heading("Reproduce"), Code(command, wrap=True)]
     return blocks
 
 

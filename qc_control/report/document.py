@@ -14,6 +14,7 @@ from numbers import Integral, Real
 from pathlib import Path
 
 import pandas as pd
+from PIL import Image as PILImage  # matplotlib's own dependency
 
 __all__ = [
     "Heading",
@@ -56,7 +57,11 @@ class Image:
 
 @dataclass(frozen=True)
 class Code:
+    """Preformatted text. ``wrap``: a long line may wrap (a command); otherwise
+    never (a matrix, whose rows must stay aligned), and its box scrolls."""
+
     text: str
+    wrap: bool = False
 
 
 #: Integer-valued floats up to this size print in full (30000, not 3e+04).
@@ -111,10 +116,11 @@ def table_cells(frame: pd.DataFrame) -> tuple[list[str], list[list[str]], list[b
     Each column is formatted from its own values (``Series.tolist`` keeps
     each column's dtype), never from ``frame.values``, which upcasts a table
     with one complex column to complex throughout. A column is numeric, and
-    right-aligned, when every value in it is a number.
+    right-aligned, when most values in it are numbers (a method's column of a
+    table with one row per measure holds a "yes" or a mode's name among them).
     """
     columns = [frame.index.tolist()] + [frame.iloc[:, j].tolist() for j in range(frame.shape[1])]
-    numeric = [bool(col) and all(_is_number(v) for v in col) for col in columns]
+    numeric = [2 * sum(_is_number(v) for v in col) > len(col) for col in columns]
     head = [str(frame.index.name or "")] + [str(c) for c in frame.columns]
     body = [[fmt(col[i]) for col in columns] for i in range(len(frame))]
     return head, body, numeric
@@ -147,22 +153,33 @@ def to_markdown(title: str, blocks) -> str:
     return "\n".join(out)
 
 
-# Tables scroll inside their own box on a narrow screen; the page never does.
+# The page itself never scrolls sideways. A table too wide for a phone scrolls
+# inside its own box, below its caption, which stays in view; a matrix scrolls
+# rather than wrap a row. On a narrow screen a figure keeps its design size
+# (`_FIGURE_CSS_PX` per inch of the figure), so its text stays readable, and its
+# box scrolls; on a wide screen it fits the column.
 _CSS = """
 body { font-family: system-ui, sans-serif; max-width: 60em; margin: 2em auto; padding: 0 1em;
        line-height: 1.45; color: #222; overflow-wrap: anywhere; }
-.table { overflow-x: auto; margin: 0.5em 0 1.5em; }
+.table { margin: 0.5em 0 1.5em; }
+.scroll { overflow-x: auto; }
 table { border-collapse: collapse; font-size: 0.85em; }
-th, td { border: 1px solid #ccc; padding: 0.2em 0.5em; vertical-align: top; }
+th, td { border: 1px solid #ccc; padding: 0.2em 0.4em; vertical-align: top; }
 th { background: #f3f3f3; overflow-wrap: normal; }
 td { white-space: nowrap; }
 .num { text-align: right; font-variant-numeric: tabular-nums; }
 .text { text-align: left; }
 figure { margin: 1em 0 2em; } figure img { max-width: 100%; height: auto; }
-figcaption, caption { font-style: italic; color: #555; text-align: left; }
-caption { caption-side: top; padding-bottom: 0.3em; }
+figcaption, .caption { font-style: italic; color: #555; text-align: left; }
+.caption { margin: 0 0 0.3em; }
 pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; white-space: pre; }
-@media print { .table { overflow: visible; } }
+pre.wrap { white-space: pre-wrap; }
+@media (max-width: 48em) {
+  figure .scroll img { max-width: none; width: var(--design-width); }
+  td.long { white-space: normal; overflow-wrap: normal; min-width: 10em; }
+  table { font-size: 0.8em; } th, td { padding: 0.2em 0.3em; }
+}
+@media print { .scroll { overflow: visible; } figure .scroll img { max-width: 100%; } }
 """
 
 
@@ -175,6 +192,78 @@ def _data_uri(path: Path) -> str:
 
 def _anchor(label: str) -> str:
     return label.lower().replace(" ", "-")
+
+
+def _header_cell(text: str) -> str:
+    """A column title that may break after '_' (``susp_travel_front``), never mid-word."""
+    return html.escape(text).replace("_", "_<wbr>")
+
+
+#: Characters from which a text cell (a description) may wrap on a narrow screen.
+_LONG_TEXT = 24
+
+
+def _cell_class(kind: str, text: str) -> str:
+    """A cell's class: numbers never wrap; a long description may, on a phone."""
+    long = kind == "text" and len(text) >= _LONG_TEXT and " " in text
+    return f' class="{kind} long"' if long else f' class="{kind}"'
+
+
+def _html_table(b: Table, caption: str) -> list[str]:
+    """A table below its caption, in a box of its own that scrolls when the table
+    is wider than the screen: the caption stays in view, outside the scrolling box."""
+    head, body, numeric = table_cells(b.frame)
+    cls = ["num" if n else "text" for n in numeric]
+    esc = html.escape
+    ident = _anchor(b.label) if b.label else ""
+    out = [f'<div class="table" id="{ident}">' if ident else '<div class="table">']
+    label = ""
+    if caption and ident:
+        out.append(f'<p class="caption" id="{ident}-caption">{caption}</p>')
+        label = f' aria-labelledby="{ident}-caption"'
+    elif caption:
+        out.append(f'<p class="caption">{caption}</p>')
+    # tabindex: a keyboard user can scroll the box; role and label name it
+    out.append(f'<div class="scroll" role="region" tabindex="0"{label}><table>')
+    out.append(
+        "<tr>"
+        + "".join(f'<th class="{k}">{_header_cell(c)}</th>' for k, c in zip(cls, head))
+        + "</tr>"
+    )
+    for row in body:
+        cells = "".join(f"<td{_cell_class(k, c)}>{esc(c)}</td>" for k, c in zip(cls, row))
+        out.append(f"<tr>{cells}</tr>")
+    out.append("</table></div></div>")
+    return out
+
+
+#: CSS pixels per inch of a figure on a narrow screen: the CSS inch, so a
+#: figure shows at the size it was designed at (10 pt text as 13.3 px).
+_FIGURE_CSS_PX = 96
+
+
+def _html_figure(b: Image, path: Path | None, caption: str) -> str:
+    """A figure in a box that scrolls on a narrow screen, its caption below, outside it.
+
+    With the file at hand, the image is embedded (data URI) and its size
+    stated: the pixel size, and as ``--design-width`` the width it was drawn
+    at, from the PNG's resolution (matplotlib writes ``dpi`` into it).
+    """
+    esc = html.escape
+    ident = f' id="{_anchor(b.label)}"' if b.label else ""
+    if path is None:
+        img = f'<img src="{esc(b.path)}" alt="{esc(caption_text(b))}">'
+    else:
+        with PILImage.open(path) as png:
+            (w, h), dpi = png.size, png.info.get("dpi", (_FIGURE_CSS_PX,))[0]
+        design = round(w * _FIGURE_CSS_PX / float(dpi or _FIGURE_CSS_PX))
+        img = (
+            f'<img src="{esc(_data_uri(path))}" alt="{esc(caption_text(b))}" width="{w}" '
+            f'height="{h}" style="--design-width: {design}px">'
+        )
+    return (
+        f'<figure{ident}><div class="scroll">{img}</div><figcaption>{caption}</figcaption></figure>'
+    )
 
 
 def to_html(title: str, blocks, image_dir=None) -> str:
@@ -214,32 +303,12 @@ def to_html(title: str, blocks, image_dir=None) -> str:
         elif isinstance(b, Paragraph):
             out.append(f"<p>{esc(b.text)}</p>")
         elif isinstance(b, Table):
-            head, body, numeric = table_cells(b.frame)
-            cls = ["num" if n else "text" for n in numeric]
-            ident = f' id="{_anchor(b.label)}"' if b.label else ""
-            out.append(f'<div class="table"{ident}><table>')
-            if b.caption or b.label:
-                out.append(f"<caption>{caption(b)}</caption>")
-            out.append(
-                "<tr>"
-                + "".join(f'<th class="{k}">{esc(c)}</th>' for k, c in zip(cls, head))
-                + "</tr>"
-            )
-            out += [
-                "<tr>"
-                + "".join(f'<td class="{k}">{esc(c)}</td>' for k, c in zip(cls, row))
-                + "</tr>"
-                for row in body
-            ]
-            out.append("</table></div>")
+            out += _html_table(b, caption(b) if b.caption or b.label else "")
         elif isinstance(b, Image):
-            src = _data_uri(Path(image_dir) / b.path) if image_dir is not None else b.path
-            ident = f' id="{_anchor(b.label)}"' if b.label else ""
-            out.append(
-                f'<figure{ident}><img src="{esc(src)}" alt="{esc(caption_text(b))}">'
-                f"<figcaption>{caption(b)}</figcaption></figure>"
-            )
+            path = Path(image_dir) / b.path if image_dir is not None else None
+            out.append(_html_figure(b, path, caption(b)))
         elif isinstance(b, Code):
-            out.append(f"<pre><code>{esc(b.text)}</code></pre>")
+            wrap = ' class="wrap"' if b.wrap else ""
+            out.append(f"<pre{wrap}><code>{esc(b.text)}</code></pre>")
     out += ["</body>", "</html>", ""]
     return "\n".join(out)

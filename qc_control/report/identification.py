@@ -250,7 +250,7 @@ def _blocks(ident: Identification, fitted, held, specs, command) -> list:
     ]
     blocks += [Image(s.name, s.caption, s.label) for s in specs]
     notes = [Heading("Notes"), *map(Paragraph, ident.notes)] if ident.notes else []
-    reproduce = [Heading("Reproduce"), Code(command)] if command else []
+    reproduce = [Heading("Reproduce"), Code(command, wrap=True)] if command else []
     return blocks + notes + reproduce
 
 
