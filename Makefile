@@ -20,24 +20,30 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 .PHONY: report test docs notebook examples check-html bench clean
 
+# uv installs the same packages from the same index in about a quarter of pip's
+# time (the test extras: 23 s against 58-119 s on 2 cores, measured side by side);
+# where uv cannot install (no wheel of it for the platform), pip does the same.
+PIP := $(BIN)/python -m pip install --quiet
+UV  := $(BIN)/python -m uv pip install --python $(BIN)/python --quiet
+
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(PIP) --upgrade pip uv || $(PIP) --upgrade pip
 
 $(STAMP_BASE): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e .
+	$(UV) -e . || $(PIP) -e .
 	touch $@
 
 $(STAMP_TEST): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e '.[test,docs]'
+	$(UV) -e '.[test,docs]' || $(PIP) -e '.[test,docs]'
 	touch $@
 
 $(STAMP_DOCS): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e '.[docs]'
+	$(UV) -e '.[docs]' || $(PIP) -e '.[docs]'
 	touch $@
 
 $(STAMP_NOTEBOOK): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e '.[notebook]'
+	$(UV) -e '.[notebook]' || $(PIP) -e '.[notebook]'
 	touch $@
 
 report: $(STAMP_BASE)

@@ -25,7 +25,15 @@ def commands(target: str) -> str:
 
 
 def installs(text: str) -> list[str]:
-    return re.findall(r"pip install --quiet (-e \S+)", text)
+    """What each install line installs: uv first, and pip the same where uv cannot."""
+    lines = [line for line in text.splitlines() if " install " in line and " -e " in line]
+    found = []
+    for line in lines:
+        by_uv, by_pip = line.split(" || ")
+        assert "-m uv pip install" in by_uv and "-m pip install" in by_pip, line
+        (what,) = set(re.findall(r"--quiet (-e \S+)", line))
+        found.append(what)
+    return found
 
 
 def stamp(text: str) -> str:
