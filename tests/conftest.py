@@ -162,20 +162,33 @@ def docs_build(tmp_path_factory, course_run):
     )
 
 
-def run_example(name: str, out, **env) -> subprocess.CompletedProcess:
-    """``python examples/NAME.py OUT`` in a process of its own, as a user runs
-    it (no plotting window, nothing from the caller's environment but ``env``);
-    the example must succeed."""
-    script = Path(__file__).parent.parent / "examples" / f"{name}.py"
-    run = subprocess.run(
-        [sys.executable, str(script), str(out)],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        env={"MPLBACKEND": "Agg", "PATH": "", **env},
-    )
-    assert run.returncode == 0, run.stderr
-    return run
+def gallery_run(docs_build, name: str) -> tuple[str, Path]:
+    """What example ``name`` printed in the docs build, and the folder it wrote.
+
+    The gallery runs every example once per run of the suite (`docs_build`);
+    a test of an example reads that run rather than running it again.
+    """
+    assert docs_build.returncode == 0, docs_build.stderr[-5000:]
+    page = (docs_build.src / "auto_examples" / f"{name}.rst").read_text(encoding="utf-8")
+    return printed_blocks(page), docs_build.src / "_build" / "gallery_output" / name
+
+
+def printed_blocks(page: str) -> str:
+    """The captured stdout of a gallery page: its output blocks, dedented and joined.
+
+    sphinx-gallery writes each block's stdout under ``.. rst-class::
+    sphx-glr-script-out`` as a ``code-block`` indented by 4 spaces.
+    """
+    lines = []
+    for block in page.split(".. rst-class:: sphx-glr-script-out")[1:]:
+        body = block.split(".. code-block:: none\n", 1)[1].splitlines()[1:]
+        for line in body:
+            if line and not line.startswith("    "):
+                break
+            lines.append(line[4:])
+        while lines and not lines[-1]:
+            lines.pop()
+    return "\n".join(lines) + "\n"
 
 
 @pytest.fixture

@@ -6,7 +6,7 @@ The exact peaks are python-control's forced_response on the same samples.
 import control
 import numpy as np
 import pytest
-from conftest import run_example
+from conftest import gallery_run
 
 from qc_control.cli.scenario import Scenario
 from qc_control.models.quarter import quarter_car
@@ -73,12 +73,13 @@ def test_pothole_scenario_kind():
 
 
 @pytest.mark.slow
-def test_the_example_prints_the_peaks_and_draws_both_figures(tmp_path):
-    out = run_example("pothole", tmp_path)
+@pytest.mark.xdist_group("docs")  # the gallery's run of the example, once per suite
+def test_the_example_prints_the_peaks_and_draws_both_figures(docs_build):
+    stdout, folder = gallery_run(docs_build, "pothole")
     exact = control.forced_response(quarter_car(road=True), T, pothole_road(T), np.zeros(4))
     peak = np.max(np.abs(exact.outputs[0]))
     # printed to 4 decimals in mm: the exact peak, and the default call's 0
-    assert f"reference      {peak * 1e3:.4f} mm" in out.stdout
-    assert "control        0.0000 mm" in out.stdout
-    assert (tmp_path / "pothole_evaluations.png").exists()
-    assert (tmp_path / "pothole_time.png").exists()
+    assert f"reference      {peak * 1e3:.4f} mm" in stdout
+    assert "control        0.0000 mm" in stdout
+    assert (folder / "pothole_evaluations.png").exists()
+    assert (folder / "pothole_time.png").exists()

@@ -3,18 +3,16 @@ from them: remade to the byte by their script, and the car found within 1 %."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
+from conftest import gallery_run
 
 from qc_control.studies.measurement import rig_record
 
 ROOT = Path(__file__).parent.parent
 DATA = ROOT / "qc_control" / "data"
-ENV = {"MPLBACKEND": "Agg", "PATH": ""}
 
 
 def test_shipped_records_are_small_and_say_they_are_simulated():
@@ -29,27 +27,17 @@ def test_shipped_records_are_small_and_say_they_are_simulated():
 
 
 @pytest.mark.slow
-def test_the_script_remakes_the_shipped_records(tmp_path):
-    script = ROOT / "examples" / "make_rig_dataset.py"
-    out = subprocess.run(
-        [sys.executable, str(script), str(tmp_path)], capture_output=True, text=True, env=ENV
-    )
-    assert out.returncode == 0, out.stderr
+@pytest.mark.xdist_group("docs")  # the gallery's run of the script, once per suite
+def test_the_script_remakes_the_shipped_records(docs_build):
+    _, folder = gallery_run(docs_build, "make_rig_dataset")
     for name in ("rig_identification.csv", "rig_validation.csv"):
-        assert (tmp_path / name).read_bytes() == (DATA / name).read_bytes(), name
+        assert (folder / name).read_bytes() == (DATA / name).read_bytes(), name
 
 
 @pytest.mark.slow
-def test_the_example_identifies_the_simulated_car(tmp_path):
-    out_dir = tmp_path / "a" / "rig"
-    run = subprocess.run(
-        [sys.executable, str(ROOT / "examples" / "identify_rig.py"), str(out_dir)],
-        capture_output=True,
-        text=True,
-        env=ENV,
-        timeout=600,
-    )
-    assert run.returncode == 0, run.stderr
+@pytest.mark.xdist_group("docs")  # the gallery's run of the example, once per suite
+def test_the_example_identifies_the_simulated_car(docs_build):
+    _, out_dir = gallery_run(docs_build, "identify_rig")
     table = pd.read_csv(out_dir / "parameters.csv", index_col=0)
     # the car examples/make_rig_dataset.py simulated; 1 % sensor noise on 3001 samples
     # leaves standard errors of 0.03-0.3 %, so 1 % holds with margin

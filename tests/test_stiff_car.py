@@ -9,7 +9,7 @@ import math
 import control
 import numpy as np
 import pytest
-from conftest import run_example
+from conftest import gallery_run
 
 import qc_control as qc
 from qc_control.cli.parser import run
@@ -121,14 +121,15 @@ def test_a_bare_mounted_system_is_not_taken_for_the_seed_car():
 
 
 @pytest.mark.slow
-def test_the_example_shows_the_mount_mode(tmp_path):
-    out = run_example("stiff_car", tmp_path, QC_STIFF_CAR_T_END="1.0")
+@pytest.mark.xdist_group("docs")  # the gallery's run of the example, once per suite
+def test_the_example_shows_the_mount_mode(docs_build):
+    stdout, folder = gallery_run(docs_build, "stiff_car")
     fast = min(np.linalg.eigvals(_maxwell_matrix(QuarterCarParams(), 1e7)).real)
     import re
 
-    printed = float(re.search(r"top mount\s+(-[\d.]+)\+", out.stdout).group(1))
+    printed = float(re.search(r"top mount\s+(-[\d.]+)\+", stdout).group(1))
     assert printed == pytest.approx(fast, abs=1e-4)  # printed to 4 decimals
-    assert (tmp_path / "stiff_evaluations.png").exists()
+    assert (folder / "stiff_evaluations.png").exists() and (folder / "stiff_time.png").exists()
 
 
 @pytest.mark.parametrize("method", ["sdirk2", "radau2", "radau3"])
