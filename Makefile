@@ -55,7 +55,7 @@ test: $(STAMP_TEST)
 	$(BIN)/python -m pytest -q -n auto --dist loadgroup
 
 docs: $(STAMP_DOCS)
-	$(BIN)/sphinx-build -W --keep-going -q -b html docs docs/_build/html
+	$(BIN)/sphinx-build -W --keep-going -q -j auto -b html docs docs/_build/html
 	@echo "open docs/_build/html/index.html"
 
 notebook: $(STAMP_NOTEBOOK)

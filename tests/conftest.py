@@ -150,7 +150,9 @@ def docs_build(tmp_path_factory, course_run):
     nbformat.write(executed, tmp / "examples" / "course.ipynb")
     html = tmp / "docs" / "_build" / "html"
     run = subprocess.run(
-        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html"]
+        # -j auto: the pages and the examples are read and run on every core, which
+        # the rest of the suite leaves idle once it has finished
+        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-j", "auto", "-b", "html"]
         + [str(tmp / "docs"), str(html)],
         capture_output=True,
         text=True,
