@@ -61,6 +61,9 @@ class QuickComparison:
         python-control's exact response on ``T``.
     responses : dict[str, FixedStepResponse]
         Each method's response (cut short where it overflowed).
+    outputs : dict[str, ndarray]
+        Per method, every output on ``T``, shape ``(outputs, T.size)``; ``inf``
+        after a run overflowed (its response stops there).
     errors : dict[str, ndarray]
         Per method, ``|y - y_exact|`` of every output, shape ``(outputs, T.size)``,
         in the outputs' units; ``inf`` after a run overflowed.
@@ -83,6 +86,7 @@ class QuickComparison:
     T: np.ndarray
     reference: control.TimeResponseData
     responses: dict
+    outputs: dict
     errors: dict
     table: pd.DataFrame
     modes: ModalAnalysis
@@ -134,11 +138,9 @@ def quick_comparison(
     modes = modal_analysis(model)
     numerical, stability = mode_errors(tabs, h, sys, modes)
     ref = np.asarray(exact.outputs).reshape(sys.noutputs, -1)
+    outputs = {name: _outputs(r, T.size) for name, r in responses.items()}
     with np.errstate(invalid="ignore", over="ignore"):  # an overflowed run's error is inf
-        errors = {
-            name: np.nan_to_num(np.abs(_outputs(r, T.size) - ref), nan=np.inf)
-            for name, r in responses.items()
-        }
+        errors = {name: np.nan_to_num(np.abs(y - ref), nan=np.inf) for name, y in outputs.items()}
     cost = pd.DataFrame(
         {
             "order": [t.order for t in tabs],
@@ -154,6 +156,7 @@ def quick_comparison(
         T=T,
         reference=exact,
         responses=responses,
+        outputs=outputs,
         errors=errors,
         table=table,
         modes=modes,

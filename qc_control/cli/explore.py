@@ -1,0 +1,614 @@
+"""``qc-control explore``: the course's interactive explorer, a Panel page on the library.
+
+Move the step and watch Euler's response swell and blow up past h_max
+while RK4 holds: the page shows each chosen method's response over
+python-control's exact one, the error against time, the convergence
+figure with the current step marked, the stability regions with every
+mode's ``hλ``, the modal table, each method's numerical frequency and
+damping at h, and the numbers a hand-in asks for. Every number comes from
+the library: `qc_control.studies.quick.quick_comparison` at the current
+step, `qc_control.studies.quick.error_ladder` for the convergence figure,
+`qc_control.numerics.stability.stability_boundary` for the regions, and a
+`Scenario` for the run, its checks (a run over `EXPLORE_MAX_STEPS` steps is
+refused with the command line's message), its TOML and its command.
+
+The figures are Bokeh's (Panel's own), updated in place: a redraw sends
+new columns to the browser, and no image is rendered on the server. Every
+script, style and font is served by the local Panel server: the page needs
+no internet. Panel is imported only here, when the page is made
+(``pip install 'qc-control[explore]'``); the rest of the package does not
+need it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import socket
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from ..models.quarter import QuarterCarParams
+from ..numerics.methods import TABLEAUS
+from ..numerics.stability import stability_boundary
+from ..studies.compare import DEFAULT_METHODS
+from ..studies.quick import QuickComparison, error_ladder, ladder_steps, quick_comparison
+from .scenario import MAX_STEPS, ROADS, Scenario, ScenarioError, road_from_mapping, whole_step
+
+__all__ = ["explorer", "serve", "PRESETS", "EXPLORE_MAX_STEPS", "scenario_of", "ExplorerUnavailable"]
+
+#: The longest run the page accepts, steps t_end/h: about a second of work per
+#: method in the LTI engine; a longer one is refused with the Scenario's message.
+EXPLORE_MAX_STEPS = 1_000_000
+
+#: Named vehicles: the seed's car (Table 1) and illustrative others, for a first look.
+PRESETS: dict[str, dict[str, float]] = {
+    "seed's car (Table 1)": {"ms": 301.2, "mu": 100.0, "ks": 30000.0, "ku": 29530.0, "zeta": 0.25},
+    "seed's car, lightly damped": {
+        "ms": 301.2,
+        "mu": 100.0,
+        "ks": 30000.0,
+        "ku": 29530.0,
+        "zeta": 0.1,
+    },
+    "family car (stiff tire)": {
+        "ms": 400.0,
+        "mu": 45.0,
+        "ks": 22000.0,
+        "ku": 200000.0,
+        "zeta": 0.3,
+    },
+    "sports car": {"ms": 300.0, "mu": 35.0, "ks": 45000.0, "ku": 250000.0, "zeta": 0.4},
+}
+_SEED = next(iter(PRESETS))
+
+#: The fixed window of the stability figure (z = hλ): every explicit tableau's
+#: region fits (RK4 reaches -2.79), and the modes move through it as h grows.
+_REGION_X = (-5.0, 1.0)
+_REGION_Y = (-4.0, 4.0)
+_COLORS = ("#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2")
+
+
+class ExplorerUnavailable(ImportError):
+    """Panel is not installed: ``pip install 'qc-control[explore]'``."""
+
+
+def _panel():
+    """Panel, imported on first use, or a clear error saying which extra installs it."""
+    try:
+        import panel as pn
+    except ImportError:
+        raise ExplorerUnavailable(
+            "qc-control explore needs Panel, which is not installed: "
+            "pip install 'qc-control[explore]'"
+        ) from None
+    return pn
+
+
+def _road_fields() -> dict[str, Any]:
+    """Every road parameter of every kind, once, with the kinds that take it."""
+    found: dict[str, Any] = {}
+    for kind, cls in ROADS.items():
+        for f in dataclasses.fields(cls):
+            if f.name != "band":  # the ISO band: a setting for specialists, left at its default
+                found.setdefault(f.name, (f, []))[1].append(kind)
+    return found
+
+
+def scenario_of(values: dict[str, Any]) -> Scenario:
+    """The `Scenario` of the page's values: the vehicle, start, road, grid and methods.
+
+    ``h`` [ms] is moved to the nearest step that divides ``t_end``
+    (`qc_control.cli.scenario.whole_step`); a run of more than `MAX_STEPS`
+    steps is given ``max_steps = EXPLORE_MAX_STEPS``, so that longer ones are
+    refused with the command line's message. Raises `ScenarioError` for a
+    bad value.
+    """
+    vehicle = {k: float(values[k]) for k in ("ms", "mu", "ks", "ku", "zeta")}
+    kind = values["road"]
+    road = {"kind": kind}
+    for name, (_, kinds) in _road_fields().items():
+        if kind in kinds:
+            road[name] = values[f"road_{name}"]
+    t_end = float(values["t_end"])
+    h = float(values["h"]) * 1e-3
+    if not (np.isfinite(h) and h > 0 and np.isfinite(t_end) and t_end > 0):
+        raise ScenarioError(
+            f"h and t_end must be times > 0, got h = {values['h']!r} ms and t_end = {t_end!r} s",
+            "scenario",
+            "h",
+        )
+    h = whole_step(t_end, h)
+    steps = round(t_end / h)
+    return Scenario(
+        vehicle=QuarterCarParams(**vehicle),
+        road=road_from_mapping(road),
+        x0=tuple(float(values[k]) for k in ("vs0", "vu0", "xs0", "xu0")),
+        t_end=t_end,
+        h=h,
+        methods=tuple(values["methods"]),
+        max_steps=MAX_STEPS if steps <= MAX_STEPS else EXPLORE_MAX_STEPS,
+    )
+
+
+@functools.lru_cache(maxsize=32)
+def _ladder(vehicle, x0, road, t_end: float, methods: tuple[str, ...]) -> pd.DataFrame:
+    """The convergence figure's ladder: it does not depend on h, so it is kept."""
+    sc = Scenario(vehicle=vehicle, x0=x0, road=road, t_end=t_end, h=t_end / 2, methods=methods)
+    model = sc.problem()[0]
+    return error_ladder(
+        model, t_end, sc.x0, lambda T: sc.road_input(T)[0], methods, ladder_steps(t_end)
+    )
+
+
+@functools.lru_cache(maxsize=32)
+def _boundary(method: str) -> list[np.ndarray]:
+    x = np.linspace(*_REGION_X, 301)
+    y = np.linspace(*_REGION_Y, 401)
+    return stability_boundary(method, x, y)
+
+
+# ------------------------------------------------------------------ the page
+
+
+def _figures(pn, methods: list[str]):
+    """The four Bokeh figures and their data sources, one source per method and figure."""
+    from bokeh.models import ColumnDataSource, Legend, Range1d, Span
+    from bokeh.plotting import figure
+
+    tools = "pan,wheel_zoom,box_zoom,reset,save"
+    common = dict(height=300, sizing_mode="stretch_width", tools=tools, output_backend="canvas")
+    response = figure(title="Response", x_axis_label="t [s]", **common)
+    response.y_range = Range1d(-0.06, 0.06)
+    error = figure(title="Error against time", x_axis_label="t [s]", y_axis_type="log", **common)
+    error.y_range = Range1d(1e-16, 1.0)
+    conv = figure(
+        title="Convergence: max body error over the run (current h marked)",
+        x_axis_label="h [s]",
+        y_axis_label="max |xs error| [m]",
+        x_axis_type="log",
+        y_axis_type="log",
+        **common,
+    )
+    conv.y_range = Range1d(1e-15, 10.0)
+    region = figure(
+        title="Stability regions |R(hλ)| ≤ 1, with hλ of each mode",
+        x_axis_label="Re hλ [-]",
+        y_axis_label="Im hλ [-]",
+        match_aspect=True,
+        **common,
+    )
+    region.x_range, region.y_range = Range1d(*_REGION_X), Range1d(*_REGION_Y)
+    sources: dict[str, dict[str, Any]] = {}
+    exact = ColumnDataSource({"t": [], "y": []})
+    response.line("t", "y", source=exact, color="black", line_width=3, alpha=0.5)
+    items = {"response": [("exact (python-control)", [response.renderers[-1]])]}
+    for name in ("response", "error", "conv", "mark", "region"):
+        items.setdefault(name, [])
+    for i, method in enumerate(TABLEAUS):
+        color = _COLORS[i % len(_COLORS)]
+        src = {k: ColumnDataSource({"x": [], "y": []}) for k in ("response", "error", "conv")}
+        src["mark"] = ColumnDataSource({"x": [], "y": []})
+        src["region"] = ColumnDataSource({"xs": [], "ys": []})
+        dash = "solid" if i % 2 == 0 else "dashed"
+        r1 = response.line("x", "y", source=src["response"], color=color, line_dash=dash)
+        r2 = error.line("x", "y", source=src["error"], color=color, line_dash=dash)
+        r3 = conv.line("x", "y", source=src["conv"], color=color, line_dash=dash)
+        conv.scatter("x", "y", source=src["conv"], color=color, size=4)
+        conv.scatter("x", "y", source=src["mark"], color=color, size=12, marker="diamond")
+        r4 = region.multi_line("xs", "ys", source=src["region"], color=color, line_width=2)
+        for key, renderer in (("response", r1), ("error", r2), ("conv", r3), ("region", r4)):
+            items[key].append((method, [renderer]))
+        sources[method] = src
+    points = ColumnDataSource({"x": [], "y": [], "mode": []})
+    region.scatter("x", "y", source=points, color="black", size=9, marker="circle_x")
+    now = Span(location=1e-3, dimension="height", line_color="gray", line_dash="dotted")
+    conv.add_layout(now)
+    legends = {}
+    for key, fig in (("response", response), ("error", error), ("conv", conv), ("region", region)):
+        legend = Legend(items=[], location="top_right", click_policy="hide")
+        fig.add_layout(legend, "right")
+        legends[key] = (legend, dict(items[key]))
+    shared = {"exact": exact, "points": points, "now": now, "legends": legends}
+    figs = {"response": response, "error": error, "conv": conv, "region": region}
+    return figs, sources, shared
+
+
+def _legend_items(legends, chosen: list[str]):
+    from bokeh.models import LegendItem
+
+    for legend, items in legends.values():
+        keep = [name for name in items if name in chosen or name.startswith("exact")]
+        legend.items = [LegendItem(label=name, renderers=items[name]) for name in keep]
+
+
+def _table_html(frame: pd.DataFrame, digits: int = 4) -> str:
+    """A frame as an HTML table, numbers to ``digits`` significant digits."""
+
+    def number(v):
+        if isinstance(v, (bool, np.bool_, str)):
+            return str(v)
+        if isinstance(v, complex):
+            return f"{v.real:.{digits}g}{v.imag:+.{digits}g}j"
+        return f"{v:.{digits}g}"
+
+    return frame.to_html(formatters=dict.fromkeys(frame.columns, number), border=0)
+
+
+class _Page:
+    """The explorer's widgets, figures and the one callback that redraws them."""
+
+    def __init__(self, pn, values: dict[str, Any]):
+        self.pn = pn
+        self.values = values
+        self.figs, self.sources, self.shared = _figures(pn, list(TABLEAUS))
+        self.widgets = _widgets(pn, values)
+        self.status = pn.pane.HTML("", sizing_mode="stretch_width", css_classes=["qc-status"])
+        self.verdicts = pn.pane.HTML("", css_classes=["qc-verdicts"])
+        self.handin = pn.pane.HTML("", css_classes=["qc-handin"])
+        self.modal = pn.pane.HTML("", css_classes=["qc-modes"])
+        self.distortion = pn.pane.HTML("", css_classes=["qc-distortion"])
+        self.toml = pn.widgets.TextAreaInput(
+            name="scenario.toml (qc-control report --config scenario.toml)",
+            height=260,
+            sizing_mode="stretch_width",
+            css_classes=["qc-toml"],
+        )
+        self.command = pn.pane.HTML("", css_classes=["qc-command"], sizing_mode="stretch_width")
+        self.redraws = 0
+        self.scenario: Scenario | None = None
+        from bokeh.models import ColumnDataSource
+
+        # updated last in every redraw: a browser test waits for it (tests/test_explore.py)
+        self.stamp = ColumnDataSource({"n": [0]}, name="qc-redraw-stamp")
+        for w in self.widgets.values():
+            w.param.watch(self._changed, "value")
+
+    # --------------------------------------------------------------- redraw
+
+    def _changed(self, event) -> None:
+        name = event.obj.name_key  # type: ignore[attr-defined]
+        self.values[name] = event.new
+        if name == "preset" and event.new in PRESETS:
+            with self.pn.io.hold():
+                for key, value in PRESETS[event.new].items():
+                    self.widgets[key].value = value  # each fires this callback
+        if name == "road":  # under a road the car starts at rest; free, it is released
+            start = (0.0, 0.0, 0.0, 0.0) if event.new != "none" else (0.0, 0.0, 0.05, 0.0)
+            for key, value in zip(("vs0", "vu0", "xs0", "xu0"), start):
+                self.values[key] = value
+                self.widgets[key].value = value
+            self._show_road_fields()
+        self.redraw()
+
+    def _show_road_fields(self) -> None:
+        for name, (_, kinds) in _road_fields().items():
+            self.widgets[f"road_{name}"].visible = self.values["road"] in kinds
+
+    def redraw(self) -> None:
+        """Recompute from the current values and update every figure and table."""
+        start = time.perf_counter()
+        try:
+            sc = scenario_of(self.values)
+            vehicle, T, U, _ = sc.problem()
+            quick = quick_comparison(vehicle, T, sc.x0, U, sc.methods)
+            ladder = _ladder(sc.vehicle, sc.x0, sc.road, sc.t_end, sc.methods)
+        except (ScenarioError, ValueError, TypeError) as exc:
+            self.status.object = f'<p style="color:#b00">⚠ {_escape(str(exc))}</p>'
+            self._stamp()
+            return
+        self.scenario = sc
+        elapsed = time.perf_counter() - start
+        with self.pn.io.hold():
+            self._draw(sc, quick, ladder, vehicle)
+            self.status.object = (
+                f"<p>{sc.steps:,} steps of h = {1e3 * sc.h:.4g} ms over 0–{sc.t_end:g} s"
+                f"{' on ' + sc.road.describe() if sc.road.describe() else ''}; "
+                f"computed in {1e3 * elapsed:.0f} ms</p>"
+            )
+            self._stamp()
+
+    def _stamp(self) -> None:
+        self.redraws += 1
+        self.stamp.data = {"n": [self.redraws]}
+
+    def _draw(self, sc: Scenario, quick: QuickComparison, ladder, vehicle) -> None:
+        label = self.values["output"]
+        unit = vehicle.unit(label)
+        labels = list(quick.reference.output_labels)
+        row = labels.index(label)
+        ref = np.asarray(quick.reference.outputs)[row]
+        self.shared["exact"].data = {"t": quick.T, "y": ref}
+        peak = float(np.max(np.abs(ref))) or 1.0
+        response, error = self.figs["response"], self.figs["error"]
+        response.y_range.start, response.y_range.end = -1.6 * peak, 1.6 * peak
+        response.yaxis.axis_label = f"{label} [{unit}]"
+        response.title.text = f"Response: {label} [{unit}], the methods over the exact response"
+        error.yaxis.axis_label = f"|{label} error| [{unit}]"
+        error.y_range.end = 10 * peak
+        h = quick.h
+        for method, src in self.sources.items():
+            chosen = method in sc.methods
+            self._draw_method(method, src, quick, ladder, row, chosen)
+        _legend_items(self.shared["legends"], list(sc.methods))
+        self.shared["now"].location = h
+        lam = quick.scaled_eigenvalues
+        self.shared["points"].data = {
+            "x": np.concatenate([lam.real, lam.real]),
+            "y": np.concatenate([lam.imag, -lam.imag]),
+            "mode": [m.name for m in quick.modes.modes] * 2,
+        }
+        self._tables(sc, quick, label, unit)
+
+    def _draw_method(self, method, src, quick, ladder, row, chosen) -> None:
+        if not chosen:
+            for key, s in src.items():
+                if s.data and len(next(iter(s.data.values()))):
+                    s.data = {k: [] for k in s.data}
+            return
+        src["response"].data = {"x": quick.T, "y": quick.outputs[method][row]}
+        src["error"].data = {"x": quick.T, "y": quick.errors[method][row]}
+        mine = ladder[ladder["method"] == method]
+        src["conv"].data = {"x": mine["h"].to_numpy(), "y": mine["error"].to_numpy()}
+        at_h = quick.table.loc[method, "max |xs err| [m]"]
+        src["mark"].data = {"x": [quick.h], "y": [at_h]}
+        if not len(src["region"].data["xs"]):
+            curves = _boundary(method)
+            src["region"].data = {
+                "xs": [c.real for c in curves],
+                "ys": [c.imag for c in curves],
+            }
+
+    def _tables(self, sc: Scenario, quick: QuickComparison, label: str, unit: str) -> None:
+        table = quick.table
+        err = f"max |{label} err| [{unit}]"
+        handin = pd.DataFrame(
+            {
+                "order": table["order"],
+                "h [s]": quick.h,
+                "RHS evals": table["RHS evals"],
+                err: table[err],
+                "max |xs err| [m]": table["max |xs err| [m]"],
+                "h_max [s]": table["h_max [s]"],
+                "limited by": table["limited by"],
+            }
+        )
+        handin = handin.loc[:, ~handin.columns.duplicated()]
+        self.handin.object = _table_html(handin)
+        self.verdicts.object = "".join(
+            f'<p class="verdict" data-method="{m}"><b>{m}</b>: {table.loc[m, "verdict"]}</p>'
+            for m in sc.methods
+        )
+        self.modal.object = _table_html(quick.modes.to_frame())
+        distortion = pd.concat(
+            {
+                m: quick.numerical_modes[m][["fd_h [Hz]", "freq error [%]", "zeta_h", "zeta error"]]
+                for m in sc.methods
+            },
+            names=["method", "mode"],
+        )
+        self.distortion.object = _table_html(distortion)
+
+    # --------------------------------------------------------------- export
+
+    def export(self, event=None) -> None:
+        """Fill the TOML and the command of the current run (the Scenario's own)."""
+        if self.scenario is None:
+            return
+        self.toml.value = self.scenario.to_toml()
+        command = self.scenario.command(config="scenario.toml")
+        self.command.object = f"<pre>{_escape(command)}</pre><pre>{_escape(self.scenario.command())}</pre>"
+
+    def layout(self):
+        pn = self.pn
+        w = self.widgets
+        export = pn.widgets.Button(name="Export scenario (TOML + command)", button_type="primary")
+        export.on_click(self.export)
+        download = pn.widgets.FileDownload(
+            callback=lambda: _text_file(self.scenario.to_toml() if self.scenario else ""),
+            filename="scenario.toml",
+            label="Download scenario.toml",
+        )
+        road = [w["road"], *(w[f"road_{n}"] for n in _road_fields())]
+        controls = pn.Column(
+            "### Vehicle",
+            w["preset"],
+            *(w[k] for k in ("ms", "mu", "ks", "ku", "zeta")),
+            "### Methods and step",
+            w["methods"],
+            w["log_h"],
+            w["h"],
+            w["t_end"],
+            "### Start [m/s, m/s, m, m]",
+            pn.Row(w["vs0"], w["vu0"]),
+            pn.Row(w["xs0"], w["xu0"]),
+            "### Road",
+            *road,
+            "### Output",
+            w["output"],
+            width=300,
+        )
+        figs = self.figs
+        main = pn.Column(
+            self.status,
+            self.verdicts,
+            pn.Row(pn.pane.Bokeh(figs["response"]), pn.pane.Bokeh(figs["error"])),
+            pn.Row(pn.pane.Bokeh(figs["conv"]), pn.pane.Bokeh(figs["region"])),
+            "### Numbers for the hand-in",
+            self.handin,
+            pn.Row(
+                pn.Column("### Modes (exact)", self.modal),
+                pn.Column("### Each method's view of the modes at h", self.distortion),
+            ),
+            "### From play to hand-in",
+            pn.Row(export, download),
+            self.command,
+            self.toml,
+            pn.pane.Bokeh(_stamp_holder(self.stamp)),
+            sizing_mode="stretch_width",
+        )
+        return pn.Row(controls, main, sizing_mode="stretch_width")
+
+
+def _stamp_holder(stamp):
+    """A plot that holds the redraw stamp, so that it is part of the browser's document."""
+    from bokeh.plotting import figure
+
+    holder = figure(width=10, height=10, toolbar_location=None, visible=False)
+    holder.scatter("n", "n", source=stamp, alpha=0)
+    return holder
+
+
+def _escape(text: str) -> str:
+    import html
+
+    return html.escape(text)
+
+
+def _text_file(text: str):
+    import io
+
+    return io.StringIO(text)
+
+
+def _widgets(pn, values: dict[str, Any]) -> dict[str, Any]:
+    """One widget per value, named by its key (``name_key``), showing its unit."""
+    from bokeh.models import CustomJSTickFormatter
+
+    W = pn.widgets
+    w: dict[str, Any] = {
+        "preset": W.Select(name="preset", options=[*PRESETS, "custom"], value=values["preset"]),
+        "ms": W.FloatInput(name="ms: body mass [kg]", value=values["ms"], start=1e-6),
+        "mu": W.FloatInput(name="mu: wheel mass [kg]", value=values["mu"], start=1e-6),
+        "ks": W.FloatInput(name="ks: suspension stiffness [N/m]", value=values["ks"], step=1000),
+        "ku": W.FloatInput(name="ku: tire stiffness [N/m]", value=values["ku"], step=1000),
+        "zeta": W.FloatInput(name="zeta: nominal damping ratio [-]", value=values["zeta"], step=0.05),
+        "methods": W.MultiChoice(name="methods", options=list(TABLEAUS), value=values["methods"]),
+        "log_h": W.FloatSlider(
+            name="step h (log scale)",
+            start=-1.0,
+            end=float(np.log10(200.0)),
+            step=0.001,
+            value=float(np.log10(values["h"])),
+            format=CustomJSTickFormatter(code="return (10 ** tick).toPrecision(3) + ' ms'"),
+        ),
+        "h": W.FloatInput(name="h [ms]", value=values["h"], start=0.1, end=200.0, css_classes=["qc-h"]),
+        "t_end": W.FloatInput(name="t_end [s]", value=values["t_end"], start=0.001),
+        "vs0": W.FloatInput(name="vs [m/s]", value=values["vs0"], width=120),
+        "vu0": W.FloatInput(name="vu [m/s]", value=values["vu0"], width=120),
+        "xs0": W.FloatInput(name="xs [m]", value=values["xs0"], width=120),
+        "xu0": W.FloatInput(name="xu [m]", value=values["xu0"], width=120),
+        "road": W.Select(name="road", options=list(ROADS), value=values["road"]),
+        "output": W.Select(
+            name="output", options=["xs", "xu", "susp_travel", "tire_defl", "body_acc"],
+            value=values["output"],
+        ),
+    }
+    for name, (f, kinds) in _road_fields().items():
+        unit = f" [{f.metadata['unit']}]" if f.metadata["unit"] else ""
+        label = f"{f.metadata['help']}{unit}"
+        value = values[f"road_{name}"]
+        if isinstance(f.default, str):
+            widget = W.Select(name=label, options=list("ABCDEFGH"), value=value)
+        elif isinstance(f.default, int):
+            widget = W.IntInput(name=label, value=value)
+        else:
+            widget = W.FloatInput(name=label, value=value)
+        widget.visible = values["road"] in kinds
+        w[f"road_{name}"] = widget
+    for key, widget in w.items():
+        widget.name_key = key
+    w["log_h"].param.watch(lambda e: setattr(w["h"], "value", round(10 ** e.new, 4)), "value")
+    return w
+
+
+def default_values() -> dict[str, Any]:
+    """The page's start: the seed's car released from 5 cm, 10 s at 1 ms, the four methods."""
+    values: dict[str, Any] = {"preset": _SEED, **PRESETS[_SEED]}
+    values.update(
+        methods=list(DEFAULT_METHODS),
+        h=1.0,
+        t_end=10.0,
+        vs0=0.0,
+        vu0=0.0,
+        xs0=0.05,
+        xu0=0.0,
+        road="none",
+        output="xs",
+    )
+    for name, (f, _) in _road_fields().items():
+        values[f"road_{name}"] = f.default
+    return values
+
+
+def explorer(**values):
+    """The explorer as a Panel layout: in a notebook, or served by `serve`.
+
+    Parameters
+    ----------
+    **values
+        Start values by key (``ms=350.0``, ``h=20.0`` [ms], ``road='bump'``,
+        ``methods=['euler', 'rk4']``); the rest are `default_values`.
+
+    Returns
+    -------
+    panel.layout.Row
+    """
+    pn = _panel()
+    start = default_values()
+    unknown = set(values) - set(start)
+    if unknown:
+        raise TypeError(f"explorer() got unknown values {sorted(unknown)}; known: {sorted(start)}")
+    start.update(values)
+    page = _Page(pn, start)
+    layout = page.layout()
+    _sync_url(pn, page)
+    page.redraw()
+    layout.explorer_page = page  # for tests and notebooks: the page behind the layout
+    return layout
+
+
+def _sync_url(pn, page: _Page) -> None:
+    """Keep the page's values in its URL's query (a link opens with the same settings)."""
+    location = pn.state.location
+    if location is None:  # a notebook: no URL to keep
+        return
+    for key, widget in page.widgets.items():
+        if key != "log_h":
+            location.sync(widget, {"value": key})
+
+
+def free_port(host: str = "127.0.0.1") -> int:
+    """A port no one listens on now (the system's choice)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind((host, 0))
+        return int(s.getsockname()[1])
+
+
+def serve(port: int = 5006, show: bool = True, say: Callable[[str], None] = print) -> None:
+    """Serve the explorer on 127.0.0.1 until interrupted; ``say`` gets its address.
+
+    ``port=0`` takes a free port. The page's scripts, styles and fonts come
+    from this server: it needs no internet.
+    """
+    pn = _panel()
+    port = free_port() if port == 0 else port
+    origins = [f"127.0.0.1:{port}", f"localhost:{port}"]
+    server = pn.serve(
+        {"/": explorer},
+        port=port,
+        address="127.0.0.1",
+        websocket_origin=origins,
+        show=False,
+        start=False,
+        title="qc-control explorer",
+    )
+    url = f"http://127.0.0.1:{port}/"
+    say(f"qc-control explore: serving {url} (Ctrl-C stops it)")
+    if show:
+        server.io_loop.add_callback(server.show, "/")
+    server.io_loop.start()
