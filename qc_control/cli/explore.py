@@ -39,7 +39,14 @@ from ..studies.compare import DEFAULT_METHODS
 from ..studies.quick import QuickComparison, error_ladder, ladder_steps, quick_comparison
 from .scenario import MAX_STEPS, ROADS, Scenario, ScenarioError, road_from_mapping, whole_step
 
-__all__ = ["explorer", "serve", "PRESETS", "EXPLORE_MAX_STEPS", "scenario_of", "ExplorerUnavailable"]
+__all__ = [
+    "explorer",
+    "serve",
+    "PRESETS",
+    "EXPLORE_MAX_STEPS",
+    "scenario_of",
+    "ExplorerUnavailable",
+]
 
 #: The longest run the page accepts, steps t_end/h: about a second of work per
 #: method in the LTI engine; a longer one is refused with the Scenario's message.
@@ -260,6 +267,7 @@ class _Page:
         )
         self.command = pn.pane.HTML("", css_classes=["qc-command"], sizing_mode="stretch_width")
         self.redraws = 0
+        self._quiet = False
         self.scenario: Scenario | None = None
         from bokeh.models import ColumnDataSource
 
@@ -272,18 +280,35 @@ class _Page:
 
     def _changed(self, event) -> None:
         name = event.obj.name_key  # type: ignore[attr-defined]
+        if name == "log_h":  # the slider sets h, whose change redraws
+            return
         self.values[name] = event.new
-        if name == "preset" and event.new in PRESETS:
-            with self.pn.io.hold():
-                for key, value in PRESETS[event.new].items():
-                    self.widgets[key].value = value  # each fires this callback
-        if name == "road":  # under a road the car starts at rest; free, it is released
-            start = (0.0, 0.0, 0.0, 0.0) if event.new != "none" else (0.0, 0.0, 0.05, 0.0)
-            for key, value in zip(("vs0", "vu0", "xs0", "xu0"), start):
-                self.values[key] = value
-                self.widgets[key].value = value
-            self._show_road_fields()
+        if self._quiet:
+            return
+        self._quiet = True  # the values set below redraw once, at the end
+        try:
+            self._follow(name, event.new)
+        finally:
+            self._quiet = False
         self.redraw()
+
+    def _follow(self, name: str, value) -> None:
+        """What one change brings with it: a preset's values, the start under a road."""
+        w = self.widgets
+        if name == "h" and value and value > 0:
+            w["log_h"].value = float(np.log10(value))
+        elif name == "preset" and value in PRESETS:
+            for key, number in PRESETS[value].items():
+                w[key].value = number
+        elif name in ("ms", "mu", "ks", "ku", "zeta"):
+            chosen = PRESETS.get(self.values["preset"], {})
+            if chosen and chosen.get(name) != value:
+                w["preset"].value = "custom"
+        elif name == "road":  # under a road the car starts at rest; free, it is released
+            start = (0.0, 0.0, 0.0, 0.0) if value != "none" else (0.0, 0.0, 0.05, 0.0)
+            for key, number in zip(("vs0", "vu0", "xs0", "xu0"), start):
+                w[key].value = number
+            self._show_road_fields()
 
     def _show_road_fields(self) -> None:
         for name, (_, kinds) in _road_fields().items():
@@ -401,7 +426,9 @@ class _Page:
             return
         self.toml.value = self.scenario.to_toml()
         command = self.scenario.command(config="scenario.toml")
-        self.command.object = f"<pre>{_escape(command)}</pre><pre>{_escape(self.scenario.command())}</pre>"
+        self.command.object = (
+            f"<pre>{_escape(command)}</pre><pre>{_escape(self.scenario.command())}</pre>"
+        )
 
     def layout(self):
         pn = self.pn
@@ -486,7 +513,9 @@ def _widgets(pn, values: dict[str, Any]) -> dict[str, Any]:
         "mu": W.FloatInput(name="mu: wheel mass [kg]", value=values["mu"], start=1e-6),
         "ks": W.FloatInput(name="ks: suspension stiffness [N/m]", value=values["ks"], step=1000),
         "ku": W.FloatInput(name="ku: tire stiffness [N/m]", value=values["ku"], step=1000),
-        "zeta": W.FloatInput(name="zeta: nominal damping ratio [-]", value=values["zeta"], step=0.05),
+        "zeta": W.FloatInput(
+            name="zeta: nominal damping ratio [-]", value=values["zeta"], step=0.05
+        ),
         "methods": W.MultiChoice(name="methods", options=list(TABLEAUS), value=values["methods"]),
         "log_h": W.FloatSlider(
             name="step h (log scale)",
@@ -496,7 +525,9 @@ def _widgets(pn, values: dict[str, Any]) -> dict[str, Any]:
             value=float(np.log10(values["h"])),
             format=CustomJSTickFormatter(code="return (10 ** tick).toPrecision(3) + ' ms'"),
         ),
-        "h": W.FloatInput(name="h [ms]", value=values["h"], start=0.1, end=200.0, css_classes=["qc-h"]),
+        "h": W.FloatInput(
+            name="h [ms]", value=values["h"], start=0.1, end=200.0, css_classes=["qc-h"]
+        ),
         "t_end": W.FloatInput(name="t_end [s]", value=values["t_end"], start=0.001),
         "vs0": W.FloatInput(name="vs [m/s]", value=values["vs0"], width=120),
         "vu0": W.FloatInput(name="vu [m/s]", value=values["vu0"], width=120),
@@ -504,7 +535,8 @@ def _widgets(pn, values: dict[str, Any]) -> dict[str, Any]:
         "xu0": W.FloatInput(name="xu [m]", value=values["xu0"], width=120),
         "road": W.Select(name="road", options=list(ROADS), value=values["road"]),
         "output": W.Select(
-            name="output", options=["xs", "xu", "susp_travel", "tire_defl", "body_acc"],
+            name="output",
+            options=["xs", "xu", "susp_travel", "tire_defl", "body_acc"],
             value=values["output"],
         ),
     }
@@ -522,7 +554,7 @@ def _widgets(pn, values: dict[str, Any]) -> dict[str, Any]:
         w[f"road_{name}"] = widget
     for key, widget in w.items():
         widget.name_key = key
-    w["log_h"].param.watch(lambda e: setattr(w["h"], "value", round(10 ** e.new, 4)), "value")
+    w["log_h"].param.watch(lambda e: setattr(w["h"], "value", round(10**e.new, 4)), "value")
     return w
 
 
