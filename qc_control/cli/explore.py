@@ -198,7 +198,10 @@ def _figures(pn, methods: list[str]):
         items.setdefault(name, [])
     for i, method in enumerate(TABLEAUS):
         color = _COLORS[i % len(_COLORS)]
-        src = {k: ColumnDataSource({"x": [], "y": []}) for k in ("response", "error", "conv")}
+        src = {
+            k: ColumnDataSource({"x": [], "y": []}, name=f"{k}-{method}")
+            for k in ("response", "error", "conv")
+        }
         src["mark"] = ColumnDataSource({"x": [], "y": []})
         src["region"] = ColumnDataSource({"xs": [], "ys": []})
         dash = "solid" if i % 2 == 0 else "dashed"
@@ -268,6 +271,7 @@ class _Page:
         self.command = pn.pane.HTML("", css_classes=["qc-command"], sizing_mode="stretch_width")
         self.redraws = 0
         self._quiet = False
+        self._legend_methods: tuple[str, ...] = ()
         self.scenario: Scenario | None = None
         from bokeh.models import ColumnDataSource
 
@@ -359,7 +363,9 @@ class _Page:
         for method, src in self.sources.items():
             chosen = method in sc.methods
             self._draw_method(method, src, quick, ladder, row, chosen)
-        _legend_items(self.shared["legends"], list(sc.methods))
+        if sc.methods != self._legend_methods:  # new legend items re-walk the whole document
+            _legend_items(self.shared["legends"], list(sc.methods))
+            self._legend_methods = sc.methods
         self.shared["now"].location = h
         lam = quick.scaled_eigenvalues
         self.shared["points"].data = {
@@ -371,7 +377,7 @@ class _Page:
 
     def _draw_method(self, method, src, quick, ladder, row, chosen) -> None:
         if not chosen:
-            for key, s in src.items():
+            for s in src.values():
                 if s.data and len(next(iter(s.data.values()))):
                     s.data = {k: [] for k in s.data}
             return
@@ -525,9 +531,7 @@ def _widgets(pn, values: dict[str, Any]) -> dict[str, Any]:
             value=float(np.log10(values["h"])),
             format=CustomJSTickFormatter(code="return (10 ** tick).toPrecision(3) + ' ms'"),
         ),
-        "h": W.FloatInput(
-            name="h [ms]", value=values["h"], start=0.1, end=200.0, css_classes=["qc-h"]
-        ),
+        "h": W.FloatInput(name="h [ms]", value=values["h"], start=0.1, end=200.0),
         "t_end": W.FloatInput(name="t_end [s]", value=values["t_end"], start=0.001),
         "vs0": W.FloatInput(name="vs [m/s]", value=values["vs0"], width=120),
         "vu0": W.FloatInput(name="vu [m/s]", value=values["vu0"], width=120),
@@ -554,6 +558,7 @@ def _widgets(pn, values: dict[str, Any]) -> dict[str, Any]:
         w[f"road_{name}"] = widget
     for key, widget in w.items():
         widget.name_key = key
+        widget.css_classes = [f"qc-{key}"]  # how a test (or a user's style) finds it
     w["log_h"].param.watch(lambda e: setattr(w["h"], "value", round(10**e.new, 4)), "value")
     return w
 
