@@ -473,10 +473,10 @@ class _Page:
             pn.Row(pn.pane.Bokeh(figs["conv"]), pn.pane.Bokeh(figs["region"])),
             "### Numbers for the hand-in",
             self.handin,
-            pn.Row(
-                pn.Column("### Modes (exact)", self.modal),
-                pn.Column("### Each method's view of the modes at h", self.distortion),
-            ),
+            "### Modes (exact)",
+            self.modal,
+            "### Each method's view of the modes at h",
+            self.distortion,
             "### From play to hand-in",
             pn.Row(export, download),
             self.command,
@@ -596,6 +596,8 @@ def explorer(**values):
     panel.layout.Row
     """
     pn = _panel()
+    if not pn.state.served:  # a notebook: load Panel's scripts into it (inline, no CDN)
+        pn.extension()
     start = default_values()
     unknown = set(values) - set(start)
     if unknown:
