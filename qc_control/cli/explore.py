@@ -236,6 +236,14 @@ def _legend_items(legends, chosen: list[str]):
         legend.items = [LegendItem(label=name, renderers=items[name]) for name in keep]
 
 
+@functools.lru_cache(maxsize=32)
+def _modal_html(vehicle: QuarterCarParams) -> str:
+    """The modal table of a vehicle (kept: it changes with the vehicle, not with h)."""
+    from ..models.modal import modal_analysis
+
+    return _table_html(modal_analysis(vehicle).to_frame())
+
+
 def _table_html(frame: pd.DataFrame, digits: int = 4) -> str:
     """A frame as an HTML table, numbers to ``digits`` significant digits."""
 
@@ -351,7 +359,8 @@ class _Page:
         labels = list(quick.reference.output_labels)
         row = labels.index(label)
         ref = np.asarray(quick.reference.outputs)[row]
-        self.shared["exact"].data = {"t": quick.T, "y": ref}
+        t, y = _shown(quick.T, ref)
+        self.shared["exact"].data = {"t": t, "y": y}
         peak = float(np.max(np.abs(ref))) or 1.0
         response, error = self.figs["response"], self.figs["error"]
         response.y_range.start, response.y_range.end = -1.6 * peak, 1.6 * peak
@@ -381,8 +390,9 @@ class _Page:
                 if s.data and len(next(iter(s.data.values()))):
                     s.data = {k: [] for k in s.data}
             return
-        src["response"].data = {"x": quick.T, "y": quick.outputs[method][row]}
-        src["error"].data = {"x": quick.T, "y": quick.errors[method][row]}
+        for key, curves in (("response", quick.outputs), ("error", quick.errors)):
+            t, y = _shown(quick.T, curves[method][row])
+            src[key].data = {"x": t, "y": y}
         mine = ladder[ladder["method"] == method]
         src["conv"].data = {"x": mine["h"].to_numpy(), "y": mine["error"].to_numpy()}
         at_h = quick.table.loc[method, "max |xs err| [m]"]
@@ -414,7 +424,7 @@ class _Page:
             f'<p class="verdict" data-method="{m}"><b>{m}</b>: {table.loc[m, "verdict"]}</p>'
             for m in sc.methods
         )
-        self.modal.object = _table_html(quick.modes.to_frame())
+        self.modal.object = _modal_html(sc.vehicle)
         distortion = pd.concat(
             {
                 m: quick.numerical_modes[m][["fd_h [Hz]", "freq error [%]", "zeta_h", "zeta error"]]
@@ -494,6 +504,36 @@ def _stamp_holder(stamp):
     holder = figure(width=10, height=10, toolbar_location=None, visible=False)
     holder.scatter("n", "n", source=stamp, alpha=0)
     return holder
+
+
+#: A curve longer than this is drawn from its extremes per stretch (`_shown`).
+_DRAWN = 2000
+
+
+def _shown(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A curve as the browser draws it: the samples that a figure 500-1000 px wide
+    can show apart, in single precision (a screen shows 3 digits).
+
+    Over ``_DRAWN`` samples, the curve is cut into ``_DRAWN / 2`` stretches and each
+    keeps its smallest and largest sample, in time order (min-max decimation): every
+    peak, and a run that blew up (inf), is drawn as it is; what is dropped are
+    samples between two others of the same stretch, which fall on the same pixel
+    column. The numbers in the tables are the library's, from every sample.
+    """
+    t, y = np.asarray(t), np.asarray(y)
+    if y.size > _DRAWN:
+        per = y.size // (_DRAWN // 2)
+        whole = per * (_DRAWN // 2)
+        block = y[:whole].reshape(-1, per)
+        base = np.arange(0, whole, per)
+        with np.errstate(invalid="ignore"):
+            keep = np.concatenate(
+                [base + np.argmin(block, axis=1), base + np.argmax(block, axis=1)]
+            )
+        keep = np.unique(np.concatenate([keep, np.arange(whole, y.size), [0, y.size - 1]]))
+        t, y = t[keep], y[keep]
+    with np.errstate(over="ignore"):
+        return t.astype(np.float32), y.astype(np.float32)
 
 
 def _escape(text: str) -> str:

@@ -433,6 +433,7 @@ def step_is_stable(method, h: float, eigenvalues):
     return bool(ok) if ok.ndim == 0 else ok
 
 
+@functools.lru_cache(maxsize=1024)  # pure; the explorer asks again at every redraw
 def _step_limit(tab, lam: complex) -> float:
     """The largest h with ``|R(hλ)| <= 1`` on ``(0, h]``, for one settled λ.
 
