@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import html
+import io
 import socket
 import time
 from collections.abc import Callable
@@ -32,6 +34,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..models.modal import modal_analysis
 from ..models.quarter import QuarterCarParams
 from ..numerics.methods import TABLEAUS
 from ..numerics.stability import stability_boundary
@@ -87,7 +90,7 @@ class ExplorerUnavailable(ImportError):
 def _panel():
     """Panel, imported on first use, or a clear error saying which extra installs it."""
     try:
-        import panel as pn
+        import panel as pn  # the explore extra: only the page needs it
     except ImportError:
         raise ExplorerUnavailable(
             "qc-control explore needs Panel, which is not installed: "
@@ -164,8 +167,8 @@ def _boundary(method: str) -> list[np.ndarray]:
 
 def _figures(pn, methods: list[str]):
     """The four Bokeh figures and their data sources, one source per method and figure."""
-    from bokeh.models import ColumnDataSource, Legend, Range1d, Span
-    from bokeh.plotting import figure
+    from bokeh.models import ColumnDataSource, Legend, Range1d, Span  # with Panel
+    from bokeh.plotting import figure  # Bokeh comes with Panel (the explore extra)
 
     tools = "pan,wheel_zoom,box_zoom,reset,save"
     common = dict(height=300, sizing_mode="stretch_width", tools=tools, output_backend="canvas")
@@ -229,7 +232,7 @@ def _figures(pn, methods: list[str]):
 
 
 def _legend_items(legends, chosen: list[str]):
-    from bokeh.models import LegendItem
+    from bokeh.models import LegendItem  # with Panel (the explore extra)
 
     for legend, items in legends.values():
         keep = [name for name in items if name in chosen or name.startswith("exact")]
@@ -239,8 +242,6 @@ def _legend_items(legends, chosen: list[str]):
 @functools.lru_cache(maxsize=32)
 def _modal_html(vehicle: QuarterCarParams) -> str:
     """The modal table of a vehicle (kept: it changes with the vehicle, not with h)."""
-    from ..models.modal import modal_analysis
-
     return _table_html(modal_analysis(vehicle).to_frame())
 
 
@@ -281,7 +282,7 @@ class _Page:
         self._quiet = False
         self._legend_methods: tuple[str, ...] = ()
         self.scenario: Scenario | None = None
-        from bokeh.models import ColumnDataSource
+        from bokeh.models import ColumnDataSource  # with Panel (the explore extra)
 
         # updated last in every redraw: a browser test waits for it (tests/test_explore.py)
         self.stamp = ColumnDataSource({"n": [0]}, name="qc-redraw-stamp")
@@ -291,7 +292,7 @@ class _Page:
     # --------------------------------------------------------------- redraw
 
     def _changed(self, event) -> None:
-        name = event.obj.name_key  # type: ignore[attr-defined]
+        name = event.obj.name_key
         if name == "log_h":  # the slider sets h, whose change redraws
             return
         self.values[name] = event.new
@@ -421,8 +422,8 @@ class _Page:
         handin = handin.loc[:, ~handin.columns.duplicated()]
         self.handin.object = _table_html(handin)
         self.verdicts.object = "".join(
-            f'<p class="verdict" data-method="{m}"><b>{m}</b>: {table.loc[m, "verdict"]}</p>'
-            for m in sc.methods
+            f'<p class="verdict" data-method="{m}"><b>{m}</b>: {verdict}</p>'
+            for m, verdict in zip(sc.methods, table.loc[list(sc.methods), "verdict"].astype(str))
         )
         self.modal.object = _modal_html(sc.vehicle)
         distortion = pd.concat(
@@ -499,7 +500,7 @@ class _Page:
 
 def _stamp_holder(stamp):
     """A plot that holds the redraw stamp, so that it is part of the browser's document."""
-    from bokeh.plotting import figure
+    from bokeh.plotting import figure  # with Panel (the explore extra)
 
     holder = figure(width=10, height=10, toolbar_location=None, visible=False)
     holder.scatter("n", "n", source=stamp, alpha=0)
@@ -537,20 +538,16 @@ def _shown(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _escape(text: str) -> str:
-    import html
-
     return html.escape(text)
 
 
 def _text_file(text: str):
-    import io
-
     return io.StringIO(text)
 
 
 def _widgets(pn, values: dict[str, Any]) -> dict[str, Any]:
     """One widget per value, named by its key (``name_key``), showing its unit."""
-    from bokeh.models import CustomJSTickFormatter
+    from bokeh.models import CustomJSTickFormatter  # with Panel (the explore extra)
 
     W = pn.widgets
     w: dict[str, Any] = {

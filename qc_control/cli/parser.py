@@ -326,6 +326,7 @@ def _port(text: str) -> int:
 
 
 def _cmd_explore(args) -> int:
+    # the page's module imports Panel when it runs: the other commands never load it
     from .explore import ExplorerUnavailable, serve
 
     try:

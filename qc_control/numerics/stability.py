@@ -31,6 +31,7 @@ import functools
 import math
 from dataclasses import dataclass
 
+import contourpy
 import control
 import numpy as np
 import pandas as pd
@@ -720,8 +721,6 @@ def stability_boundary(method, x, y) -> list[np.ndarray]:
     >>> bool(np.all(np.abs(np.abs(1 + curve) - 1) < 0.01))
     True
     """
-    import contourpy  # matplotlib's contouring: loaded with the first region drawn
-
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     if x.ndim != 1 or y.ndim != 1 or x.size < 2 or y.size < 2:
         raise ValueError(
@@ -729,8 +728,9 @@ def stability_boundary(method, x, y) -> list[np.ndarray]:
         )
     z = x[None, :] + 1j * y[:, None]
     size = np.minimum(np.abs(_r_of(get_method(method), z)), 1e6)
-    lines = contourpy.contour_generator(x, y, size).lines(1.0)
-    return [line[:, 0] + 1j * line[:, 1] for line in lines]  # type: ignore[index]
+    lines = contourpy.contour_generator(x, y, size).lines(1.0)  # LineType.Separate: (n, 2) each
+    curves = [np.asarray(line, dtype=float) for line in lines]
+    return [c[:, 0] + 1j * c[:, 1] for c in curves]
 
 
 def step_verdict(h: float, h_max: float) -> str:

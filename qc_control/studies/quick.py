@@ -25,19 +25,10 @@ import pandas as pd
 from ..models.modal import ModalAnalysis, modal_analysis
 from ..models.vehicle import VehicleModel
 from ..numerics.exact import exact_outputs
+from ..numerics.integrate import uniform_step
+from ..numerics.methods import get_method
 from ..numerics.stability import step_verdict
-from .compare import (
-    Reference,
-    _exact,
-    _grid,
-    _max_error,
-    _outputs,
-    _simulate,
-    _tableaus,
-    error_table,
-    method_responses,
-    mode_errors,
-)
+from .compare import Reference, error_table, method_responses, mode_errors
 
 __all__ = ["QuickComparison", "quick_comparison", "error_ladder", "ladder_steps"]
 
@@ -50,6 +41,8 @@ LADDER_SAMPLES = 20_000
 @dataclass(eq=False)
 class QuickComparison:
     """The methods at one step against python-control's exact response.
+
+    Made by `quick_comparison`; every curve is on the grid ``T``.
 
     Attributes
     ----------
@@ -129,16 +122,21 @@ def quick_comparison(
             f"{type(sys).__name__}"
         )
     T = np.asarray(T, dtype=float)
-    h, substeps = _grid(T, None)
+    h = uniform_step(T)
+    if h is None:
+        raise ValueError("T must be a uniform grid: its spacing is the step")
     X0 = np.asarray(X0, dtype=float)
-    tabs = _tableaus(methods)
-    exact = _exact(sys, T, X0, U)
+    tabs = tuple(get_method(m) for m in methods)
+    if U is None:
+        exact = control.initial_response(sys, T, X0)
+    else:
+        exact = control.forced_response(sys, T, U, X0)
     reference = Reference(exact, math.nan, "", f"python-control {control.__version__}")
-    responses = method_responses(sys, T, X0, U, tabs, substeps)
+    responses = method_responses(sys, T, X0, U, tabs)
     modes = modal_analysis(model)
     numerical, stability = mode_errors(tabs, h, sys, modes)
     ref = np.asarray(exact.outputs).reshape(sys.noutputs, -1)
-    outputs = {name: _outputs(r, T.size) for name, r in responses.items()}
+    outputs = {name: _padded(r, T.size) for name, r in responses.items()}
     with np.errstate(invalid="ignore", over="ignore"):  # an overflowed run's error is inf
         errors = {name: np.nan_to_num(np.abs(y - ref), nan=np.inf) for name, y in outputs.items()}
     cost = pd.DataFrame(
@@ -224,7 +222,7 @@ def error_ladder(
     sys = model.system
     body = list(sys.output_labels).index(model.body_disp)
     A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
-    tabs = _tableaus(methods)
+    tabs = tuple(get_method(m) for m in methods)
     X0 = np.asarray(X0, dtype=float)
     rows = []
     for n in steps:
@@ -232,9 +230,17 @@ def error_ladder(
         U = inputs(T)
         samples = np.zeros((sys.ninputs, T.size)) if U is None else np.atleast_2d(U)
         exact = exact_outputs(A, B, C, D, t_end / n, samples, X0)[body]
-        for tab in tabs:
-            response = _simulate(sys, T, X0, U, tab, 1)
-            y = np.asarray(response.outputs)[body]
-            error = _max_error(y, exact, T.size)
-            rows.append({"method": tab.name, "h": t_end / n, "nfev": response.nfev, "error": error})
+        for name, response in method_responses(sys, T, X0, U, tabs).items():
+            with np.errstate(invalid="ignore", over="ignore"):  # a run that blew up: inf
+                gap = np.abs(_padded(response, T.size)[body] - exact)
+            error = float(np.max(np.nan_to_num(gap, nan=np.inf)))
+            rows.append({"method": name, "h": t_end / n, "nfev": response.nfev, "error": error})
     return pd.DataFrame(rows)
+
+
+def _padded(response, samples: int) -> np.ndarray:
+    """Every output of a response on all ``samples``: ``inf`` after a run cut short
+    where it overflowed (its missing samples are infinitely wrong)."""
+    y = np.asarray(response.outputs).reshape(len(response.output_labels), -1)
+    missing = np.full((y.shape[0], samples - y.shape[1]), np.inf)
+    return np.concatenate([y, missing], axis=1) if missing.size else y
