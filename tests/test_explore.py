@@ -325,3 +325,28 @@ def test_make_explore_installs_the_extra_and_runs_the_command():
     assert "pip install --quiet -e '.[explore]'" in text
     assert "qc-control explore" in text
     assert "touch .venv/.installed-explore" in text
+
+
+@pytest.mark.slow
+def test_every_road_redraws_and_a_too_coarse_step_gets_the_scenarios_message():
+    from qc_control.cli.explore import explorer
+
+    page = explorer().explorer_page
+    for road in ("step", "bump", "sine", "iso8608"):
+        page.widgets["road"].value = road
+        sc = page.scenario
+        assert sc.road.kind == road and sc.x0 == (0.0, 0.0, 0.0, 0.0)  # at rest under a road
+        assert sc.road.describe() in page.status.object
+    page.widgets["road"].value = "bump"
+    page.widgets["h"].value = 20.0  # the 1 m bump at 20 m/s lasts 50 ms: 4 steps need 12.5 ms
+    with pytest.raises(ValueError) as refusal:
+        Scenario(road={"kind": "bump"}, h=0.02)
+    assert html_text(str(refusal.value).split("] ", 1)[1]) in page.status.object
+    page.widgets["h"].value = None
+    assert "h must be given: the box is empty" in page.status.object
+
+
+def html_text(text: str) -> str:
+    import html
+
+    return html.escape(text)

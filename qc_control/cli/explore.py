@@ -118,6 +118,9 @@ def scenario_of(values: dict[str, Any]) -> Scenario:
     refused with the command line's message. Raises `ScenarioError` for a
     bad value.
     """
+    empty = [k for k in ("ms", "mu", "ks", "ku", "zeta", "h", "t_end") if values[k] is None]
+    if empty:
+        raise ScenarioError(f"{empty[0]} must be given: the box is empty", None, empty[0])
     vehicle = {k: float(values[k]) for k in ("ms", "mu", "ks", "ku", "zeta")}
     kind = values["road"]
     road = {"kind": kind}
@@ -145,14 +148,22 @@ def scenario_of(values: dict[str, Any]) -> Scenario:
     )
 
 
-@functools.lru_cache(maxsize=32)
-def _ladder(vehicle, x0, road, t_end: float, methods: tuple[str, ...]) -> pd.DataFrame:
-    """The convergence figure's ladder: it does not depend on h, so it is kept."""
-    sc = Scenario(vehicle=vehicle, x0=x0, road=road, t_end=t_end, h=t_end / 2, methods=methods)
-    model = sc.problem()[0]
-    return error_ladder(
-        model, t_end, sc.x0, lambda T: sc.road_input(T)[0], methods, ladder_steps(t_end)
-    )
+#: The convergence ladders computed, by what they depend on (not h): a change of the
+#: step reuses its ladder.
+_LADDERS: dict[tuple, pd.DataFrame] = {}
+
+
+def _ladder(sc: Scenario, vehicle) -> pd.DataFrame:
+    """The convergence figure's errors over a ladder of steps up to what the road allows."""
+    key = (sc.vehicle, sc.x0, sc.road, sc.t_end, sc.methods)
+    if key not in _LADDERS:
+        if len(_LADDERS) >= 32:
+            _LADDERS.clear()
+        steps = ladder_steps(sc.t_end, h_range=(1e-4, min(0.2, sc.road.largest_step())))
+        _LADDERS[key] = error_ladder(
+            vehicle, sc.t_end, sc.x0, lambda T: sc.road_input(T)[0], sc.methods, steps
+        )
+    return _LADDERS[key]
 
 
 @functools.lru_cache(maxsize=32)
@@ -334,7 +345,7 @@ class _Page:
             sc = scenario_of(self.values)
             vehicle, T, U, _ = sc.problem()
             quick = quick_comparison(vehicle, T, sc.x0, U, sc.methods)
-            ladder = _ladder(sc.vehicle, sc.x0, sc.road, sc.t_end, sc.methods)
+            ladder = _ladder(sc, vehicle)
         except (ScenarioError, ValueError, TypeError) as exc:
             self.status.object = f'<p style="color:#b00">⚠ {_escape(str(exc))}</p>'
             self._stamp()
