@@ -176,8 +176,10 @@ def _boundary(method: str) -> list[np.ndarray]:
 # ------------------------------------------------------------------ the page
 
 
-def _figures(pn, methods: list[str]):
-    """The four Bokeh figures and their data sources, one source per method and figure."""
+def _figures():
+    """The four Bokeh figures, the exact response's source, the modes' points, the
+    current-h line and the legends; each method's lines are added when it is first
+    chosen (`_method_lines`): a figure paints every renderer it holds, used or not."""
     from bokeh.models import ColumnDataSource, Legend, Range1d, Span  # with Panel
     from bokeh.plotting import figure  # Bokeh comes with Panel (the explore extra)
 
@@ -204,42 +206,48 @@ def _figures(pn, methods: list[str]):
         **common,
     )
     region.x_range, region.y_range = Range1d(*_REGION_X), Range1d(*_REGION_Y)
-    sources: dict[str, dict[str, Any]] = {}
     exact = ColumnDataSource({"t": [], "y": []})
-    response.line("t", "y", source=exact, color="black", line_width=3, alpha=0.5)
-    items = {"response": [("exact (python-control)", [response.renderers[-1]])]}
-    for name in ("response", "error", "conv", "mark", "region"):
-        items.setdefault(name, [])
-    for i, method in enumerate(TABLEAUS):
-        color = _COLORS[i % len(_COLORS)]
-        src = {
-            k: ColumnDataSource({"x": [], "y": []}, name=f"{k}-{method}")
-            for k in ("response", "error", "conv")
-        }
-        src["mark"] = ColumnDataSource({"x": [], "y": []})
-        src["region"] = ColumnDataSource({"xs": [], "ys": []})
-        dash = "solid" if i % 2 == 0 else "dashed"
-        r1 = response.line("x", "y", source=src["response"], color=color, line_dash=dash)
-        r2 = error.line("x", "y", source=src["error"], color=color, line_dash=dash)
-        r3 = conv.line("x", "y", source=src["conv"], color=color, line_dash=dash)
-        conv.scatter("x", "y", source=src["conv"], color=color, size=4)
-        conv.scatter("x", "y", source=src["mark"], color=color, size=12, marker="diamond")
-        r4 = region.multi_line("xs", "ys", source=src["region"], color=color, line_width=2)
-        for key, renderer in (("response", r1), ("error", r2), ("conv", r3), ("region", r4)):
-            items[key].append((method, [renderer]))
-        sources[method] = src
+    line = response.line("t", "y", source=exact, color="black", line_width=3, alpha=0.5)
     points = ColumnDataSource({"x": [], "y": [], "mode": []})
     region.scatter("x", "y", source=points, color="black", size=9, marker="circle_x")
     now = Span(location=1e-3, dimension="height", line_color="gray", line_dash="dotted")
     conv.add_layout(now)
+    figs = {"response": response, "error": error, "conv": conv, "region": region}
     legends = {}
-    for key, fig in (("response", response), ("error", error), ("conv", conv), ("region", region)):
+    for key, fig in figs.items():
         legend = Legend(items=[], location="top_right", click_policy="hide")
         fig.add_layout(legend, "right")
-        legends[key] = (legend, dict(items[key]))
+        legends[key] = (legend, {"exact (python-control)": [line]} if key == "response" else {})
     shared = {"exact": exact, "points": points, "now": now, "legends": legends}
-    figs = {"response": response, "error": error, "conv": conv, "region": region}
-    return figs, sources, shared
+    return figs, shared
+
+
+def _method_lines(figs, legends, method: str) -> dict[str, Any]:
+    """A method's sources and lines in every figure, in its colour; its legend entries."""
+    from bokeh.models import ColumnDataSource  # with Panel (the explore extra)
+
+    i = list(TABLEAUS).index(method)
+    color, dash = _COLORS[i % len(_COLORS)], ("solid" if i % 2 == 0 else "dashed")
+    src = {
+        k: ColumnDataSource({"x": [], "y": []}, name=f"{k}-{method}")
+        for k in ("response", "error", "conv")
+    }
+    src["mark"] = ColumnDataSource({"x": [], "y": []})
+    src["region"] = ColumnDataSource({"xs": [], "ys": []})
+    style = dict(color=color, line_dash=dash)
+    lines = {
+        "response": figs["response"].line("x", "y", source=src["response"], **style),
+        "error": figs["error"].line("x", "y", source=src["error"], **style),
+        "conv": figs["conv"].line("x", "y", source=src["conv"], **style),
+        "region": figs["region"].multi_line(
+            "xs", "ys", source=src["region"], color=color, line_width=2
+        ),
+    }
+    figs["conv"].scatter("x", "y", source=src["conv"], color=color, size=4)
+    figs["conv"].scatter("x", "y", source=src["mark"], color=color, size=12, marker="diamond")
+    for key, renderer in lines.items():
+        legends[key][1][method] = [renderer]
+    return src
 
 
 def _legend_items(legends, chosen: list[str]):
@@ -275,13 +283,21 @@ class _Page:
     def __init__(self, pn, values: dict[str, Any]):
         self.pn = pn
         self.values = values
-        self.figs, self.sources, self.shared = _figures(pn, list(TABLEAUS))
+        self.figs, self.shared = _figures()
+        self.sources: dict[str, dict[str, Any]] = {}  # per method, once it was chosen
         self.widgets = _widgets(pn, values)
-        self.status = pn.pane.HTML("", sizing_mode="stretch_width", css_classes=["qc-status"])
-        self.verdicts = pn.pane.HTML("", css_classes=["qc-verdicts"])
-        self.handin = pn.pane.HTML("", css_classes=["qc-handin"])
-        self.modal = pn.pane.HTML("", css_classes=["qc-modes"])
-        self.distortion = pn.pane.HTML("", css_classes=["qc-distortion"])
+        # fixed heights: new text in a pane does not move the figures, which would
+        # then be laid out and painted again
+        scroll = {"overflow-y": "auto"}
+        self.status = pn.pane.HTML(
+            "", height=40, sizing_mode="stretch_width", css_classes=["qc-status"], styles=scroll
+        )
+        self.verdicts = pn.pane.HTML(
+            "", height=110, sizing_mode="stretch_width", css_classes=["qc-verdicts"], styles=scroll
+        )
+        self.handin = pn.pane.HTML("", height=190, css_classes=["qc-handin"], styles=scroll)
+        self.modal = pn.pane.HTML("", height=90, css_classes=["qc-modes"], styles=scroll)
+        self.distortion = pn.pane.HTML("", height=330, css_classes=["qc-distortion"], styles=scroll)
         self.toml = pn.widgets.TextAreaInput(
             name="scenario.toml (qc-control report --config scenario.toml)",
             height=260,
@@ -381,6 +397,9 @@ class _Page:
         error.yaxis.axis_label = f"|{label} error| [{unit}]"
         error.y_range.end = 10 * peak
         h = quick.h
+        for method in sc.methods:
+            if method not in self.sources:
+                self.sources[method] = _method_lines(self.figs, self.shared["legends"], method)
         for method, src in self.sources.items():
             chosen = method in sc.methods
             self._draw_method(method, src, quick, ladder, row, chosen)
