@@ -297,7 +297,7 @@ class _Page:
         )
         self.handin = pn.pane.HTML("", height=190, css_classes=["qc-handin"], styles=scroll)
         self.modal = pn.pane.HTML("", height=90, css_classes=["qc-modes"], styles=scroll)
-        self.distortion = pn.pane.HTML("", height=330, css_classes=["qc-distortion"], styles=scroll)
+        self.distortion = pn.pane.HTML("", height=300, css_classes=["qc-distortion"], styles=scroll)
         self.toml = pn.widgets.TextAreaInput(
             name="scenario.toml (qc-control report --config scenario.toml)",
             height=260,
@@ -452,7 +452,7 @@ class _Page:
         handin = handin.loc[:, ~handin.columns.duplicated()]
         self.handin.object = _table_html(handin)
         self.verdicts.object = "".join(
-            f'<p class="verdict" data-method="{m}"><b>{m}</b>: {verdict}</p>'
+            f'<p class="verdict" data-method="{m}" style="margin:2px 0"><b>{m}</b>: {verdict}</p>'
             for m, verdict in zip(sc.methods, table.loc[list(sc.methods), "verdict"].astype(str))
         )
         self.modal.object = _modal_html(sc.vehicle)
