@@ -35,9 +35,11 @@ browser = chromium.browser  # the module-scoped fixture
 pytest.importorskip("panel", reason="the explore extra (in the test extra) installs Panel")
 
 #: The redraw bound [ms] on the seed's scenario (10 s at 1 ms, four methods and the
-#: exact response). The issue asks for 300 ms on this machine; the median measured
-#: here is about 120 ms (docs/guide/explorer.md), so a loaded 2-core CI machine has
-#: more than 2x headroom before this fails.
+#: exact response): the issue's 300 ms. Measured here on a 2-core machine shared with
+#: other jobs (load average 4-7): medians of 256-306 ms, of which about 80 ms is the
+#: server's work (benchmarks/run.py --only explore) and about 100 ms the browser's
+#: painting; on an idle machine the margin is larger. A median over ten redraws, so
+#: one slow frame does not decide it.
 REDRAW_BOUND_MS = 300.0
 
 STAMP = """() => {
