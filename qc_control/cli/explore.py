@@ -417,15 +417,20 @@ class _Page:
 
     def _draw_method(self, method, src, quick, ladder, row, chosen) -> None:
         if not chosen:
-            for s in src.values():
-                if s.data and len(next(iter(s.data.values()))):
-                    s.data = {k: [] for k in s.data}
+            src.pop("ladder", None)
+            for key in ("response", "error", "conv", "mark"):
+                if len(src[key].data["x"]):
+                    src[key].data = {"x": [], "y": []}
+            if len(src["region"].data["xs"]):
+                src["region"].data = {"xs": [], "ys": []}
             return
         for key, curves in (("response", quick.outputs), ("error", quick.errors)):
             t, y = _shown(quick.T, curves[method][row])
             src[key].data = {"x": t, "y": y}
-        mine = ladder[ladder["method"] == method]
-        src["conv"].data = {"x": mine["h"].to_numpy(), "y": mine["error"].to_numpy()}
+        if src.get("ladder") is not ladder:  # a new ladder (not a new h): send it
+            mine = ladder[ladder["method"] == method]
+            src["conv"].data = {"x": mine["h"].to_numpy(), "y": mine["error"].to_numpy()}
+            src["ladder"] = ladder
         at_h = quick.table.loc[method, "max |xs err| [m]"]
         src["mark"].data = {"x": [quick.h], "y": [at_h]}
         if not len(src["region"].data["xs"]):
