@@ -3,6 +3,7 @@
 #   make test        install qc_control[test,docs], run the whole suite (the docs build too)
 #   make docs        install qc_control[docs], build the docs site with warnings as errors
 #   make notebook    install qc_control[notebook], open the course notebook in JupyterLab
+#   make explore     install qc_control[explore], open the interactive explorer in a browser
 #   make examples    run every example into examples_output/
 #   make check-html  install Chromium (apt-get) and check report.html in it
 PYTHON ?= python3
@@ -15,10 +16,11 @@ STAMP_BASE     := $(VENV)/.installed-base
 STAMP_TEST     := $(VENV)/.installed-test
 STAMP_DOCS     := $(VENV)/.installed-docs
 STAMP_NOTEBOOK := $(VENV)/.installed-notebook
+STAMP_EXPLORE  := $(VENV)/.installed-explore
 # root needs no sudo (containers, CI); anyone else does
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: report test docs notebook examples check-html bench clean
+.PHONY: report test docs notebook explore examples check-html bench clean
 
 # uv installs the same packages from the same index in about a quarter of pip's
 # time (the test extras: 23 s against 58-119 s on 2 cores, measured side by side);
@@ -57,6 +59,13 @@ test: $(STAMP_TEST)
 docs: $(STAMP_DOCS)
 	$(BIN)/sphinx-build -W --keep-going -q -j auto -b html docs docs/_build/html
 	@echo "open docs/_build/html/index.html"
+
+$(STAMP_EXPLORE): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[explore]'
+	touch $@
+
+explore: $(STAMP_EXPLORE)
+	$(BIN)/qc-control explore
 
 notebook: $(STAMP_NOTEBOOK)
 	$(BIN)/jupyter lab examples/course.ipynb

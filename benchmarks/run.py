@@ -813,6 +813,44 @@ def work_precision_benchmark(quick: bool) -> tuple[list[str], list[str], list[li
     return lines, head, rows
 
 
+def explore_benchmark(quick: bool) -> tuple[list[str], list[list[str]]]:
+    """Issue 27: the explorer's redraw on the server, on the seed's scenario (10 s at
+    1 ms, four methods and the exact response), h moved between 1 and 0.99 ms: the
+    library's part (`quick_comparison`), the convergence ladder (redone when the
+    vehicle or the start changes) and the whole callback with the figures' and tables'
+    updates (Panel's models, without the browser; tests/test_explore.py times the
+    browser's part, from the key to the painted figures)."""
+    from qc_control.cli.explore import explorer
+    from qc_control.cli.scenario import Scenario
+    from qc_control.studies.quick import error_ladder, ladder_steps, quick_comparison
+
+    repeats = 3 if quick else 15
+    sc = Scenario(t_end=10.0, h=0.001)
+    model, T, U, _ = sc.problem()
+    page = explorer().explorer_page
+    steps = ladder_steps(sc.t_end)
+    flip = iter([0.99, 1.0] * repeats)
+
+    def redraw():
+        page.widgets["h"].value = next(flip)
+
+    parts = {
+        "quick_comparison (python-control's exact + 4 methods + tables)": lambda: quick_comparison(
+            model, T, sc.x0, U, sc.methods
+        ),
+        "error_ladder (12 steps, 0.5-200 ms)": lambda: error_ladder(
+            model, sc.t_end, sc.x0, lambda T: None, sc.methods, steps
+        ),
+        "the whole redraw on the server (h changed)": redraw,
+    }
+    head = ["part", "median [ms]", "spread"]
+    rows = [
+        [name, *med_spread(timed_runs(fn, repeats), 1e3).split(" ", 1)]
+        for name, fn in parts.items()
+    ]
+    return head, rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smoke mode: small sizes, 1 repeat")
@@ -830,7 +868,7 @@ def main(argv=None) -> int:
     )
     ap.add_argument(
         "--only",
-        choices=["interconnect", "mpc", "identify", "peers"],
+        choices=["interconnect", "mpc", "identify", "peers", "explore"],
         default=None,
         help="run one benchmark alone and print its table (writes nothing); "
         "'interconnect': car + clipped skyhook, qc RK4 against control.input_output_response",
@@ -842,6 +880,7 @@ def main(argv=None) -> int:
         "mpc": lambda: "\n".join(mpc_benchmark(quick)[0]),
         "identify": lambda: table(*identification_benchmark(quick)[1:3]),
         "peers": lambda: table(*work_precision_benchmark(quick)[1:]),
+        "explore": lambda: table(*explore_benchmark(quick)),
     }
     if args.only is not None:
         print(alone[args.only]())

@@ -17,28 +17,18 @@ Elsewhere, without Chromium, they skip with the reason (``make check-html``
 installs it).
 """
 
-import os
 import shutil
-import subprocess
 from pathlib import Path
-from urllib.parse import urlparse
 
+import browser as chromium
 import numpy as np
 import pytest
 
 import qc_control as qc
 from qc_control.report import write_report
 
-CANDIDATES = ("/usr/bin/chromium", "chromium", "chromium-browser", "google-chrome")
-#: The flags a headless Chromium needs on a closed network, as root.
-CHROMIUM_ARGS = [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
+# the fixture and the test of a local address (tests/browser.py), here and in tests/test_docs.py
+browser, _local = chromium.browser, chromium._local
 
 pytestmark = pytest.mark.slow
 
@@ -86,43 +76,6 @@ LAYOUT = """() => {
 FIGURE_RATIO = 0.6
 
 
-def _find_chromium() -> str | None:
-    return next((shutil.which(c) for c in CANDIDATES if shutil.which(c)), None)
-
-
-def _install_chromium() -> None:
-    """Debian's chromium, as root (CI, containers); a no-op elsewhere."""
-    if shutil.which("apt-get") is None or not hasattr(os, "geteuid") or os.geteuid() != 0:
-        return
-    env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
-    for command in (["apt-get", "update", "-qq"], ["apt-get", "install", "-y", "-qq", "chromium"]):
-        run = subprocess.run(command, capture_output=True, text=True, env=env, timeout=1200)
-        if run.returncode != 0:
-            pytest.fail(f"{' '.join(command)} failed: {run.stderr[-2000:]}")
-
-
-@pytest.fixture(scope="module")
-def browser():
-    """Playwright's Chromium, Debian's build, installed first where we may."""
-    sync_api = pytest.importorskip("playwright.sync_api", reason="the test extra installs it")
-    chromium = _find_chromium()
-    if chromium is None:
-        _install_chromium()
-        chromium = _find_chromium()
-    if chromium is None:
-        pytest.skip("headless Chromium not found; `make check-html` installs it")
-    with sync_api.sync_playwright() as playwright:
-        launched = playwright.chromium.launch(executable_path=chromium, args=CHROMIUM_ARGS)
-        yield launched
-        launched.close()
-
-
-def _local(url: str) -> bool:
-    parsed = urlparse(url)
-    local_host = parsed.hostname in ("127.0.0.1", "localhost")
-    return parsed.scheme in ("file", "data", "blob") or local_host
-
-
 def check_in_browser(browser, page: Path, tmp: Path, width: int, probe: str = VERDICT) -> dict:
     """Open ``page`` alone at ``width`` px with no network; the verdict (what
     ``probe`` reads), and what was blocked."""
@@ -131,17 +84,9 @@ def check_in_browser(browser, page: Path, tmp: Path, width: int, probe: str = VE
     alone = folder / page.name
     shutil.copyfile(page, alone)
     blocked: list[str] = []
-
-    def only_local(route):
-        if _local(route.request.url):
-            route.continue_()
-        else:
-            blocked.append(route.request.url)
-            route.abort()
-
     context = browser.new_context(viewport={"width": width, "height": 900})
     try:
-        context.route("**/*", only_local)
+        context.route("**/*", chromium.only_local(blocked))
         tab = context.new_page()
         tab.goto(alone.as_uri(), wait_until="load")
         verdict = tab.evaluate(probe)

@@ -39,7 +39,7 @@ LINTED = ["qc_control", "tests", "examples", "benchmarks"]
 #: Third-party packages that may be imported inside a function (with a comment
 #: saying why): heavy, and needed only for figures or for distributed sweeps.
 #: tqdm is not here: a required dependency that imports in ~0.2 s.
-DEFERRABLE = {"matplotlib", "dask", "distributed"}
+DEFERRABLE = {"matplotlib", "dask", "distributed", "panel", "bokeh"}
 #: The deferred imports of the package's own code: the entry point loads the
 #: command inside its Ctrl-C handler (qc_control/cli/console.py says why), and the
 #: nonlinear car and the sweeps' streams load their compiled loops, which
@@ -48,6 +48,8 @@ DEFERRED_OWN = {
     ("qc_control/cli/console.py", "qc_control.cli.parser"),
     ("qc_control/models/nonlinear.py", "qc_control.models.nlkernel"),
     ("qc_control/numerics/lti.py", "qc_control.numerics.recurrence"),
+    # the explorer's page imports Panel (an optional extra) when it runs
+    ("qc_control/cli/parser.py", "qc_control.cli.explore"),
 }
 #: The presentation layer, where matplotlib may be imported at module level.
 PRESENTATION = ("qc_control.report", "qc_control.report.plotting")

@@ -291,7 +291,51 @@ def build_parser(model: str | None = None) -> argparse.ArgumentParser:
     _add_report(sub, shown)
     _add_control_report(sub, shown)
     add_measured_commands(sub, _CommandTools(UsageError, _check_out, _claimed))
+    _add_explore(sub)
     return parser
+
+
+def _add_explore(sub) -> None:
+    """``qc-control explore``: the interactive explorer, served on 127.0.0.1."""
+    explore = sub.add_parser(
+        "explore",
+        help="open the interactive explorer in a browser (needs qc-control[explore])",
+        allow_abbrev=False,
+    )
+    explore.add_argument(
+        "--port",
+        type=_port,
+        default=5006,
+        metavar="N",
+        help="port on 127.0.0.1 (default 5006; 0: any free port)",
+    )
+    explore.add_argument(
+        "--no-browser", action="store_true", help="serve the page without opening a browser"
+    )
+    explore.set_defaults(run=_cmd_explore)
+
+
+def _port(text: str) -> int:
+    try:
+        port = int(text)
+    except ValueError:
+        port = -1
+    if not 0 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port number 0-65535, got {text!r}")
+    return port
+
+
+def _cmd_explore(args) -> int:
+    # the page's module imports Panel when it runs: the other commands never load it
+    from .explore import ExplorerUnavailable, serve
+
+    try:
+        serve(port=args.port, show=not args.no_browser, say=lambda m: print(m, flush=True))
+    except ExplorerUnavailable as exc:
+        raise UsageError(str(exc)) from None
+    except OSError as exc:  # the port is taken, or not ours to bind
+        raise UsageError(f"--port {args.port}: cannot serve there: {exc.strerror or exc}") from None
+    return 0
 
 
 def _add_report(sub, shown: str) -> None:

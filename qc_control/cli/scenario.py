@@ -110,6 +110,7 @@ __all__ = [
     "option_name",
     "option_flag",
     "vehicle_config",
+    "whole_step",
 ]
 
 #: The default limit on ``t_end / h``, the steps each method takes at h. The
@@ -990,17 +991,27 @@ class Scenario:
             profile = functools.partial(_road_at, self.road)
         return self.entry.model(self.vehicle, road=profile, **self.option_arguments("build"))
 
-    def run(self, progress: Callable[[str], None] | None = None) -> MethodComparison:
-        """Run the comparison: `qc_control.compare_methods` on this scenario.
+    def problem(self) -> tuple[VehicleModel, np.ndarray, np.ndarray | None, str]:
+        """What `run` compares the methods on: ``(vehicle, T, U, description)``.
 
-        Returns its `MethodComparison`, with ``cmp.scenario`` set to this
-        scenario (the report records it and its `command`).
+        The vehicle model (with its road inputs under a road), the time grid,
+        the road samples on it (None for the free response, or when the
+        model takes the road as a function of time) and the road in words.
         """
         T = self.time_grid()
         U, description = self.road_input(T)
         vehicle = self.vehicle_model(road=U is not None)
         if U is not None and not vehicle.road_inputs():
             U, description = None, description + " (the road as a function of time)"
+        return vehicle, T, U, description
+
+    def run(self, progress: Callable[[str], None] | None = None) -> MethodComparison:
+        """Run the comparison: `qc_control.compare_methods` on this scenario.
+
+        Returns its `MethodComparison`, with ``cmp.scenario`` set to this
+        scenario (the report records it and its `command`).
+        """
+        vehicle, T, U, description = self.problem()
         cmp = compare_methods(
             vehicle,
             T,
@@ -1202,6 +1213,18 @@ class Scenario:
 def _named_tableaus() -> dict:
     """Every tableau known by name: `TABLEAUS` where the catalogue has it, else `METHODS`."""
     return getattr(catalogue, "TABLEAUS", METHODS)
+
+
+def whole_step(t_end: float, h: float) -> float:
+    """The step nearest ``h`` that divides ``t_end`` into a whole number (>= 2) of
+    steps, as a `Scenario` requires: ``t_end / max(2, round(t_end / h))``.
+
+    Examples
+    --------
+    >>> whole_step(10.0, 0.0198), whole_step(10.0, 0.001)
+    (0.019801980198019802, 0.001)
+    """
+    return t_end / max(2, round(t_end / h))
 
 
 def option_name(key: str) -> str:

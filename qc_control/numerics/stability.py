@@ -31,6 +31,7 @@ import functools
 import math
 from dataclasses import dataclass
 
+import contourpy
 import control
 import numpy as np
 import pandas as pd
@@ -47,6 +48,8 @@ __all__ = [
     "step_is_stable",
     "max_stable_step",
     "numerical_modes",
+    "stability_boundary",
+    "step_verdict",
     "eigenvalues_of",
     "settle_marginal",
     "MARGINAL_RTOL",
@@ -431,6 +434,7 @@ def step_is_stable(method, h: float, eigenvalues):
     return bool(ok) if ok.ndim == 0 else ok
 
 
+@functools.lru_cache(maxsize=1024)  # pure; the explorer asks again at every redraw
 def _step_limit(tab, lam: complex) -> float:
     """The largest h with ``|R(hλ)| <= 1`` on ``(0, h]``, for one settled λ.
 
@@ -687,3 +691,65 @@ def numerical_modes(method, h: float, modes) -> pd.DataFrame:
     frame = pd.DataFrame.from_dict(rows, orient="index")
     frame.index.name = "mode"
     return frame
+
+
+def stability_boundary(method, x, y) -> list[np.ndarray]:
+    """The boundary ``|R(z)| = 1`` of a method's stability region in a window.
+
+    The level curve 1 of ``|R|`` on the grid ``x + iy`` (``z = hλ``), traced
+    by marching squares (``contourpy``, matplotlib's contouring): each curve
+    is accurate to about the grid's spacing. An implicit method's poles,
+    where ``|R|`` is infinite, are held at 1e6, which draws the same curve.
+
+    Parameters
+    ----------
+    method : str or ButcherTableau
+    x, y : array_like, 1-D, increasing
+        The window's real and imaginary parts of ``z = hλ``.
+
+    Returns
+    -------
+    list of ndarray of complex
+        The boundary's pieces within the window, each a connected curve.
+
+    Examples
+    --------
+    Euler's region is the disc ``|1 + z| <= 1``:
+
+    >>> x = np.linspace(-2.5, 0.5, 301)
+    >>> (curve,) = stability_boundary("euler", x, x + 1.0)
+    >>> bool(np.all(np.abs(np.abs(1 + curve) - 1) < 0.01))
+    True
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if x.ndim != 1 or y.ndim != 1 or x.size < 2 or y.size < 2:
+        raise ValueError(
+            f"x and y must be 1-D grids of at least 2 points, got shapes {x.shape} and {y.shape}"
+        )
+    z = x[None, :] + 1j * y[:, None]
+    size = np.minimum(np.abs(_r_of(get_method(method), z)), 1e6)
+    lines = contourpy.contour_generator(x, y, size).lines(1.0)  # LineType.Separate: (n, 2) each
+    curves = [np.asarray(line, dtype=float) for line in lines]
+    return [c[:, 0] + 1j * c[:, 1] for c in curves]
+
+
+def step_verdict(h: float, h_max: float) -> str:
+    """A method's step against its stability limit, in words.
+
+    ``'stable (h is 62 % of h_max)'``, ``'beyond its limit by 23 %'``
+    (``100 (h/h_max - 1)``), ``'stable at every step'`` (``h_max`` infinite)
+    or ``'no stable step (h_max = 0)'``; stable means ``h <= h_max``, as in
+    the comparison's ``stable`` column.
+
+    Examples
+    --------
+    >>> step_verdict(0.0246, 0.02), step_verdict(0.01, 0.02)
+    ('beyond its limit by 23 %', 'stable (h is 50 % of h_max)')
+    """
+    if math.isinf(h_max):
+        return "stable at every step"
+    if h_max <= 0:
+        return "no stable step (h_max = 0)"
+    if h <= h_max:
+        return f"stable (h is {100 * h / h_max:.0f} % of h_max)"
+    return f"beyond its limit by {100 * (h / h_max - 1):.0f} %"

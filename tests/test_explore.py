@@ -1,0 +1,354 @@
+"""The explorer (``qc-control explore``) in a real browser, and its command.
+
+One server (``qc-control explore --no-browser --port 0``, a subprocess, as a
+student starts it) serves every browser test of this module: they share an
+xdist group. Chromium is Debian's (tests/browser.py), with every request
+that leaves 127.0.0.1 aborted and recorded. The page's numbers are checked
+against independent references: the Euler limit of the body mode from its
+closed form ``h = -2 Re λ / |λ|²``, the modes from `qc_control.modal_analysis`,
+and the report that the exported TOML reruns.
+
+A redraw is timed in the browser: from the Enter key that commits a new h
+to the second animation frame after the page's redraw stamp (a data source
+the server updates last, in the same message as the figures) changed, when
+the figures have been painted.
+"""
+
+import re
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import browser as chromium
+import numpy as np
+import pandas as pd
+import pytest
+
+import qc_control as qc
+from qc_control.cli.scenario import Scenario
+
+ROOT = Path(__file__).parent.parent
+browser = chromium.browser  # the module-scoped fixture
+
+pytest.importorskip("panel", reason="the explore extra (in the test extra) installs Panel")
+
+#: The redraw bound [ms] on the seed's scenario (10 s at 1 ms, four methods and the
+#: exact response): the issue's 300 ms. Measured here on a 2-core machine shared with
+#: other jobs (load average 4-7): medians of 256-306 ms, of which about 80 ms is the
+#: server's work (benchmarks/run.py --only explore) and about 100 ms the browser's
+#: painting; on an idle machine the margin is larger. A median over ten redraws, so
+#: one slow frame does not decide it.
+REDRAW_BOUND_MS = 300.0
+
+STAMP = """() => {
+  const doc = window.Bokeh && Bokeh.documents[0];
+  const m = doc && doc.get_model_by_name('qc-redraw-stamp');
+  return m ? m.data.n[0] : null;
+}"""
+
+#: Resolves, after the Enter key, once the stamp has moved past ``before`` and two
+#: frames were drawn: the time [ms] from the key to then.
+TIMED = """(before) => new Promise(resolve => {
+  const m = Bokeh.documents[0].get_model_by_name('qc-redraw-stamp');
+  const wait = () => {
+    if (window.__t0 !== undefined && m.data.n[0] > before) {
+      const done = () => resolve(performance.now() - window.__t0);
+      requestAnimationFrame(() => requestAnimationFrame(done));
+    } else {
+      requestAnimationFrame(wait);
+    }
+  };
+  wait();
+})"""
+
+#: An HTML table's rows as lists of cell texts.
+TABLE = "t => Array.from(t.rows).map(r => Array.from(r.cells).map(c => c.innerText.trim()))"
+
+ARM = """() => {
+  delete window.__t0;
+  window.addEventListener('keydown', e => {
+    if (e.key === 'Enter' && window.__t0 === undefined) window.__t0 = performance.now();
+  }, {capture: true, once: true});
+}"""
+
+
+@pytest.fixture(scope="module")
+def server():
+    """``qc-control explore --no-browser --port 0``: its address, once it says it."""
+    exe = Path(sys.executable).with_name("qc-control")
+    command = [str(exe)] if exe.exists() else [sys.executable, "-m", "qc_control.cli.console"]
+    proc = subprocess.Popen(
+        [*command, "explore", "--no-browser", "--port", "0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    url, seen = None, []
+    deadline = time.monotonic() + 120
+    while url is None and time.monotonic() < deadline:
+        line = proc.stdout.readline()
+        if not line:
+            break
+        seen.append(line)
+        match = re.search(r"qc-control explore: serving (http://127\.0\.0\.1:\d+/)", line)
+        url = match.group(1) if match else None
+    if url is None:
+        proc.kill()
+        pytest.fail("the explorer did not say its address:\n" + "".join(seen))
+    yield url
+    proc.terminate()
+    try:
+        proc.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+
+
+class Page:
+    """One tab on the explorer, with what it blocked, what failed and what it logged."""
+
+    def __init__(self, browser, url: str, width: int = 1280):
+        self.blocked: list[str] = []
+        self.failed: list[str] = []
+        self.errors: list[str] = []
+        self.context = browser.new_context(viewport={"width": width, "height": 900})
+        self.context.route("**/*", chromium.only_local(self.blocked))
+        self.tab = self.context.new_page()
+        self.tab.on("requestfailed", lambda r: self.failed.append(f"{r.url}: {r.failure}"))
+        self.tab.on("pageerror", lambda e: self.errors.append(str(e)))
+        self.tab.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
+        self.tab.goto(url, wait_until="networkidle")
+        self.tab.wait_for_function(f"({STAMP})() >= 1", timeout=60_000)
+        self.tab.locator(".qc-status p").first.wait_for(timeout=60_000)
+
+    def stamp(self) -> int:
+        return self.tab.evaluate(STAMP)
+
+    def enter(self, css: str, value) -> float:
+        """Type ``value`` into the input of the widget ``css``, press Enter, wait for
+        the redraw; the time [ms] from the key to the figures painted."""
+        before = self.stamp()
+        box = self.tab.locator(f"{css} input")
+        box.fill(str(value))
+        self.tab.evaluate(ARM)
+        box.press("Enter")
+        return self.tab.evaluate(TIMED, before)
+
+    def text(self, css: str) -> str:
+        """The text of the HTML pane ``css`` (its paragraphs and preformatted blocks)."""
+        return "\n".join(self.tab.locator(f"{css} p, {css} pre").all_inner_texts())
+
+    def curve(self, name: str) -> np.ndarray:
+        js = f"() => Array.from(Bokeh.documents[0].get_model_by_name('{name}').data.y)"
+        return np.array(self.tab.evaluate(js), dtype=float)
+
+    def table(self, css: str) -> pd.DataFrame:
+        """The HTML table of the pane ``css``: its header row, and one row per index."""
+        rows = self.tab.locator(f"{css} table").first.evaluate(TABLE)
+        # pandas' second header row holds only the index's name: not a row of numbers
+        header = rows[0]
+        body = [r for r in rows[1:] if len(r) == len(header) and any(r[1:])]
+        frame = pd.DataFrame([r[1:] for r in body], index=[r[0] for r in body], columns=header[1:])
+        for column in frame.columns:
+            try:
+                frame[column] = pd.to_numeric(frame[column])
+            except ValueError:  # words: the mode that limits, a verdict
+                pass
+        return frame
+
+    def close(self):
+        self.context.close()
+
+
+@pytest.fixture
+def page(browser, server):
+    tab = Page(browser, server)
+    yield tab
+    tab.close()
+
+
+def verdict(page: Page, method: str) -> str:
+    return page.tab.locator(f'.qc-verdicts p[data-method="{method}"]').inner_text()
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("explore")
+def test_the_page_loads_with_nothing_from_outside_and_no_error(page):
+    assert page.blocked == []  # every script, style and font from 127.0.0.1
+    assert page.failed == []
+    assert page.errors == []
+    assert "10,000 steps of h = 1 ms" in page.text(".qc-status")
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("explore")
+def test_euler_crosses_its_limit_at_19_8_ms_and_diverges_while_rk4_holds(page):
+    body = qc.modal_analysis(qc.QuarterCarParams()).body.eigenvalue
+    h_max = -2 * body.real / abs(body) ** 2  # Euler's |1 + hλ| = 1 on the body mode
+    assert 0.0198 < h_max < 0.0199
+    page.enter(".qc-h", 19.0)
+    assert verdict(page, "euler").startswith("euler: stable")
+    assert verdict(page, "rk4").startswith("rk4: stable")
+    below = page.curve("response-euler")
+    page.enter(".qc-h", 21.0)
+    h = 10.0 / round(10.0 / 0.021)  # the page's step: a whole number over 10 s
+    assert verdict(page, "euler") == f"euler: beyond its limit by {100 * (h / h_max - 1):.0f} %"
+    assert verdict(page, "rk4").startswith("rk4: stable")
+    above, rk4 = page.curve("response-euler"), page.curve("response-rk4")
+    tail = lambda y: np.max(np.abs(y[-len(y) // 5 :]))  # the last 2 s
+    early = lambda y: np.max(np.abs(y[len(y) // 5 : 2 * len(y) // 5]))  # 2-4 s
+    assert tail(below) < early(below)  # inside the limit, Euler's response decays
+    assert tail(above) > early(above)  # beyond it, it grows
+    # RK4 decays as the car does: the body mode's e^(-0.46 t) over the 2.5 s between
+    # the windows' peaks is 0.3; a fifth leaves room for where the peaks fall
+    assert tail(rk4) < 0.5 * early(rk4)
+    assert page.errors == []
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("explore")
+def test_a_new_body_mass_gives_modal_analysis_modes(page):
+    page.enter(".qc-ms", 400.0)
+    shown = page.table(".qc-modes")
+    exact = qc.modal_analysis(qc.QuarterCarParams(ms=400.0)).to_frame()
+    for column in ("fn [Hz]", "zeta [-]", "fd [Hz]"):
+        # the page prints 4 significant digits: agreement to half a unit in the 4th
+        np.testing.assert_allclose(shown[column], exact[column], rtol=5e-4)
+    assert shown.loc["body bounce", "fn [Hz]"] != pytest.approx(1.087, rel=1e-3)  # it moved
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("explore")
+def test_the_exported_toml_reruns_with_the_report_and_its_errors(page, tmp_path):
+    page.enter(".qc-t_end", 2.0)
+    page.enter(".qc-h", 10.0)
+    page.tab.get_by_role("button", name="Export scenario (TOML + command)").click()
+    area = page.tab.locator(".qc-toml textarea")
+    page.tab.wait_for_function(
+        "el => el.value.length > 0", arg=area.element_handle(), timeout=10_000
+    )
+    toml = area.input_value()
+    expected = Scenario(t_end=2.0, h=0.01, x0=(0.0, 0.0, 0.05, 0.0))
+    assert toml == expected.to_toml()
+    assert "qc-control report --config scenario.toml" in page.text(".qc-command")
+    assert expected.command() in page.text(".qc-command")
+    config = tmp_path / "scenario.toml"
+    config.write_text(toml, encoding="utf-8")
+    exe = Path(sys.executable).with_name("qc-control")
+    run = subprocess.run(
+        [str(exe), "report", "--config", str(config), "--out", str(tmp_path / "r"), "-q"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert run.returncode == 0, run.stderr
+    report = pd.read_csv(tmp_path / "r" / "methods.csv", index_col=0)
+    shown = page.table(".qc-handin")
+    # the page prints 4 significant digits of the same numbers
+    np.testing.assert_allclose(
+        shown["max |xs err| [m]"], report.loc[shown.index, "max |xs err| [m]"], rtol=5e-4
+    )
+    assert (shown["RHS evals"] == report.loc[shown.index, "RHS evals"]).all()
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("explore")
+def test_the_url_carries_the_state(page, browser):
+    page.enter(".qc-h", 21.0)
+    page.tab.wait_for_function("() => location.search.includes('h=21')", timeout=10_000)
+    again = Page(browser, page.tab.url)
+    try:
+        assert again.tab.locator(".qc-h input").input_value() == "21"
+        assert "beyond its limit" in verdict(again, "euler")
+    finally:
+        again.close()
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("explore")
+def test_a_run_of_more_than_a_million_steps_is_refused_with_the_commands_message(page):
+    page.enter(".qc-t_end", 200.0)
+    page.enter(".qc-h", 0.1)
+    text = page.text(".qc-status")
+    with pytest.raises(ValueError) as refusal:
+        Scenario(t_end=200.0, h=1e-4, max_steps=1_000_000)
+    assert " ".join(str(refusal.value).split()) in " ".join(text.split())
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("explore")
+def test_a_redraw_of_the_seed_scenario_takes_under_300_ms_in_the_browser(page):
+    assert "10,000 steps of h = 1 ms over 0–10 s" in page.text(".qc-status")
+    times = [page.enter(".qc-h", h) for h in (0.99, 1.0) * 5]  # the seed's 10 s near 1 ms
+    median = statistics.median(times)
+    print(f"redraw in the browser: median {median:.0f} ms of {[round(t) for t in times]}")
+    assert median < REDRAW_BOUND_MS, times
+
+
+def test_the_package_and_the_other_commands_do_not_import_panel():
+    code = (
+        "import sys, qc_control, qc_control.cli.parser, qc_control.cli.explore; "
+        "qc_control.compare_methods; print('panel' in sys.modules)"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert run.stdout.strip() == "False"
+
+
+def test_without_panel_the_command_says_which_extra_to_install():
+    code = (
+        "import sys; sys.modules['panel'] = None\n"
+        "from qc_control.cli.console import main\n"
+        "sys.exit(main(['explore', '--no-browser']))"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 2
+    assert run.stderr.strip().splitlines() == [
+        "qc-control: error: qc-control explore needs Panel, which is not installed: "
+        "pip install 'qc-control[explore]'"
+    ]
+
+
+def test_a_bad_port_is_one_line_and_status_2():
+    exe = Path(sys.executable).with_name("qc-control")
+    run = subprocess.run([str(exe), "explore", "--port", "http"], capture_output=True, text=True)
+    assert run.returncode == 2
+    assert run.stderr.strip() == (
+        "qc-control: error: argument --port: expected a port number 0-65535, got 'http'"
+    )
+
+
+def test_make_explore_installs_the_extra_and_runs_the_command():
+    if subprocess.run(["make", "--version"], capture_output=True).returncode != 0:
+        pytest.skip("no make on this machine")
+    text = subprocess.run(
+        ["make", "-n", "-B", "explore"], cwd=ROOT, capture_output=True, text=True, check=True
+    ).stdout
+    assert "pip install --quiet -e '.[explore]'" in text
+    assert "qc-control explore" in text
+    assert "touch .venv/.installed-explore" in text
+
+
+@pytest.mark.slow
+def test_every_road_redraws_and_a_too_coarse_step_gets_the_scenarios_message():
+    from qc_control.cli.explore import explorer
+
+    page = explorer().explorer_page
+    for road in ("step", "bump", "sine", "iso8608"):
+        page.widgets["road"].value = road
+        sc = page.scenario
+        assert sc.road.kind == road and sc.x0 == (0.0, 0.0, 0.0, 0.0)  # at rest under a road
+        assert sc.road.describe() in page.status.object
+    page.widgets["road"].value = "bump"
+    page.widgets["h"].value = 20.0  # the 1 m bump at 20 m/s lasts 50 ms: 4 steps need 12.5 ms
+    with pytest.raises(ValueError) as refusal:
+        Scenario(road={"kind": "bump"}, h=0.02)
+    assert html_text(str(refusal.value).split("] ", 1)[1]) in page.status.object
+    page.widgets["h"].value = None
+    assert "h must be given: the box is empty" in page.status.object
+
+
+def html_text(text: str) -> str:
+    import html
+
+    return html.escape(text)
