@@ -61,7 +61,7 @@ docs: $(STAMP_DOCS)
 	@echo "open docs/_build/html/index.html"
 
 $(STAMP_EXPLORE): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e '.[explore]'
+	$(UV) -e '.[explore]' || $(PIP) -e '.[explore]'
 	touch $@
 
 explore: $(STAMP_EXPLORE)
