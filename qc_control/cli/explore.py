@@ -544,7 +544,7 @@ def _stamp_holder(stamp):
 
 
 #: A curve longer than this is drawn from its extremes per stretch (`_shown`).
-_DRAWN = 2000
+_DRAWN = 1000
 
 
 def _shown(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
