@@ -230,6 +230,9 @@ def test_the_exported_toml_reruns_with_the_report_and_its_errors(page, tmp_path)
     page.tab.wait_for_function(
         "el => el.value.length > 0", arg=area.element_handle(), timeout=10_000
     )
+    # the command is a pane of its own: its update may land a message after the TOML's
+    command = page.tab.locator(".qc-command p, .qc-command pre").filter(has_text="--config")
+    command.first.wait_for(timeout=10_000)
     toml = area.input_value()
     expected = Scenario(t_end=2.0, h=0.01, x0=(0.0, 0.0, 0.05, 0.0))
     assert toml == expected.to_toml()

@@ -36,3 +36,29 @@ def test_the_package_is_marked_typed_and_the_marker_ships():
     extras = " ".join(config["project"]["optional-dependencies"]["test"])
     for tool in ("pytest-xdist", "build", "twine"):
         assert re.search(rf"\b{tool}\b", extras), tool
+
+
+@pytest.mark.slow  # two xdist workers start: about 3 s
+def test_a_group_stays_on_one_worker(tmp_path):
+    """`--dist loadgroup` sends a group's tests to one worker (each writes which),
+    so that the docs build and the notebook run happen once per suite, not once
+    per worker. pytest 9.2 with pytest-xdist 3.8 splits them (pytest-xdist #1386)."""
+    pytest.importorskip("xdist", reason="the test extra installs pytest-xdist")
+    (tmp_path / "test_grouped.py").write_text(
+        "import os, pytest\n"
+        "@pytest.mark.xdist_group('g')\n"
+        "@pytest.mark.parametrize('i', range(6))\n"
+        "def test_in_group(i, tmp_path_factory):\n"
+        "    worker = os.environ.get('PYTEST_XDIST_WORKER', 'none')\n"
+        "    (tmp_path_factory.getbasetemp().parent.parent / f'ran-{i}-{worker}').touch()\n",
+        encoding="utf-8",
+    )
+    run = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-n", "2", "--dist", "loadgroup", "-p",
+         "no:cacheprovider", "--basetemp", str(tmp_path / "base"), "test_grouped.py"],
+        cwd=tmp_path, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stdout + run.stderr
+    workers = {p.name.rsplit("-", 1)[1] for p in tmp_path.glob("ran-*")}
+    assert len(list(tmp_path.glob("ran-*"))) == 6
+    assert len(workers) == 1, f"the group ran on {sorted(workers)}"
