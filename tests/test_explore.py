@@ -336,6 +336,7 @@ def test_a_redraw_of_the_seed_scenario_takes_under_300_ms_in_the_browser(page):
     assert median < REDRAW_BOUND_MS, times
 
 
+@pytest.mark.slow  # a fresh interpreter imports the package and Panel: about 2.5 s
 def test_the_package_and_the_other_commands_do_not_import_panel():
     code = (
         "import sys, qc_control, qc_control.cli.parser, qc_control.cli.explore; "
@@ -345,6 +346,7 @@ def test_the_package_and_the_other_commands_do_not_import_panel():
     assert run.stdout.strip() == "False"
 
 
+@pytest.mark.slow  # a fresh interpreter imports the package and Panel: about 2.5 s
 def test_without_panel_the_command_says_which_extra_to_install():
     code = (
         "import sys; sys.modules['panel'] = None\n"
@@ -359,6 +361,7 @@ def test_without_panel_the_command_says_which_extra_to_install():
     ]
 
 
+@pytest.mark.slow  # a fresh interpreter imports the package and Panel: about 2.5 s
 def test_a_bad_port_is_one_line_and_status_2():
     exe = Path(sys.executable).with_name("qc-control")
     run = subprocess.run([str(exe), "explore", "--port", "http"], capture_output=True, text=True)

@@ -54,6 +54,7 @@ def test_preformatted_text_scrolls_rather_than_wraps_a_row():
     assert re.search(r"pre \{[^}]*white-space: pre;", _CSS)
 
 
+@pytest.mark.slow  # a whole report with its PDF: about 4 s
 def test_a_wide_table_in_the_pdf_splits_into_column_groups_not_below_7_pt(tmp_path, monkeypatch):
     import pandas as pd
 
