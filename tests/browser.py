@@ -11,9 +11,12 @@ tests/test_docs.py (the built site) and tests/test_explore.py (the explorer).
 import os
 import shutil
 import subprocess
+import tempfile
+from pathlib import Path
 from urllib.parse import urlparse
 
 import pytest
+from filelock import FileLock
 
 CANDIDATES = ("/usr/bin/chromium", "chromium", "chromium-browser", "google-chrome")
 #: The flags a headless Chromium needs on a closed network, as root.
@@ -36,7 +39,11 @@ def _install_chromium() -> None:
     if shutil.which("apt-get") is None or not hasattr(os, "geteuid") or os.geteuid() != 0:
         return
     env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
-    for command in (["apt-get", "update", "-qq"], ["apt-get", "install", "-y", "-qq", "chromium"]):
+    wait = ["-o", "DPkg::Lock::Timeout=600"]  # another apt run (the machine's own) holds dpkg
+    for command in (
+        ["apt-get", *wait, "update", "-qq"],
+        ["apt-get", *wait, "install", "-y", "-qq", "chromium"],
+    ):
         run = subprocess.run(command, capture_output=True, text=True, env=env, timeout=1200)
         if run.returncode != 0:
             pytest.fail(f"{' '.join(command)} failed: {run.stderr[-2000:]}")
@@ -48,7 +55,11 @@ def browser():
     sync_api = pytest.importorskip("playwright.sync_api", reason="the test extra installs it")
     chromium = _find_chromium()
     if chromium is None:
-        _install_chromium()
+        # the suite's workers may reach this at once (the report's, the site's and the
+        # explorer's tests run on different workers): one installs, the others wait
+        with FileLock(Path(tempfile.gettempdir()) / "qc-control-chromium-install.lock"):
+            if _find_chromium() is None:
+                _install_chromium()
         chromium = _find_chromium()
     if chromium is None:
         pytest.skip("headless Chromium not found; `make check-html` installs it")
