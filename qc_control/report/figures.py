@@ -28,7 +28,7 @@ from matplotlib.patches import Rectangle
 from matplotlib.ticker import NullFormatter
 
 from ..models.registry import model_for_params, model_for_system
-from ..numerics.stability import stability_function
+from ..numerics.stability import stability_boundary
 from .findings import coincidence_groups
 from .plotting import output_signal, output_unit
 
@@ -412,18 +412,10 @@ def work_precision_figure(cmp) -> Figure:
 
 
 def _regions(ax, cmp, x, y, colors, rank):
-    Z = x[None, :] + 1j * y[:, None]
     for tab in cmp.methods:
-        ax.contour(
-            x,
-            y,
-            # a pole of an implicit method's R is inf: any value above 1 draws the same line
-            np.minimum(np.abs(stability_function(tab)(Z)), 1e6),
-            levels=[1.0],
-            colors=[colors[tab.name]],
-            linewidths=1.5,
-            linestyles=[_OVERLAY_STYLES[rank[tab.name] % len(_OVERLAY_STYLES)]],
-        )
+        style = _OVERLAY_STYLES[rank[tab.name] % len(_OVERLAY_STYLES)]
+        for curve in stability_boundary(tab, x, y):
+            ax.plot(curve.real, curve.imag, color=colors[tab.name], lw=1.5, ls=style)
 
 
 def _modes(ax, cmp, size=6):

@@ -59,6 +59,7 @@ __all__ = [
     "exact_reference",
     "sampled_reference",
     "method_responses",
+    "max_error",
     "error_table",
     "convergence_study",
     "ConvergencePoint",
@@ -512,8 +513,9 @@ class _Refinement(NamedTuple):
 _RefinementRun = Callable[[ButcherTableau, int, np.ndarray, np.ndarray | None], _Refinement]
 
 
-def _max_error(y: np.ndarray, reference: np.ndarray, samples: int) -> float:
-    """Largest |y - reference|; infinite for a run cut short by a divergence."""
+def max_error(y: np.ndarray, reference: np.ndarray, samples: int) -> float:
+    """Largest ``|y - reference|`` over ``samples`` samples; infinite for a run cut
+    short by a divergence (fewer samples) or one that overflowed."""
     if y.size != samples:
         return math.inf
     # a run that overflowed is infinitely wrong, whatever its samples' arithmetic gives
@@ -553,7 +555,7 @@ def _convergence_points(
                 steps=response.steps,
                 nfev=response.nfev,
                 time=refinement.seconds,
-                error=_max_error(y, refinement.reference, Tl.size),
+                error=max_error(y, refinement.reference, Tl.size),
                 stable=h / 2**level <= h_max,
             )
         )
