@@ -15,7 +15,7 @@ findings and each one's cost to bring the ride metric within 1 %; writes
 ``stiff_evaluations.png`` and ``stiff_time.png``.
 
 Run: ``python examples/stiff_car.py [OUT_DIR]`` (default ``./stiff_car_output``).
-It drives 5 s of road, which shows the lesson in well under a minute;
+It drives 2 s (40 m) of road, which shows the lesson in seconds;
 ``qc-control report --scenario stiff`` runs the scenario's full 60 s.
 """
 
@@ -24,7 +24,7 @@ from qc_control.report.peers import peer_findings, peers_figure, ride_cost_findi
 from qc_control.studies.scenarios import StiffCar, stiff_car_comparison
 
 out = output_folder("stiff_car")  # OUT_DIR from the command line, if any
-t_end = 5.0  # seconds of road
+t_end = 2.0  # seconds of road
 print(f"writing into {out.resolve()}")
 
 cmp = stiff_car_comparison(
