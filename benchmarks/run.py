@@ -134,8 +134,8 @@ def slope(xs, ys) -> float:
 def sweep_comparison(T, quick: bool):
     """Free and road-step sweeps of the ks × ζ grid against loops of control calls.
 
-    Medians of at least 5 runs on each side, side by side (alternating). The
-    loop's time per design does not depend on the design, so each run times
+    Medians of 5 runs on each side (one in the smoke mode), side by side
+    (alternating). The loop's time per design does not depend on the design, so each run times
     every 10th design and scales by 10 (stated in the table).
     """
     n_ks, n_zeta = (4, 5) if quick else (40, 25)
@@ -159,7 +159,7 @@ def sweep_comparison(T, quick: bool):
             "≥ 100",
         ),
     }
-    runs = 5
+    runs = 1 if quick else 5  # the smoke mode: one repeat (--help), same code paths
     rows = []
     for name, (ours, theirs, target) in cases.items():
         t_ours, t_loop, ratios = in_turns(ours, theirs, runs, wall_time)
@@ -199,7 +199,7 @@ def memory_and_spectral(T, quick: bool):
         rows.append([name, str(n * n), str(T.size), med_spread(times), g(peak_memory(fn))])
     road = qc.ISO8608Road("C", speed=20.0)
     spectral = lambda: sweep(grid, road=road)  # noqa: E731
-    times = timed_runs(spectral, 5)
+    times = timed_runs(spectral, 1 if quick else 5)
     rows.append(
         [
             "spectral, ISO 8608 C at 20 m/s (exact)",
@@ -233,7 +233,7 @@ def scaling(quick: bool, out_dir: Path):
         U = np.where(T >= 0.05 * T[-1], 0.05, 0.0)
         ks = np.linspace(15e3, 45e3, m)
         fn = lambda: sweep({"ks": ks}, T, np.zeros(4), U=U, progress=False)  # noqa: E731
-        times = timed_runs(fn, 3 if m * N <= 10**7 else 1)
+        times = timed_runs(fn, 3 if m * N <= 10**7 and not quick else 1)
         return statistics.median(times), peak_memory(fn)
 
     by_designs = [run(m, base_samples) for m in designs_axis]
@@ -824,7 +824,7 @@ def explore_benchmark(quick: bool) -> tuple[list[str], list[list[str]]]:
     from qc_control.cli.scenario import Scenario
     from qc_control.studies.quick import error_ladder, ladder_steps, quick_comparison
 
-    repeats = 3 if quick else 15
+    repeats = 1 if quick else 15
     sc = Scenario(t_end=10.0, h=0.001)
     model, T, U, _ = sc.problem()
     page = explorer().explorer_page
@@ -998,7 +998,7 @@ def main(argv=None) -> int:
     ]
 
     # -- 2. generic stepper against hand-written loops (Python f)
-    head, rows, text = loop_comparison(f, T, 3 if quick else 15)
+    head, rows, text = loop_comparison(f, T, 1 if quick else 15)
     md += [
         "### The generic stepper against a hand-written loop",
         "",
@@ -1097,7 +1097,8 @@ def main(argv=None) -> int:
         f"{n_designs} designs (ks × ζ grid), RK4 at h = {h * 1e3:g} ms, {n_samples} samples; "
         f"the sweep computes its {len(DEFAULT_METRICS)} default metrics per design "
         f"({', '.join(DEFAULT_METRICS)}), streamed; the loop only calls control (systems "
-        "built beforehand). Medians of 5 runs on each side, alternating, with (min–max); "
+        f"built beforehand). Medians of {1 if quick else 5} runs on each side, alternating, "
+        "with (min–max); "
         "the ratio is the median of the runs' ratios.",
         "",
         table(head, rows),

@@ -16,7 +16,10 @@ import qc_control as qc
 
 SCRIPT = Path(__file__).parent.parent / "benchmarks" / "run.py"
 
-pytestmark = pytest.mark.slow  # the quick benchmark run takes about 8 s
+#: slow: the quick benchmark run takes about 12 s. One xdist group: every test here
+#: reads the one run of the module's fixture; spread over two workers, each worker
+#: ran the benchmark script itself (measured: 13.6 s and 13.1 s of setup in a 2-worker run)
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("benchmarks")]
 
 
 def _cells(line: str) -> list[str]:
@@ -136,3 +139,20 @@ def test_nonlinear_sweep_benchmark_table(results):
         ratio = float(row["ratio (target ≥ 300)"])
         assert math.isfinite(ratio) and ratio > 0
         assert float(row["batch vs qc.input_output_response (rel.)"]) < 1e-12
+
+
+def test_the_work_precision_table_names_every_run_and_rk4_is_its_own_unit(results):
+    """The benchmark's work–precision section (its ratios are its own business):
+    every row names a run, and RK4's own ratios (evaluations and time against
+    RK4) are 1 in both cars. Read from the module's one smoke run, which writes the
+    section as ``--only peers`` prints it (the same `work_precision_benchmark` table)."""
+    rows = _table(results, "seed car evals/rk4")
+    assert all(row["run"] for row in rows)
+    (rk4,) = [row for row in rows if row["run"] == "rk4"]
+    columns = (
+        "seed car evals/rk4",
+        "seed car time/rk4",
+        "stiff car evals/rk4",
+        "stiff car time/rk4",
+    )
+    assert [rk4[c] for c in columns] == ["1"] * 4

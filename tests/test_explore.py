@@ -29,6 +29,7 @@ import pandas as pd
 import pytest
 
 import qc_control as qc
+from qc_control.cli.console import main
 from qc_control.cli.scenario import Scenario
 
 ROOT = Path(__file__).parent.parent
@@ -240,14 +241,10 @@ def test_the_exported_toml_reruns_with_the_report_and_its_errors(page, tmp_path)
     assert expected.command() in page.text(".qc-command")
     config = tmp_path / "scenario.toml"
     config.write_text(toml, encoding="utf-8")
-    exe = Path(sys.executable).with_name("qc-control")
-    run = subprocess.run(
-        [str(exe), "report", "--config", str(config), "--out", str(tmp_path / "r"), "-q"],
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
-    assert run.returncode == 0, run.stderr
+    # the page's command, by the entry point's function in this process: the
+    # numbers are what is compared, not a new interpreter (a subprocess cost ~6 s of CPU)
+    status = main(["report", "--config", str(config), "--out", str(tmp_path / "r"), "-q"])
+    assert status == 0
     report = pd.read_csv(tmp_path / "r" / "methods.csv", index_col=0)
     shown = page.table(".qc-handin")
     # the page prints 4 significant digits of the same numbers
@@ -346,27 +343,23 @@ def test_the_package_and_the_other_commands_do_not_import_panel():
     assert run.stdout.strip() == "False"
 
 
-@pytest.mark.slow  # a fresh interpreter imports the package and Panel: about 2.5 s
-def test_without_panel_the_command_says_which_extra_to_install():
-    code = (
-        "import sys; sys.modules['panel'] = None\n"
-        "from qc_control.cli.console import main\n"
-        "sys.exit(main(['explore', '--no-browser']))"
-    )
-    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert run.returncode == 2
-    assert run.stderr.strip().splitlines() == [
+def test_without_panel_the_command_says_which_extra_to_install(monkeypatch, capsys):
+    # in this process: ``sys.modules['panel'] = None`` makes ``import panel`` raise
+    # ImportError whether or not Panel was imported before (as where it is not
+    # installed), and the explorer imports it only when the page is made
+    monkeypatch.setitem(sys.modules, "panel", None)
+    assert main(["explore", "--no-browser"]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
         "qc-control: error: qc-control explore needs Panel, which is not installed: "
         "pip install 'qc-control[explore]'"
     ]
 
 
-@pytest.mark.slow  # a fresh interpreter imports the package and Panel: about 2.5 s
-def test_a_bad_port_is_one_line_and_status_2():
-    exe = Path(sys.executable).with_name("qc-control")
-    run = subprocess.run([str(exe), "explore", "--port", "http"], capture_output=True, text=True)
-    assert run.returncode == 2
-    assert run.stderr.strip() == (
+def test_a_bad_port_is_one_line_and_status_2(capsys):
+    # the entry point's own function, in this process: what is checked is its
+    # status and its stderr, not a new interpreter (a subprocess cost ~4 s of CPU)
+    assert main(["explore", "--port", "http"]) == 2
+    assert capsys.readouterr().err.strip() == (
         "qc-control: error: argument --port: expected a port number 0-65535, got 'http'"
     )
 

@@ -122,27 +122,6 @@ def test_report_has_both_figures_and_the_findings(study, tmp_path):
     assert build_blocks(cmp)
 
 
-@pytest.mark.slow
-def test_the_benchmark_runs_the_work_precision_table():
-    """A smoke run of the benchmark's work–precision section (its ratios are its own
-    business): every row names a run, and RK4's own ratio is 1 in both cars."""
-    import subprocess
-    import sys
-    from pathlib import Path
-
-    script = Path(__file__).parent.parent / "benchmarks" / "run.py"
-    out = subprocess.run(
-        [sys.executable, str(script), "--quick", "--only", "peers"],
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
-    assert out.returncode == 0, out.stderr
-    rows = [line for line in out.stdout.splitlines() if line.startswith("| rk4 ")]
-    cells = [c.strip() for c in rows[0].strip("|").split("|")]
-    assert [cells[i] for i in (3, 4, 7, 8)] == ["1"] * 4  # evals/rk4, time/rk4, both cars
-
-
 def test_the_adaptive_pairs_are_rows_of_the_work_precision_study():
     # an embedded pair over the tolerance ladder goes through the responses'
     # rtol/atol. Dormand-Prince with scipy's controller takes RK45's steps, so

@@ -2,6 +2,7 @@
 and the package marked as typed (the quick checks; tests/test_wheel.py
 builds and installs the wheel itself)."""
 
+import os
 import re
 import shutil
 import subprocess
@@ -53,10 +54,14 @@ def test_a_group_stays_on_one_worker(tmp_path):
         "    (tmp_path_factory.getbasetemp().parent.parent / f'ran-{i}-{worker}').touch()\n",
         encoding="utf-8",
     )
+    # only pytest-xdist among the installed plugins: the three interpreters (the
+    # controller and two workers) skip importing the others (hypothesis, playwright,
+    # anyio...), which this file does not use (measured, this file's CPU: 13.1 s -> 10.6 s)
+    env = {**os.environ, "PYTEST_DISABLE_PLUGIN_AUTOLOAD": "1"}
     run = subprocess.run(
-        [sys.executable, "-m", "pytest", "-q", "-n", "2", "--dist", "loadgroup", "-p",
-         "no:cacheprovider", "--basetemp", str(tmp_path / "base"), "test_grouped.py"],
-        cwd=tmp_path, capture_output=True, text=True, timeout=300,
+        [sys.executable, "-m", "pytest", "-q", "-p", "xdist", "-n", "2", "--dist", "loadgroup",
+         "-p", "no:cacheprovider", "--basetemp", str(tmp_path / "base"), "test_grouped.py"],
+        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300,
     )  # fmt: skip
     assert run.returncode == 0, run.stdout + run.stderr
     workers = {p.name.rsplit("-", 1)[1] for p in tmp_path.glob("ran-*")}
