@@ -10,6 +10,7 @@ never meets a switching function sitting at 0.
 """
 
 import math
+import re
 import warnings
 
 import numpy as np
@@ -241,8 +242,12 @@ def test_friction_comparison_ends_with_a_value_error():
     model = qc.nonlinear_quarter_car_model(**FRICTION)
     with pytest.raises(ValueError, match="without a switching function") as info:
         qc.compare_methods(model, np.array([0.0, 0.8]), np.zeros(4))
-    assert "budget of 105000 " in str(info.value)  # the default: 1000 x 5 samples + 100,000
-    assert "reached only t = 0.1000" in str(info.value)  # stalled at the bump's start
+    message = str(info.value)
+    assert "budget of 105000 " in message  # the default: 1000 x 5 samples + 100,000
+    # stalled within 1 ms of the bump's start, T0 (measured 0.100025 s; 0.100094 s after
+    # 400,000 evaluations): where the damper first moves and sign(v) starts to chatter
+    reached = float(re.search(r"reached only t = (\S+) s", message).group(1))
+    assert T0 <= reached < T0 + 1e-3
 
 
 def test_a_road_far_faster_than_the_samples_stops_with_the_other_cause():
