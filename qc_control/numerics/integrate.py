@@ -18,6 +18,7 @@ stage loop). The time-grid rules live here too
 from __future__ import annotations
 
 import functools
+import math
 import warnings
 from dataclasses import dataclass, field
 
@@ -159,10 +160,13 @@ def check_time_grid(t, name: str = "T") -> np.ndarray:
         raise ValueError(f"{name} must be an array of real times [s], got {show(t)}") from None
     if t.ndim != 1 or t.size < 2:
         raise ValueError(f"{name} must be a 1-D array of at least 2 times, got shape {t.shape}")
-    steps = np.diff(t)
+    # the steps as a slice difference, and the ends checked as Python floats: the same
+    # values as np.diff and np.isfinite at a third of their cost on the two-point grids
+    # a road profile is evaluated on at every right-hand-side call of a nonlinear car
+    steps = t[1:] - t[:-1]
     # finite ends and positive steps leave no room for NaN or inf in between
     # (a NaN fails every comparison): one pass over the steps on a good grid
-    if np.isfinite(t[0]) and np.isfinite(t[-1]) and steps.min() > 0:
+    if math.isfinite(t[0]) and math.isfinite(t[-1]) and steps.min() > 0:
         return t
     if not np.all(np.isfinite(t)):
         i = int(np.argmin(np.isfinite(t)))

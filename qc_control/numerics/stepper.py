@@ -41,6 +41,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.linalg import get_lapack_funcs, lu_factor
@@ -396,7 +397,7 @@ class ImplicitSteps:
         self.nfev = self.jacobians = self.iterations = 0
         self._J: np.ndarray | None = None  # the Jacobian in use, and its factorisation at _lu_h
         self._lu: tuple[np.ndarray, np.ndarray] | None = None
-        self._getrs = None  # LAPACK's solve with those factors, for their dtype
+        self._getrs: Any = None  # LAPACK's solve with those factors, for their dtype
         self._lu_h: float | None = None
         self._c, self._b = tab.c.tolist(), tab.b
         # d = A^-T b when A is safely invertible: the step's end without s more calls of f
@@ -458,7 +459,8 @@ class ImplicitSteps:
         if self._lu is None or self._lu_h != h:  # one factorisation per Jacobian and step size
             self._lu = lu_factor(np.eye(s * n) - np.kron(ha, J))
             self._lu_h = h
-            (self._getrs,) = get_lapack_funcs(("getrs",), (self._lu[0],))
+            funcs: Any = get_lapack_funcs(("getrs",), (self._lu[0],))  # a list, for a tuple
+            self._getrs = funcs[0]
         (lu, piv), getrs = self._lu, self._getrs
         Z = np.zeros((s, n), dtype=J.dtype)
         scale, previous, slowest = float(np.max(np.abs(x), initial=0.0)), math.inf, 0.0
