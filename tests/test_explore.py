@@ -15,6 +15,7 @@ the figures have been painted.
 """
 
 import contextlib
+import importlib.util
 import os
 import re
 import statistics
@@ -35,7 +36,10 @@ from qc_control.cli.scenario import Scenario
 ROOT = Path(__file__).parent.parent
 browser = chromium.browser  # the module-scoped fixture
 
-pytest.importorskip("panel", reason="the explore extra (in the test extra) installs Panel")
+# found, not imported: every worker collects this module, and importing Panel
+# and Bokeh costs each of them seconds that only the explorer's tests need
+if importlib.util.find_spec("panel") is None:
+    pytest.skip("the explore extra (in the test extra) installs Panel", allow_module_level=True)
 
 #: The redraw bound [ms] on the seed's scenario (10 s at 1 ms, four methods and the
 #: exact response): the issue's 300 ms. Measured on this 2-core machine: medians of
