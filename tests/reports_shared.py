@@ -1,0 +1,64 @@
+"""Fixtures of the tests that write reports where the report's pictures or
+wall times are not what they check (imported by the test files that use them:
+``from reports_shared import quick_figures``).
+
+A report's cost is its figures (constrained layout, text, PNG and PDF
+rendering: about 3-4 CPU-s a report) and, from the command line, the
+comparison's wall-time runs. A test of what the report *says*, or of how its
+files are written, needs neither at full cost:
+
+- `quick_figures`: the figures drawn at 40 dpi instead of `report.DPI`
+  (150): the same artists, layout and files, fewer pixels.
+- `placeholder_figures`: every figure of `write_report` drawn as a small
+  blank figure, under its own file name, number and caption: for the tests of
+  the writer's files, locks and faults (tests/test_report_safety.py), which
+  read no figure. The figures themselves are checked by tests/test_report.py,
+  tests/test_html_browser.py and tests/test_pdf_layout.py.
+- `untimed`: the command's comparison run without its wall-time
+  measurements (``compare_methods(timing=False)``), whose columns then hold
+  NaN: for tests that read no time (a rerun changes the times anyway).
+"""
+
+import dataclasses
+import functools
+
+import pytest
+from matplotlib.figure import Figure
+
+from qc_control import report as report_package
+from qc_control.cli import scenario as scenario_module
+
+
+@pytest.fixture
+def quick_figures(monkeypatch):
+    """What is checked is the text and the files, not the pictures: 40 dpi keeps it quick."""
+    monkeypatch.setattr(report_package, "DPI", 40)
+
+
+def _blank() -> Figure:
+    return Figure(figsize=(1.0, 1.0))
+
+
+def use_placeholders(monkeypatch) -> None:
+    """Draw each figure of `write_report` as a blank 1 x 1 in figure under its
+    own name, number and caption (what `placeholder_figures` does)."""
+    real = report_package.figure_specs
+
+    def specs(cmp):
+        return [dataclasses.replace(spec, make=_blank) for spec in real(cmp)]
+
+    monkeypatch.setattr(report_package, "figure_specs", specs)
+    monkeypatch.setattr(report_package, "DPI", 40)
+
+
+@pytest.fixture
+def placeholder_figures(monkeypatch):
+    """Each figure of `write_report` a blank figure under its own name."""
+    use_placeholders(monkeypatch)
+
+
+@pytest.fixture
+def untimed(monkeypatch):
+    """The command's comparison without wall-time runs (the times are NaN)."""
+    real = scenario_module.compare_methods
+    monkeypatch.setattr(scenario_module, "compare_methods", functools.partial(real, timing=False))
