@@ -57,8 +57,20 @@ def placeholder_figures(monkeypatch):
     use_placeholders(monkeypatch)
 
 
+def use_untimed(monkeypatch) -> None:
+    """Run `Scenario.run`'s comparison without wall-time runs (what `untimed` does)."""
+    real = scenario_module.compare_methods
+    monkeypatch.setattr(scenario_module, "compare_methods", functools.partial(real, timing=False))
+
+
 @pytest.fixture
 def untimed(monkeypatch):
     """The command's comparison without wall-time runs (the times are NaN)."""
-    real = scenario_module.compare_methods
-    monkeypatch.setattr(scenario_module, "compare_methods", functools.partial(real, timing=False))
+    use_untimed(monkeypatch)
+
+
+def run_untimed(scenario):
+    """``scenario.run()`` without its wall-time runs, for a module's fixture."""
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        use_untimed(monkeypatch)
+        return scenario.run()
