@@ -74,3 +74,27 @@ def run_untimed(scenario):
     with pytest.MonkeyPatch.context() as monkeypatch:
         use_untimed(monkeypatch)
         return scenario.run()
+
+
+#: The tests that read `half_car_report` (tests/test_html_browser.py and
+#: tests/test_pdf_layout.py) carry this group, so that xdist runs them on one
+#: worker and the report is written once per suite.
+HALF_CAR_GROUP = "half-car-report"
+_SHARED: dict[str, tuple] = {}
+
+
+def half_car_report(tmp_path_factory) -> tuple:
+    """The README's half car over a bump (``qc-control report --model half
+    --road bump --speed 10 --t-end 2``): its comparison, and its report
+    written once per process as HTML beside its PNG figures at the report's
+    150 dpi (the figures the PDF embeds; the tables are the widest a report
+    has: 25 error measures, 4 wheels' modes, 14 ride metrics, an 8-state A).
+    """
+    if "half" not in _SHARED:
+        from qc_control.cli.scenario import Scenario
+        from qc_control.report import write_report
+
+        cmp = Scenario(model="half", road={"kind": "bump", "speed": 10.0}, t_end=2.0).run()
+        out = tmp_path_factory.mktemp("half-car") / "report"
+        _SHARED["half"] = (cmp, write_report(cmp, out, formats=("html",)))
+    return _SHARED["half"]
