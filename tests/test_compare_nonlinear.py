@@ -22,7 +22,6 @@ import math
 import control
 import numpy as np
 import pytest
-from reports_shared import quick_figures  # noqa: F401  (a fixture)
 from scipy.integrate import solve_ivp
 
 import qc_control as qc
@@ -261,7 +260,6 @@ def test_report_has_the_nonlinear_section(lift_off):
 
 
 @pytest.mark.slow
-@pytest.mark.usefixtures("quick_figures")  # the files and words, not the pixels
 def test_write_report_of_a_nonlinear_comparison(lift_off, tmp_path):
     out = qc.write_report(lift_off, tmp_path / "report", formats=("md", "html", "csv"))
     html = (out / "report.html").read_text(encoding="utf-8")
