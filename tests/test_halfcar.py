@@ -8,6 +8,7 @@ import control
 import numpy as np
 import pytest
 import scipy.linalg
+from reports_shared import placeholder_figures  # noqa: F401  (a fixture)
 
 import qc_control as qc
 from qc_control.models.halfcar import FullCarParams, HalfCarParams
@@ -332,7 +333,8 @@ def test_compare_methods_and_ride_metrics_on_the_half_car(half_car_comparison):
     assert short.model.road_inputs() == ["zr_front", "zr_rear"]
 
 
-@pytest.mark.slow  # the report's figures: about 9 s here
+# its words: the half car's figures are drawn by tests/test_html_browser.py and test_pdf_layout.py
+@pytest.mark.usefixtures("placeholder_figures")
 def test_the_report_of_a_half_car_comparison(half_car_comparison, tmp_path):
     report = qc.write_report(half_car_comparison, tmp_path / "report", formats=("md",))
     text = (report / "report.md").read_text(encoding="utf-8")

@@ -23,6 +23,7 @@ from pathlib import Path
 import browser as chromium
 import numpy as np
 import pytest
+from reports_shared import HALF_CAR_GROUP, half_car_report
 
 import qc_control as qc
 from qc_control.report import write_report
@@ -30,7 +31,8 @@ from qc_control.report import write_report
 # the fixture and the test of a local address (tests/browser.py), here and in tests/test_docs.py
 browser, _local = chromium.browser, chromium._local
 
-pytestmark = pytest.mark.slow
+# the half car's report is written once per suite for this file and tests/test_pdf_layout.py
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group(HALF_CAR_GROUP)]
 
 VERDICT = """() => {
   const root = document.documentElement;
@@ -125,19 +127,16 @@ def test_report_html_renders_every_image_and_fits_the_page(browser, road_report,
 
 
 @pytest.fixture(scope="module")
-def half_car_report(tmp_path_factory):
+def half_car(tmp_path_factory):
     """The half car on a bump: the widest tables (25 error measures, 4 wheels'
-    modes, 14 ride metrics) and a 8-state A, as ``qc-control report --model half``."""
-    from qc_control.cli.scenario import Scenario
-
-    cmp = Scenario(model="half", road={"kind": "bump", "speed": 10.0}, t_end=2.0).run()
-    out = tmp_path_factory.mktemp("browser-half") / "report"
-    return write_report(cmp, out, formats=("html",))
+    modes, 14 ride metrics) and a 8-state A, as ``qc-control report --model half``
+    (tests/reports_shared.py: shared with tests/test_pdf_layout.py)."""
+    return half_car_report(tmp_path_factory)[1]
 
 
 @pytest.fixture(scope="module", params=["quarter", "half"])
-def report_page(request, road_report, half_car_report) -> Path:
-    return (road_report if request.param == "quarter" else half_car_report) / "report.html"
+def report_page(request, road_report, half_car) -> Path:
+    return (road_report if request.param == "quarter" else half_car) / "report.html"
 
 
 @pytest.mark.parametrize("width", [420, 1280])

@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from PIL import Image as PILImage
+from reports_shared import HALF_CAR_GROUP, half_car_report
 
 from qc_control.report import _matrix, build_blocks, figure_specs, pdf
 from qc_control.report.document import Code, Heading, Image, Paragraph, Table
@@ -112,15 +113,15 @@ def test_a_matrix_keeps_its_leading_spaces_so_its_columns_line_up(tmp_path, monk
 
 @pytest.fixture(scope="module")
 def half_car_pages(tmp_path_factory):
-    """The README's half car over a bump (2 s of it), its PDF laid out."""
-    from qc_control.cli.scenario import Scenario
-
-    cmp = Scenario(model="half", road={"kind": "bump", "speed": 10.0}, t_end=2.0).run()
-    folder = tmp_path_factory.mktemp("pdf-half")
-    for spec in figure_specs(cmp):
-        spec.make().savefig(folder / spec.name, dpi=150)
+    """The README's half car over a bump (2 s of it), its PDF laid out from the
+    figures its report drew (shared with tests/test_html_browser.py)."""
+    cmp, folder = half_car_report(tmp_path_factory)
+    for spec in figure_specs(cmp):  # every figure, drawn at the report's 150 dpi
+        with PILImage.open(folder / spec.name) as png:
+            assert png.info["dpi"] == pytest.approx((150, 150), abs=0.1), spec.name  # px/m, rounded
     blocks = build_blocks(cmp, "qc-control report --model half --road bump --speed 10")
-    return blocks, pdf._render("Half car", blocks, folder, folder / "report.pdf")
+    out = tmp_path_factory.mktemp("pdf-half") / "report.pdf"
+    return blocks, pdf._render("Half car", blocks, folder, out)
 
 
 #: No page but the last is filled less than this: none is half empty.
@@ -128,6 +129,7 @@ MIN_FILL = 0.5
 
 
 @pytest.mark.slow  # the comparison and its figures: about 8 s
+@pytest.mark.xdist_group(HALF_CAR_GROUP)  # the half car's report, written once per suite
 def test_the_half_car_report_has_no_half_empty_page_and_no_stranded_heading(half_car_pages):
     """Every page but the last is at least `MIN_FILL` full, and a page ends
     early only because what came next was taller than the room left; each

@@ -31,6 +31,7 @@ import control
 import numpy as np
 import pandas as pd
 import pytest
+from reports_shared import placeholder_figures, quick_figures, untimed  # noqa: F401  (fixtures)
 
 import qc_control as qc
 from qc_control.cli.console import main
@@ -293,13 +294,14 @@ def test_sweep_against_control(seated):
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("quick_figures")  # which curves are drawn, not their pixels
 def test_write_report_draws_its_wheel(seated, tmp_path):
     from qc_control.report.figures import method_figure, reference_figure
 
     model = seated.model()
     T = np.linspace(0.0, 2.0, 201)
     cmp = qc.compare_methods(model, T, seated.free_start(model.params), timing=False)
-    path = qc.write_report(cmp, tmp_path / "report")
+    path = qc.write_report(cmp, tmp_path / "report", formats=("md", "html", "csv"))
     assert {"report.md", "report.html", "methods.csv", "method_rk4.png"} <= {
         f.name for f in path.iterdir()
     }
@@ -327,6 +329,7 @@ def _rk4(A, B, T, U, x0):
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("placeholder_figures", "untimed")  # its numbers, not pictures or times
 def test_scenario_and_cli_report_from_toml(seated, tmp_path, capsys):
     config = tmp_path / "seated.toml"
     config.write_text(

@@ -3,6 +3,7 @@ number formats, the self-contained HTML, the PDF, numbering, and the figures."""
 
 import base64
 import copy
+import dataclasses
 import re
 import shutil
 import subprocess
@@ -14,8 +15,10 @@ import pandas as pd
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from reports_shared import placeholder_figures, untimed  # noqa: F401  (fixtures)
 
 import qc_control as qc
+from qc_control import report as rep_package
 from qc_control.cli.console import main
 from qc_control.report import (
     MARKER,
@@ -154,6 +157,7 @@ def test_refuses_a_directory_that_is_not_a_report(cmp, tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("placeholder_figures")  # what is replaced is the directory
 def test_replaces_its_own_report(cmp, tmp_path):
     """An earlier report is replaced; a file a user put inside it is not deleted
     (issue 14 item 18): the run is refused naming it, and goes once it is moved."""
@@ -170,15 +174,24 @@ def test_replaces_its_own_report(cmp, tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("placeholder_figures")  # the files kept or dropped, not their pixels
 def test_a_failure_leaves_no_partial_output(cmp, tmp_path, monkeypatch):
     out = tmp_path / "rep"
     write_report(cmp, out)
     before = sorted(p.name for p in out.iterdir())
 
-    def broken(_):
+    def broken():
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr("qc_control.report.stability_figure", broken)
+    drawn = rep_package.figure_specs  # the last figure fails as it is drawn
+    monkeypatch.setattr(
+        rep_package,
+        "figure_specs",
+        lambda c: [
+            dataclasses.replace(spec, make=broken) if spec.name == "stability.png" else spec
+            for spec in drawn(c)
+        ],
+    )
     with pytest.raises(RuntimeError, match="disk full"):
         write_report(cmp, out)
     assert sorted(p.name for p in out.iterdir()) == before  # old report intact
@@ -194,6 +207,7 @@ def test_unknown_format(cmp, tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("placeholder_figures")  # the command's output and files
 def test_cli_report_writes_and_prints(tmp_path, capsys):
     out = tmp_path / "rep"
     assert (
@@ -238,6 +252,7 @@ def test_cli_refuses_foreign_directory(tmp_path, capsys):
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("placeholder_figures", "untimed")  # its text and files
 def test_road_report_has_the_ride_section(tmp_path, capsys):
     out = tmp_path / "road"
     assert (
@@ -462,6 +477,7 @@ class _Scenario:
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("placeholder_figures")
 def test_scenario_toml_beside_the_report_and_its_command(cmp, tmp_path):
     with_scenario = copy.copy(cmp)
     with_scenario.scenario = _Scenario()
@@ -472,6 +488,7 @@ def test_scenario_toml_beside_the_report_and_its_command(cmp, tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("placeholder_figures")
 def test_reproduce_never_claims_a_command_it_does_not_have(cmp, tmp_path):
     out = write_report(cmp, tmp_path / "rep", formats=("md",))
     reproduce = (out / "report.md").read_text(encoding="utf-8").split("## Reproduce")[1]

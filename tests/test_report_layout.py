@@ -5,6 +5,7 @@ import re
 
 import numpy as np
 import pytest
+from reports_shared import run_untimed
 
 from qc_control.cli.scenario import Scenario
 from qc_control.report import _matrix, _system_blocks
@@ -38,14 +39,20 @@ def test_a_matrix_prints_in_aligned_blocks_that_fit_the_page(model):
     np.testing.assert_allclose(parse(text, A.shape), A, rtol=5e-6, atol=1e-12 * abs(A).max())
 
 
-def test_a_free_response_shows_no_empty_b():
-    cmp = Scenario(t_end=1.0).run()
+@pytest.fixture(scope="module")
+def free_response():
+    """The seed's car released from 5 cm for 1 s (no wall times: none is read here)."""
+    return run_untimed(Scenario(t_end=1.0))
+
+
+def test_a_free_response_shows_no_empty_b(free_response):
+    cmp = free_response
     (code,) = [b for b in _system_blocks(cmp) if isinstance(b, Code)]
     assert "A =" in code.text and "B" not in code.text
 
 
 def test_a_forced_response_shows_b():
-    cmp = Scenario(road={"kind": "bump"}, t_end=1.0, methods=["rk4"]).run()
+    cmp = run_untimed(Scenario(road={"kind": "bump"}, t_end=1.0, methods=["rk4"]))
     (code,) = [b for b in _system_blocks(cmp) if isinstance(b, Code)]
     assert "\nB =\n" in code.text
 
@@ -80,10 +87,10 @@ def test_a_wide_table_in_the_pdf_splits_into_column_groups_not_below_7_pt(tmp_pa
     assert min(sizes) >= 7.0
 
 
-def test_coinciding_methods_are_described_in_words_not_symbols():
+def test_coinciding_methods_are_described_in_words_not_symbols(free_response):
     from qc_control.report.findings import _coincidence
 
-    (text,) = _coincidence(Scenario(t_end=1.0).run())
+    (text,) = _coincidence(free_response)
     # the issue's wording: "largest state difference 0 m, which is rounding" and "T_2(hA)"
     assert "which is rounding" not in text and "T_2" not in text
     assert "identical to the last bit" in text  # Midpoint and Heun: bit for bit on a free response

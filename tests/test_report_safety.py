@@ -11,18 +11,21 @@ from pathlib import Path
 import filelock
 import numpy as np
 import pytest
+from reports_shared import use_placeholders
 
 import qc_control as qc
 from qc_control import report as rep
 from qc_control.report import MARKER, ReportError, write_report
 
-pytestmark = pytest.mark.slow  # each case writes whole reports (figures, PDF)
+pytestmark = pytest.mark.slow  # each case writes whole reports (every file, the PDF)
 
 
 @pytest.fixture(autouse=True)
-def _coarse_figures(monkeypatch):
-    """What is checked here is the writing, not the pictures: 40 dpi keeps it quick."""
-    monkeypatch.setattr(rep, "DPI", 40)
+def _placeholder_figures(monkeypatch):
+    """What is checked here is the writing, not the pictures: each figure is a
+    blank one under its own name (tests/reports_shared.py), so that a report
+    still has every file, and writes in a fraction of the time."""
+    use_placeholders(monkeypatch)
 
 
 @pytest.fixture(scope="module")
@@ -105,7 +108,7 @@ def test_a_fault_at_any_stage_leaves_one_complete_report(cmp, tmp_path, monkeypa
     with pytest.raises(fault):
         write_report(cmp, out, fmts, command="new")
     monkeypatch.undo()
-    monkeypatch.setattr(rep, "DPI", 40)
+    use_placeholders(monkeypatch)
 
     assert out.is_dir()
     files = {p.name for p in out.iterdir()} - {MARKER}
