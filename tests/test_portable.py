@@ -102,7 +102,9 @@ def _run_without_posix(script: str, tmp_path: Path) -> subprocess.CompletedProce
     )
 
 
-@pytest.mark.slow  # a fresh interpreter imports everything and writes a whole report (~20 s)
+# a fresh interpreter imports everything and writes a whole report (~10 s); 2 s of
+# the seed's scenario run every writer, as the default 10 s do
+@pytest.mark.slow
 def test_every_import_modes_and_a_report_without_posix_only_modules(tmp_path):
     modules = sorted(m.name for m in pkgutil.walk_packages(qc_control.__path__, "qc_control."))
     script = f"""
@@ -120,7 +122,7 @@ def test_every_import_modes_and_a_report_without_posix_only_modules(tmp_path):
     from qc_control.cli.console import main
     code = main(["modes"])
     print("modes exit", code)
-    code = main(["report", "--quiet", "--out", "rep"])
+    code = main(["report", "--quiet", "--t-end", "2", "--out", "rep"])
     print("report exit", code)
     """
     run = _run_without_posix(script, tmp_path)
