@@ -753,16 +753,20 @@ def _interrupts_seen():
     flag it leaves makes `_write` stop before the swap. Only the main thread
     receives signals; Python's own handler still raises the interrupt.
     """
+    if threading.current_thread() is not threading.main_thread():
+        yield  # only the main thread receives signals: nothing to keep
+        return
+    # a flag an earlier report's Ctrl-C left belongs to that report, not this one
+    _INTERRUPTED.clear()
     previous = signal.getsignal(signal.SIGINT)
-    if threading.current_thread() is not threading.main_thread() or not callable(previous):
-        yield  # another thread, or Ctrl-C ignored or left to the OS: nothing to keep
+    if not callable(previous):
+        yield  # Ctrl-C ignored or left to the OS: nothing to keep
         return
 
     def remember(signum, frame):
         _INTERRUPTED.set()
         previous(signum, frame)
 
-    _INTERRUPTED.clear()
     signal.signal(signal.SIGINT, remember)
     try:
         yield
