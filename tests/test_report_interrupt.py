@@ -62,19 +62,14 @@ def test_the_interrupt_handler_is_restored_and_a_clean_run_writes(tmp_path):
 
 
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+@pytest.mark.usefixtures("ctrl_c_raises")  # which also puts the handler back afterwards
 def test_a_report_after_a_swallowed_ctrl_c_writes_where_ctrl_c_is_ignored(tmp_path):
     """The interrupt an earlier report saw is that report's: a later one, in a
     process where Ctrl-C is ignored (a background job), writes as asked."""
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            write_document(
-                tmp_path / "first", "First", _blocks_with_a_swallowed_interrupt, formats=("md",)
-            )
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        out = write_document(
-            tmp_path / "second", "Second", lambda: [Paragraph("y")], formats=("md",)
+    with pytest.raises(KeyboardInterrupt):
+        write_document(
+            tmp_path / "first", "First", _blocks_with_a_swallowed_interrupt, formats=("md",)
         )
-    finally:
-        signal.signal(signal.SIGINT, previous)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    out = write_document(tmp_path / "second", "Second", lambda: [Paragraph("y")], formats=("md",))
     assert "y" in (out / "report.md").read_text(encoding="utf-8")

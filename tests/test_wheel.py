@@ -37,19 +37,16 @@ SOURCES = ("pyproject.toml", "README.md", "LICENSE", "qc_control", "tests")
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("wheel")]
 
 
-def run(*cmd, cwd: Path, timeout: float = 600, in_fresh_env: bool = False) -> str:
+def run(*cmd, cwd: Path, timeout: float = 600) -> str:
     """Run ``cmd`` without the repository on the path; its stdout (exit 0 asserted).
 
-    ``in_fresh_env``: a command of the fresh environment, which may write its
-    bytecode. Neither uv nor pip byte-compiles that environment's dependencies,
-    and where PYTHONDONTWRITEBYTECODE is set (some CI images, this machine's
-    shell) every command compiled numpy, scipy, control and matplotlib afresh;
-    without it the first command that imports a module writes its bytecode into
-    the throw-away environment and the next ones read it (measured, this file
-    run alone: 42 s of CPU with it set, 29 s without it).
+    The fresh environment writes its bytecode (conftest.py clears
+    PYTHONDONTWRITEBYTECODE for every process the suite starts): neither uv nor
+    pip byte-compiles its dependencies, and the first command that imports a
+    module compiles it for the next ones (this file alone: 42 s of CPU when each
+    command compiled numpy, scipy, control and matplotlib afresh, 29 s without).
     """
-    drop = ("PYTHONPATH", "VIRTUAL_ENV") + (("PYTHONDONTWRITEBYTECODE",) if in_fresh_env else ())
-    env = {k: v for k, v in os.environ.items() if k not in drop}
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
     env["MPLBACKEND"] = "Agg"
     out = subprocess.run(
         [str(c) for c in cmd], cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout
@@ -127,14 +124,14 @@ def test_build_makes_a_wheel_and_an_sdist_that_twine_accepts(dist):
 
 def test_the_installed_package_comes_from_the_wheel(venv, tmp_path):
     where = run(venv_python(venv), "-c", "import qc_control; print(qc_control.__file__)",
-                cwd=tmp_path, in_fresh_env=True)  # fmt: skip
+                cwd=tmp_path)  # fmt: skip
     package = Path(where.strip()).resolve()
     assert package.is_relative_to(venv.resolve()), package  # not the work tree
     assert (package.parent / "py.typed").exists()
 
 
 def test_qc_control_modes_prints_the_seed_cars_modes(venv, tmp_path):
-    out = run(venv_script(venv, "qc-control"), "modes", cwd=tmp_path, in_fresh_env=True)
+    out = run(venv_script(venv, "qc-control"), "modes", cwd=tmp_path)
     # the seed's car (Table 1): A from M, C, K here; cs = 2ζ√(ks·ms), ζ = 0.25
     ms, mu, ks, ku = 301.2, 100.0, 30000.0, 29530.0
     cs = 2 * 0.25 * np.sqrt(ks * ms)
@@ -154,7 +151,7 @@ def test_qc_control_report_writes_the_report(venv, tmp_path):
     """Every writer (HTML, Markdown, PDF, CSV, figures) from the installed
     package; 2 s of the seed's scenario keep the computing short."""
     run(venv_script(venv, "qc-control"), "report", "--t-end", "2", "--out", "rep", "--quiet",
-        cwd=tmp_path, in_fresh_env=True)  # fmt: skip
+        cwd=tmp_path)  # fmt: skip
     report = tmp_path / "rep"
     for name in ("report.html", "report.md", "report.pdf", "methods.csv"):
         assert (report / name).stat().st_size > 0, name
@@ -168,7 +165,7 @@ def test_initial_response_from_the_installed_package(venv, tmp_path):
         "r = qc.initial_response(qc.quarter_car(), T, [0, 0, 0.05, 0], method='rk4')\n"
         "print(json.dumps({'y': r.outputs.tolist(), 'labels': list(r.output_labels)}))\n"
     )
-    got = json.loads(run(venv_python(venv), "-c", code, cwd=tmp_path, in_fresh_env=True))
+    got = json.loads(run(venv_python(venv), "-c", code, cwd=tmp_path))
     y = np.asarray(got["y"])
     # the exact response of the same car, by python-control here (this environment)
     import qc_control as qc
