@@ -225,6 +225,10 @@ class Road:
         """The largest time step [s] that samples this road; inf if any step does."""
         return math.inf
 
+    def jumps(self) -> tuple[float, ...]:
+        """The times [s] where the road height jumps; () for a continuous road."""
+        return ()
+
     def sampled(self) -> str:
         """What `largest_step` samples, in words."""
         return self.noun
@@ -249,6 +253,9 @@ class StepRoad(Road):
 
     def describe(self) -> str:
         return f"a {_length(self.height)} road step at t = {self.t0:g} s"
+
+    def jumps(self) -> tuple[float, ...]:
+        return (self.t0,)
 
 
 #: One speed default for every road that has a speed: `qc_control.ride.road.iso8608`'s.
@@ -983,12 +990,13 @@ class Scenario:
 
         With ``road=True`` a model that takes the road as a function of time
         (`ModelEntry.road_function`) gets this scenario's road so, evaluated
-        at every stage; an ISO 8608 road, which has no closed form, stays
-        the input ``zr``.
+        at every stage, with its ``jumps`` (`Road.jumps`: a step's t0); an
+        ISO 8608 road, which has no closed form, stays the input ``zr``.
         """
         profile: Any = bool(road)
         if road and self.entry.road_function and not isinstance(self.road, (NoRoad, ISO8608Road)):
             profile = functools.partial(_road_at, self.road)
+            profile.jumps = self.road.jumps()
         return self.entry.model(self.vehicle, road=profile, **self.option_arguments("build"))
 
     def problem(self) -> tuple[VehicleModel, np.ndarray, np.ndarray | None, str]:

@@ -326,6 +326,19 @@ def _road_height(road, actuator: bool):
     return zr_at, inputs, ia
 
 
+def _road_jumps(road) -> tuple[float, ...]:
+    """The times [s] where a road function jumps (its ``jumps``, sorted); () for an
+    input ``zr``, which python-control interpolates linearly, or for no road."""
+    given = getattr(road, "jumps", ()) if callable(road) else ()
+    try:
+        jumps = tuple(sorted(float(t) for t in given))
+    except (TypeError, ValueError):
+        jumps = (math.nan,)
+    if not all(math.isfinite(t) for t in jumps):
+        raise ValueError(f"road.jumps must be finite times [s], got {given!r}")
+    return jumps
+
+
 def _force_elements(p, *, tire: str, bump_stop, damper, spring, gravity: bool, zr_at):
     """``elements(t, x, u, q) -> (F_s + F_d + F_b, F_t - ku δ0, F_t, δ)``, the force
     elements at the state ``x`` (module docstring), checked and built once."""
@@ -420,7 +433,8 @@ def nonlinear_quarter_car(
         the nonlinear car is mostly driven by one). A callable: the road
         height as a function of time, evaluated at every stage (no ``zr``
         input), so that no interpolation of samples limits the order of a
-        convergence study.
+        convergence study. Its optional attribute ``jumps`` lists the times
+        [s] where it jumps (a step), which the system carries.
     actuator : bool
         The input ``fa`` [N], as in `quarter_car`.
     name : str
@@ -430,7 +444,9 @@ def nonlinear_quarter_car(
     control.NonlinearIOSystem
         Also with ``switching(t, x, u, params) -> ndarray`` and
         ``switching_labels``: the functions whose sign changes are the
-        kinks of the right-hand side (for ``events=True``).
+        kinks of the right-hand side (for ``events=True``); and ``jumps``:
+        the road function's jumps [s], sorted (empty without), where
+        `qc_control.studies.compare.nonlinear_reference` restarts.
 
     Raises
     ------
@@ -475,6 +491,7 @@ def nonlinear_quarter_car(
     )
     sys.switching = switching
     sys.switching_labels = switching_labels
+    sys.jumps = _road_jumps(road)
     return sys
 
 

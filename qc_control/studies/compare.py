@@ -1218,6 +1218,26 @@ def _sided_events(switching, sides: np.ndarray, t_start: float) -> list:
     return funcs
 
 
+def _read_inside(f, t_start: float, t_stop: float):
+    """``f(t, x)`` read on the open segment ``(t_start, t_stop)``: at an end, one ulp in.
+
+    The state at a segment's ends is the limit from inside it, so the right-hand
+    side there is too: a road that jumps at a break (a step, ``zr = height`` for
+    ``t >= t0``) is read before the jump by the segment that ends at ``t0`` and
+    after it by the one that starts there. DOP853's last stage sits at the step's
+    end (c = 1): read after a jump, it kicks the state by ``h·Δa`` (a 5 cm kerb:
+    Δa = ku·0.05/mu = 15 m/s² on the seed's wheel) however small ``h``, and a
+    car at rest until then has a tolerance of ~1e-24 that no step meets.
+    For a continuous right-hand side it moves the time by one ulp.
+    """
+    lo, hi = float(np.nextafter(t_start, math.inf)), float(np.nextafter(t_stop, -math.inf))
+
+    def inside(t, x):
+        return f(min(max(t, lo), hi), x)
+
+    return inside
+
+
 def _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks, budget):
     """DOP853 from event to event: no step straddles a kink of the right-hand side.
 
@@ -1226,8 +1246,10 @@ def _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks, budget):
     side (`_sided_events`), so any number of events between two samples, or
     at the same instant, each get their restart and every sample is read from
     the segment that holds it. ``breaks``: times where the input's slope jumps
-    (samples of a piecewise-linear input); each is a restart too, so no step
-    straddles one or steps over an input that starts after a quiet stretch.
+    (samples of a piecewise-linear input) or the right-hand side jumps in time
+    (a road function's step); each is a restart too, so no step straddles one
+    or steps over an input that starts after a quiet stretch, and each
+    segment reads the right-hand side inside itself (`_read_inside`).
     ``budget``: right-hand-side evaluations, over all segments, after which
     `_BudgetSpent` is raised (a stalled solve).
     """
@@ -1253,8 +1275,10 @@ def _piecewise_ivp(rhs, switching, T, x0, rtol, atol, breaks, budget):
     stops = sorted({float(b) for b in breaks if T[0] < b < T[-1]} | {float(T[-1])})
     for t_stop in stops:
         while t < t_stop:
-            funcs = _sided_events(switching, sides, t) if switching else None
-            sol = solve_ivp(counted, (t, t_stop), x, events=funcs or None, **kw)
+            rhs_in = _read_inside(counted, t, t_stop)
+            on = _read_inside(switching, t, t_stop) if switching else None
+            funcs = _sided_events(on, sides, t) if on else None
+            sol = solve_ivp(rhs_in, (t, t_stop), x, events=funcs or None, **kw)
             if not sol.success and sol.status != 1:
                 raise RuntimeError(
                     f"the reference solve_ivp failed at t = {t:.6g} s: {sol.message}"
@@ -1349,7 +1373,13 @@ def nonlinear_reference(
     a kink, where a function is exactly 0, has not crossed it). The input
     is python-control's: linear between the samples; the solve also
     restarts at each sample where the input's slope changes (a kink in
-    time, and no first step that leaps over a bump after a quiet stretch).
+    time, and no first step that leaps over a bump after a quiet stretch),
+    and at each of the system's ``jumps`` when it has them: the times [s]
+    where its right-hand side jumps in time (`qc_control.nonlinear_quarter_car`
+    lists its road function's, e.g. a step's). Each segment reads the
+    right-hand side inside itself, at its ends by the limit from inside (one
+    ulp in time), as the state there is: a road step at the last sample
+    moves nothing before it.
     Its own accuracy is estimated, as the matrix exponential's is for
     linear systems, against a second solve at ``rtol / 100`` and ``atol /
     100`` (scipy raises an rtol below 100·eps, 2.2e-14, to it).
@@ -1370,6 +1400,8 @@ def nonlinear_reference(
     Parameters
     ----------
     sys : control.NonlinearIOSystem
+        Optionally with ``jumps``: the times [s] where its right-hand side
+        jumps in time, each a restart (above).
     T, U, X0, params
         As for `qc_control.input_output_response`.
     events : None, True or callable ``events(t, x, u, params)``
@@ -1418,7 +1450,8 @@ def nonlinear_reference(
     # not 0 (beyond rounding: a grid refined by interpolation adds no kinks)
     tiny = 64 * np.finfo(float).eps * np.max(np.abs(u), axis=1, initial=0.0)[:, None]
     kinks = np.flatnonzero(np.any(np.abs(np.diff(u, 2, axis=1)) > tiny, axis=0)) + 1
-    breaks = T[kinks]
+    # and where the system's right-hand side jumps in time (a road function's step)
+    breaks = [*T[kinks], *getattr(sys, "jumps", ())]
     x, tighter, t_events, nfev, which, atol = _refined_solves(
         rhs, switching, T, x0, rtol, breaks, budget
     )
