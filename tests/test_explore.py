@@ -1,9 +1,12 @@
 """The explorer (``qc-control explore``) in a real browser, and its command.
 
 One server (``qc-control explore --no-browser --port 0``, a subprocess, as a
-student starts it) serves every browser test of this module: they share an
-xdist group. Chromium is Debian's (tests/browser.py), with every request
-that leaves 127.0.0.1 aborted and recorded. The page's numbers are checked
+student starts it) serves every browser test of this module, and one tab on
+it is loaded once for them (a load is the costly part): each test finds it as
+it opened, the entries of the test before undone (`Page.back_to_load`, which
+checks every box against its value at the load), or a new tab where they
+cannot be. They share an xdist group. Chromium is Debian's (tests/browser.py),
+with every request that leaves 127.0.0.1 aborted and recorded. The page's numbers are checked
 against independent references: the Euler limit of the body mode from its
 closed form ``h = -2 Re λ / |λ|²``, the modes from `qc_control.modal_analysis`,
 and the report that the exported TOML reruns.
@@ -28,6 +31,7 @@ import browser as chromium
 import numpy as np
 import pandas as pd
 import pytest
+from reports_shared import placeholder_figures, untimed  # noqa: F401  (fixtures)
 
 import qc_control as qc
 from qc_control.cli.console import main
@@ -112,6 +116,11 @@ def server():
         proc.kill()
 
 
+#: The value of every input and select on the page, in document order (Playwright's
+#: CSS engine reaches into the widgets' shadow roots).
+VALUES = "els => els.map(e => e.value)"
+
+
 class Page:
     """One tab on the explorer, with what it blocked, what failed and what it logged."""
 
@@ -128,6 +137,14 @@ class Page:
         self.tab.goto(url, wait_until="networkidle")
         self.tab.wait_for_function(f"({STAMP})() >= 1", timeout=60_000)
         self.tab.locator(".qc-status p").first.wait_for(timeout=60_000)
+        #: what the load itself blocked, failed and logged, for the test of the load
+        self.at_load = (tuple(self.blocked), tuple(self.failed), tuple(self.errors))
+        self.loaded = self.inputs()  # every box as the page opened
+        self.preset = self.tab.locator(".qc-preset select").input_value()
+        self.entered: dict[str, str] = {}  # each box entered, and its text before, in order
+
+    def inputs(self) -> list[str]:
+        return self.tab.locator("input, select").evaluate_all(VALUES)
 
     def stamp(self) -> int:
         return self.tab.evaluate(STAMP)
@@ -137,10 +154,33 @@ class Page:
         the redraw; the time [ms] from the key to the figures painted."""
         before = self.stamp()
         box = self.tab.locator(f"{css} input")
+        self.entered.setdefault(css, box.input_value())
         box.fill(str(value))
         self.tab.evaluate(ARM)
         box.press("Enter")
         return self.tab.evaluate(TIMED, before)
+
+    def back_to_load(self) -> bool:
+        """Undo the entries, the last entered box first (through states that the
+        test went through itself, none heavier), and a preset that an entry turned
+        to custom; True when no error was logged since the test began and every box
+        holds its value as the page opened, on which the page's figures and tables
+        are redrawn."""
+        preset = self.tab.locator(".qc-preset select")
+        if preset.input_value() != self.preset:  # it sets the vehicle's five values at once
+            self._redrawn(lambda: preset.select_option(self.preset))
+        for css, text in reversed(self.entered.items()):
+            box = self.tab.locator(f"{css} input")
+            if float(box.input_value()) != float(text):
+                self._redrawn(lambda: (box.fill(text), box.press("Enter")))
+        self.entered.clear()
+        return not self.errors and self.inputs() == self.loaded
+
+    def _redrawn(self, change) -> None:
+        """Make the ``change`` and wait until the server's redraw has reached the page."""
+        before = self.stamp()
+        change()
+        self.tab.wait_for_function(f"({STAMP})() > {before}", timeout=60_000)
 
     def text(self, css: str) -> str:
         """The text of the HTML pane ``css`` (its paragraphs and preformatted blocks)."""
@@ -168,11 +208,35 @@ class Page:
         self.context.close()
 
 
+@pytest.fixture(scope="module")
+def shared(browser, server):
+    """The module's tab, loaded once: a load costs about 4 CPU-s (3 of them
+    Chromium's, laying out Panel's page), a redraw a tenth of that."""
+    kept: dict[str, Page] = {}
+    yield kept
+    if "page" in kept:
+        kept["page"].close()
+
+
 @pytest.fixture
-def page(browser, server):
-    tab = Page(browser, server)
-    yield tab
-    tab.close()
+def page(shared, browser, server):
+    """The module's tab as it opened, for each test: the entries of the test
+    before undone (`Page.back_to_load`), or a new tab where they cannot be;
+    with this test's own records of blocked and failed requests and errors."""
+    tab = shared.get("page")
+    if tab is not None:
+        try:
+            as_loaded = tab.back_to_load()
+        except Exception:  # a test that failed may leave the tab anywhere
+            as_loaded = False
+        if not as_loaded:
+            tab.close()
+            tab = None
+    if tab is None:
+        tab = shared["page"] = Page(browser, server)
+    for records in (tab.blocked, tab.failed, tab.errors):
+        records.clear()
+    return tab
 
 
 def verdict(page: Page, method: str) -> str:
@@ -182,9 +246,10 @@ def verdict(page: Page, method: str) -> str:
 @pytest.mark.slow
 @pytest.mark.xdist_group("explore")
 def test_the_page_loads_with_nothing_from_outside_and_no_error(page):
-    assert page.blocked == []  # every script, style and font from 127.0.0.1
-    assert page.failed == []
-    assert page.errors == []
+    blocked, failed, errors = page.at_load
+    assert blocked == ()  # every script, style and font from 127.0.0.1
+    assert failed == ()
+    assert errors == ()
     assert "10,000 steps of h = 1 ms" in page.text(".qc-status")
 
 
@@ -227,6 +292,7 @@ def test_a_new_body_mass_gives_modal_analysis_modes(page):
 
 @pytest.mark.slow
 @pytest.mark.xdist_group("explore")
+@pytest.mark.usefixtures("placeholder_figures", "untimed")  # its errors and RHS evaluations
 def test_the_exported_toml_reruns_with_the_report_and_its_errors(page, tmp_path):
     page.enter(".qc-t_end", 2.0)
     page.enter(".qc-h", 10.0)
@@ -246,7 +312,9 @@ def test_the_exported_toml_reruns_with_the_report_and_its_errors(page, tmp_path)
     config = tmp_path / "scenario.toml"
     config.write_text(toml, encoding="utf-8")
     # the page's command, by the entry point's function in this process: the
-    # numbers are what is compared, not a new interpreter (a subprocess cost ~6 s of CPU)
+    # numbers are what is compared, not a new interpreter (a subprocess cost ~6 s of CPU),
+    # nor the report's figures and wall times (blank and untimed: ~6 CPU-s less; the
+    # figures are checked by tests/test_report.py and tests/test_html_browser.py)
     status = main(["report", "--config", str(config), "--out", str(tmp_path / "r"), "-q"])
     assert status == 0
     report = pd.read_csv(tmp_path / "r" / "methods.csv", index_col=0)
@@ -274,8 +342,10 @@ def test_the_url_carries_the_state(page, browser):
 @pytest.mark.slow
 @pytest.mark.xdist_group("explore")
 def test_a_run_of_more_than_a_million_steps_is_refused_with_the_commands_message(page):
-    page.enter(".qc-t_end", 200.0)
+    # h first: 100,000 steps over the seed's 10 s (its convergence figure kept), where
+    # t_end first would run 200,000 steps and a new convergence figure before the refusal
     page.enter(".qc-h", 0.1)
+    page.enter(".qc-t_end", 200.0)
     text = page.text(".qc-status")
     with pytest.raises(ValueError) as refusal:
         Scenario(t_end=200.0, h=1e-4, max_steps=1_000_000)
