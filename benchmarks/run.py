@@ -34,22 +34,29 @@ from qc_control.studies.sweeps import DEFAULT_METRICS, design_grid, sweep
 
 X0 = np.array([0.0, 0.0, 0.05, 0.0])
 
+#: One untimed call before the timed ones (caches, fresh memory pages). The smoke
+#: run (``--quick``, `main`) turns it off: its times are never read, and a warm-up
+#: repeats the same call on the same code path (in the smoke run, a third of the
+#: CPU time of the timed benchmarks).
+WARMUP = True
+
 
 def best_of(fn, repeats: int) -> float:
-    """Best of ``repeats`` timed calls after one untimed warm-up call."""
-    return best_time(fn, repeats, warmup=True)
+    """Best of ``repeats`` timed calls after one untimed warm-up call (`WARMUP`)."""
+    return best_time(fn, repeats, warmup=WARMUP)
 
 
 def in_turns(fn_a, fn_b, rounds: int, measure) -> tuple[list[float], list[float], list[float]]:
     """``rounds`` times of ``fn_a`` and of ``fn_b`` taken in turns, and each round's ratio.
 
-    After one untimed call of each, the two are measured in turns (a b, b a,
+    After one untimed call of each (`WARMUP`), the two are measured in turns (a b, b a,
     a b, ...), so that a drift of the machine's load reaches both sides alike;
     ``measure(fn)`` gives one time. Returns ``(a's times, b's times, b / a per
     round)``.
     """
-    fn_a()
-    fn_b()
+    if WARMUP:
+        fn_a()
+        fn_b()
     times: tuple[list[float], list[float]] = ([], [])
     for r in range(rounds):
         for side in (0, 1) if r % 2 == 0 else (1, 0):
@@ -102,8 +109,9 @@ def paired_medians(fn_a, fn_b, repeats: int) -> tuple[float, float, float]:
 
 
 def timed_runs(fn, repeats: int) -> list[float]:
-    """Wall times [s] of ``repeats`` calls after one untimed warm-up."""
-    fn()
+    """Wall times [s] of ``repeats`` calls after one untimed warm-up (`WARMUP`)."""
+    if WARMUP:
+        fn()
     return [wall_time(fn) for _ in range(repeats)]
 
 
@@ -875,6 +883,8 @@ def main(argv=None) -> int:
     )
     args = ap.parse_args(argv)
     quick = args.quick
+    global WARMUP
+    WARMUP = not quick
     alone = {
         "interconnect": lambda: table(*interconnect_benchmark(quick)[1:]),
         "mpc": lambda: "\n".join(mpc_benchmark(quick)[0]),

@@ -10,6 +10,7 @@ configuration is in pyproject.toml, shared with .pre-commit-config.yaml.
 from __future__ import annotations
 
 import ast
+import functools
 import importlib
 import importlib.metadata
 import io
@@ -179,9 +180,20 @@ def _imports(tree: ast.AST) -> Iterator[tuple[ast.Import | ast.ImportFrom, bool,
                 yield from walk(child, in_function, typing_only)
             return
         for child in ast.iter_child_nodes(node):
-            yield from walk(child, in_function, typing_only)
+            # an import is a statement, and statements nest only in statements,
+            # except clauses and match cases: the expressions (most of a module's
+            # nodes) hold none, and walking them took most of this file's AST time
+            if isinstance(child, ast.stmt | ast.excepthandler | ast.match_case):
+                yield from walk(child, in_function, typing_only)
 
     yield from walk(tree, False, False)
+
+
+@functools.cache
+def _tree(source: str) -> ast.Module:
+    """A module's syntax tree, parsed once per source text: the checks below each
+    read every module of the package (the walkers never change a tree)."""
+    return ast.parse(source)
 
 
 def _top_level(node: ast.Import | ast.ImportFrom) -> set[str]:
@@ -211,7 +223,7 @@ def private_name_imports() -> list[str]:
     submodule, ``from . import _x``, is the package's own and is allowed)."""
     offenders = []
     for path, module, is_package in _modules():
-        for node, _, _ in _imports(ast.parse(path.read_text(encoding="utf-8"))):
+        for node, _, _ in _imports(_tree(path.read_text(encoding="utf-8"))):
             if not isinstance(node, ast.ImportFrom):
                 continue
             target = _target(node, module, is_package)
@@ -236,7 +248,7 @@ def function_level_imports() -> list[str]:
     for path, _, _ in _modules():
         source = path.read_text(encoding="utf-8")
         with_comment, comment_only = _comment_lines(source)
-        for node, in_function, _ in _imports(ast.parse(source)):
+        for node, in_function, _ in _imports(_tree(source)):
             if not in_function:
                 continue
             lines = range(node.lineno, (node.end_lineno or node.lineno) + 1)
@@ -261,7 +273,7 @@ def module_level_matplotlib() -> list[str]:
     for path, module, _ in _modules():
         if module.startswith(PRESENTATION):
             continue
-        for node, in_function, typing_only in _imports(ast.parse(path.read_text("utf-8"))):
+        for node, in_function, typing_only in _imports(_tree(path.read_text("utf-8"))):
             if not in_function and not typing_only and "matplotlib" in _top_level(node):
                 offenders.append(_where(path, node))
     return offenders
@@ -346,7 +358,7 @@ def long_functions(limit: int = MAX_FUNCTION_LINES) -> list[str]:
     for path, _, _ in _modules():
         source = path.read_text(encoding="utf-8")
         lines = source.splitlines()
-        for node in ast.walk(ast.parse(source)):
+        for node in ast.walk(_tree(source)):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 count = _code_lines(lines, node)
                 if count > limit:
