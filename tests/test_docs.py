@@ -86,28 +86,43 @@ def test_every_guide_page_ran_its_code(site, docs_build):
     assert "max |xs error| = 0.000192 m with 2000 RHS evaluations" in start
 
 
-@pytest.mark.slow  # a kernel started and three pages run in it: about 2 s
+@pytest.mark.slow  # a kernel started and five pages run in it: about 2 s
 def test_the_shared_kernel_gives_each_page_a_fresh_namespace_and_folder(tmp_path):
     """What `guide_in_one_kernel` keeps from one page to the next is no more
     than a process keeps: a name the page did not define or import fails it
     (it is left out of the cache, so the build runs it alone and fails on it),
-    and each page starts in an empty folder of its own."""
+    each page starts in an empty folder of its own, and a warning shown once
+    on one page is shown again on the next."""
     from conftest import DOCS_ENV, guide_in_one_kernel
+    from jupyter_cache import get_cache
 
-    guide = tmp_path / "guide"
-    guide.mkdir()
+    lib, guide, pages = (tmp_path / name for name in ("lib", "guide", "pages"))
+    for folder in (lib, guide, pages):
+        folder.mkdir()
+    # a warning raised inside a module, as the library's are: Python shows it once
+    # per place in that module unless the warnings' registry is forgotten
+    (lib / "warner.py").write_text(
+        "import warnings\n\ndef warn():\n    warnings.warn('from a module', UserWarning)\n"
+    )
     front = "---\nfile_format: mystnb\nkernelspec: {name: python3, display_name: Python 3}\n---\n"
     for name, code in {
         "a": "import numpy as np\nopen('left-behind.txt', 'w').close()",
         "b": "import os\nassert os.listdir('.') == [], os.listdir('.')",
         "c": "np.zeros(1)  # imported by page a only",
+        "d": "import warner\nwarner.warn()  # page d",
+        "e": "import warner\nwarner.warn()  # page e: the same place in warner.py",
     }.items():
         cell = f"```{{code-cell}} ipython3\n{code}\n```\n"
         (guide / f"{name}.md").write_text(f"{front}# {name}\n\n{cell}", encoding="utf-8")
-    (tmp_path / "pages").mkdir()
-    cached = guide_in_one_kernel(guide, tmp_path / "cache", tmp_path / "pages", DOCS_ENV)
-    assert cached == ["a", "b"]
-    assert (tmp_path / "pages" / "a" / "left-behind.txt").exists()
+    env = dict(DOCS_ENV, PYTHONPATH=str(lib))
+    cached = guide_in_one_kernel(guide, tmp_path / "cache", pages, env)
+    assert cached == ["a", "b", "d", "e"]
+    assert (pages / "a" / "left-behind.txt").exists()
+    db = get_cache(str(tmp_path / "cache"))
+    for record in db.list_cache_records():
+        if record.uri.endswith(("d.md", "e.md")):
+            (cell,) = db.get_cache_bundle(record.pk).nb.cells
+            assert "UserWarning: from a module" in str(cell.outputs), (record.uri, cell.outputs)
 
 
 #: Pages with formulas: a guide page with display and inline math ($$ and $),
