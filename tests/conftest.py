@@ -129,6 +129,80 @@ def course_run(tmp_path_factory):
     )
 
 
+#: The guide's kernels inherit this environment from the build (``docs/conf.py`` adds the
+#: IProgress filter to PYTHONWARNINGS in the build's own process).
+DOCS_ENV = {"MPLBACKEND": "Agg", "PATH": str(Path(sys.executable).parent)}
+
+
+def guide_in_one_kernel(guide: Path, cache: Path, folder: Path, env: dict) -> list[str]:
+    """Execute the guide's pages one after the other in one Jupyter kernel, into a
+    jupyter-cache at ``cache`` that the docs build reads (``nb_execution_mode=cache``).
+
+    ``make docs`` starts a kernel for each page; here one kernel runs them all,
+    which saves each page's start (the kernel, and importing numpy, control,
+    matplotlib, pandas and qc_control: about 3 s of CPU a page). Before each
+    page the kernel forgets the namespace (``%reset -f``: a page that uses a
+    name it did not define or import still fails), moves to a new empty
+    folder of its own (as ``nb_execution_in_temp``) and forgets which warnings
+    it has shown (each page shows its own). What it keeps is what a process
+    keeps: the modules imported so far and their state (caches, matplotlib's
+    rcParams; a submodule an earlier page imported is an attribute of its
+    package). A page whose cells raise is left out of the cache, so the build
+    runs it again in a kernel of its own and fails on it as ``make docs``
+    does. Returns the pages cached.
+    """
+    import nbclient
+    import nbformat
+    from jupyter_cache import get_cache
+    from jupyter_cache.base import CacheBundleIn
+    from myst_nb.core.read import is_myst_markdown_notebook, read_myst_markdown_notebook
+    from myst_parser.config.main import MdParserConfig
+
+    config = MdParserConfig(enable_extensions={"dollarmath", "amsmath"})  # as docs/conf.py
+    pages, merged = [], nbformat.v4.new_notebook()
+    for path in sorted(guide.glob("*.md")):
+        text = path.read_text(encoding="utf-8")
+        if not is_myst_markdown_notebook(text):
+            continue
+        nb = read_myst_markdown_notebook(text, config=config, add_source_map=True, path=path)
+        merged.metadata.setdefault("kernelspec", nb.metadata.get("kernelspec"))
+        workdir = folder / path.stem
+        workdir.mkdir()
+        merged.cells.append(
+            nbformat.v4.new_code_cell(
+                "%reset -f\n"
+                f"__import__('os').chdir({str(workdir)!r})\n"
+                "with __import__('warnings').catch_warnings():  # forgets the ones shown once\n"
+                "    pass"
+            )
+        )
+        start = len(merged.cells)
+        merged.cells += [c for c in nb.cells if c.cell_type == "code"]
+        pages.append((path, nb, start))
+    nbclient.NotebookClient(
+        merged, timeout=300, allow_errors=True, record_timing=False,
+        resources={"metadata": {"path": str(folder)}},
+    ).execute(env=env)  # fmt: skip
+    db = get_cache(str(cache))
+    cached = []
+    for path, nb, start in pages:
+        code = [c for c in nb.cells if c.cell_type == "code"]
+        ran = merged.cells[start : start + len(code)]
+        failed = any(
+            o.output_type == "error" and "raises-exception" not in c.metadata.get("tags", [])
+            for c in ran
+            for o in c.outputs
+        )
+        if failed:
+            continue
+        for n, (cell, done) in enumerate(zip(code, ran), 1):
+            cell.outputs, cell.execution_count = done.outputs, n
+        nb.metadata["language_info"] = merged.metadata.get("language_info", {})
+        db.cache_notebook_bundle(CacheBundleIn(nb, str(path)), check_validity=False)
+        cached.append(path.stem)
+    return cached
+
+
 @pytest.fixture(scope="session")
 def docs_build(tmp_path_factory, course_run):
     """The docs site built once per run (``sphinx-build -W``): the user guide
@@ -139,9 +213,13 @@ def docs_build(tmp_path_factory, course_run):
     build directory (``docs/_build/gallery_output/NAME``); tests/test_examples.py
     reads what they wrote and printed. The course notebook is the one
     `course_run` executed, its outputs rendered as they are: myst-nb's
-    per-notebook setting keeps the build from executing it again.
-    Returns ``src`` (the copied docs folder), ``html``, ``returncode`` and
-    ``stderr``.
+    per-notebook setting keeps the build from executing it again. The guide's
+    pages run one after the other in one kernel (`guide_in_one_kernel`), and
+    the build renders their outputs from that run: this is the one difference
+    from ``make docs``, which gives each page a kernel of its own.
+    Returns ``src`` (the copied docs folder), ``html``, ``returncode``,
+    ``stderr``, ``cached`` (the guide's pages that ran in the shared kernel)
+    and ``executed_by_build`` (those the build ran in a kernel of their own).
     """
     for name in ("sphinx", "numpydoc", "sphinx_gallery", "myst_nb"):
         pytest.importorskip(name, reason="the docs extra is not installed: `make docs` installs it")
@@ -158,19 +236,33 @@ def docs_build(tmp_path_factory, course_run):
     executed = copy.deepcopy(course_run.shipped)
     executed.metadata["mystnb"] = {"execution_mode": "off"}
     nbformat.write(executed, tmp / "examples" / "course.ipynb")
+    env = dict(DOCS_ENV, PYTHONWARNINGS="ignore:IProgress not found")  # as docs/conf.py
+    cache = tmp / "guide_cache"
+    pages = tmp_path_factory.mktemp("guide_pages")
+    cached = guide_in_one_kernel(tmp / "docs" / "guide", cache, pages, env)
     html = tmp / "docs" / "_build" / "html"
     run = subprocess.run(
         # -j auto: the pages and the examples are read and run on every core, which
         # the rest of the suite leaves idle once it has finished
         [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-j", "auto", "-b", "html"]
+        + ["-D", "nb_execution_mode=cache", "-D", f"nb_execution_cache_path={cache}"]
         + [str(tmp / "docs"), str(html)],
         capture_output=True,
         text=True,
         timeout=1800,
-        env={"MPLBACKEND": "Agg", "PATH": str(Path(sys.executable).parent)},
+        env=DOCS_ENV,
     )
+    from jupyter_cache import get_cache
+
+    # a page the cache did not hold, the build executed and recorded in the cache's project
+    executed_by_build = [Path(r.uri).stem for r in get_cache(str(cache)).list_project_records()]
     return SimpleNamespace(
-        src=tmp / "docs", html=html, returncode=run.returncode, stderr=run.stderr
+        src=tmp / "docs",
+        html=html,
+        returncode=run.returncode,
+        stderr=run.stderr,
+        cached=cached,
+        executed_by_build=executed_by_build,
     )
 
 

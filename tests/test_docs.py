@@ -2,7 +2,12 @@
 notebook, built with Sphinx with warnings as errors (what ``make docs`` runs),
 once per run by conftest's ``docs_build``, then read offline in headless
 Chromium: the formulas typeset with nothing fetched, no raw TeX left on the
-page."""
+page.
+
+One difference from ``make docs``: the suite runs the guide's pages one after
+the other in one kernel, each with a fresh namespace and folder
+(conftest's ``guide_in_one_kernel``), where ``make docs`` gives each page a
+kernel of its own; the build renders the outputs of that run."""
 
 import pkgutil
 import re
@@ -64,8 +69,13 @@ def test_docs_build_with_warnings_as_errors(site):
 
 @pytest.mark.slow
 @pytest.mark.xdist_group("docs")
-def test_every_guide_page_ran_its_code(site):
+def test_every_guide_page_ran_its_code(site, docs_build):
     """Each guide page is in the site with its cells' outputs: the build ran them."""
+    pages = sorted(p.stem for p in (DOCS / "guide").glob("*.md") if p.stem != "index")
+    # every page ran in the shared kernel without an error, and the build rendered
+    # that run (a page it had to run again would be one the shared kernel ran otherwise)
+    assert docs_build.cached == pages
+    assert docs_build.executed_by_build == []
     for page in (DOCS / "guide").glob("*.md"):
         if page.stem == "index":
             continue
@@ -74,6 +84,45 @@ def test_every_guide_page_ran_its_code(site):
     # a number the reader is told to expect, computed in the build
     start = (site / "guide" / "getting-started.html").read_text(encoding="utf-8")
     assert "max |xs error| = 0.000192 m with 2000 RHS evaluations" in start
+
+
+@pytest.mark.slow  # a kernel started and five pages run in it: about 2 s
+def test_the_shared_kernel_gives_each_page_a_fresh_namespace_and_folder(tmp_path):
+    """What `guide_in_one_kernel` keeps from one page to the next is no more
+    than a process keeps: a name the page did not define or import fails it
+    (it is left out of the cache, so the build runs it alone and fails on it),
+    each page starts in an empty folder of its own, and a warning shown once
+    on one page is shown again on the next."""
+    from conftest import DOCS_ENV, guide_in_one_kernel
+    from jupyter_cache import get_cache
+
+    lib, guide, pages = (tmp_path / name for name in ("lib", "guide", "pages"))
+    for folder in (lib, guide, pages):
+        folder.mkdir()
+    # a warning raised inside a module, as the library's are: Python shows it once
+    # per place in that module unless the warnings' registry is forgotten
+    (lib / "warner.py").write_text(
+        "import warnings\n\ndef warn():\n    warnings.warn('from a module', UserWarning)\n"
+    )
+    front = "---\nfile_format: mystnb\nkernelspec: {name: python3, display_name: Python 3}\n---\n"
+    for name, code in {
+        "a": "import numpy as np\nopen('left-behind.txt', 'w').close()",
+        "b": "import os\nassert os.listdir('.') == [], os.listdir('.')",
+        "c": "np.zeros(1)  # imported by page a only",
+        "d": "import warner\nwarner.warn()  # page d",
+        "e": "import warner\nwarner.warn()  # page e: the same place in warner.py",
+    }.items():
+        cell = f"```{{code-cell}} ipython3\n{code}\n```\n"
+        (guide / f"{name}.md").write_text(f"{front}# {name}\n\n{cell}", encoding="utf-8")
+    env = dict(DOCS_ENV, PYTHONPATH=str(lib))
+    cached = guide_in_one_kernel(guide, tmp_path / "cache", pages, env)
+    assert cached == ["a", "b", "d", "e"]
+    assert (pages / "a" / "left-behind.txt").exists()
+    db = get_cache(str(tmp_path / "cache"))
+    for record in db.list_cache_records():
+        if record.uri.endswith(("d.md", "e.md")):
+            (cell,) = db.get_cache_bundle(record.pk).nb.cells
+            assert "UserWarning: from a module" in str(cell.outputs), (record.uri, cell.outputs)
 
 
 #: Pages with formulas: a guide page with display and inline math ($$ and $),
