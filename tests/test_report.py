@@ -535,8 +535,9 @@ def test_legends_never_cover_data(h):
 @pytest.mark.slow
 def test_midpoint_and_heun_are_shown_to_coincide(cmp):
     assert ("midpoint", "heun") in cmp.coincident
+    drawn = _all_figures(cmp)  # each figure made once, not all seven for each name
     for name in ("overlay", "error", "convergence", "work_precision"):
-        fig = _all_figures(cmp)[name]
+        fig = drawn[name]
         lines = {ln.get_label(): ln for ln in fig.axes[0].lines}
         mid, heun = lines["midpoint"], lines["heun"]
         assert mid.get_linestyle() == "-" and heun.get_linestyle() == "--", name
