@@ -12,7 +12,12 @@ from pathlib import Path
 import filelock
 import pandas as pd
 import pytest
-from reports_shared import placeholder_figures, quick_figures, untimed  # noqa: F401  (fixtures)
+from reports_shared import (  # noqa: F401  (fixtures)
+    placeholder_figures,
+    quick_figures,
+    untimed,
+    without_pdf,
+)
 
 import qc_control
 from qc_control.cli import console
@@ -279,12 +284,14 @@ def reproduce_line(directory) -> str:
 
 
 @pytest.mark.slow
-@pytest.mark.usefixtures("placeholder_figures", "untimed")  # the numbers, not the pictures
+# the numbers, not the pictures, the times or the PDF (which holds the same words and tables)
+@pytest.mark.usefixtures("placeholder_figures", "untimed", "without_pdf")
 def test_report_reproduces_from_its_own_command_and_scenario_toml(files, capsys):
     """Issue 13: a custom car on a 10 cm bump at 15 m/s reproduces from its "Reproduce" line.
 
-    The wall times are left out of the comparison (a rerun changes them), and
-    the figures are placeholders: what must reproduce is every other number."""
+    The wall times are left out of the comparison (a rerun changes them), the
+    figures are placeholders and no PDF is written: what must reproduce is
+    every other number."""
     args = ["--ms", "350", "--zeta", "0.3", "--road", "bump", "--road-height", "0.1"]
     args += ["--speed", "15", "--t-end", "2", "--methods", "euler,rk4", "--out", "A"]
     assert main(["report", *args]) == 0
@@ -415,8 +422,8 @@ def test_nonlinear_options_make_the_scenario(files):
 
 
 @pytest.mark.slow
-# its words, not its pictures (tests/test_compare_nonlinear.py draws them) nor times
-@pytest.mark.usefixtures("placeholder_figures", "untimed")
+# its words, not its pictures (tests/test_compare_nonlinear.py draws them), times or PDF
+@pytest.mark.usefixtures("placeholder_figures", "untimed", "without_pdf")
 def test_nonlinear_report_from_the_command_line(files, capsys):
     assert main(["report", "--model", "nonlinear", "--quiet", "--out", "NL"]) == 0
     report = (files / "NL" / "report.md").read_text(encoding="utf-8")
