@@ -17,6 +17,11 @@ files are written, needs neither at full cost:
 - `untimed`: the command's comparison run without its wall-time
   measurements (``compare_methods(timing=False)``), whose columns then hold
   NaN: for tests that read no time (a rerun changes the times anyway).
+- `without_pdf`: ``qc-control report`` writes every file but ``report.pdf``
+  (with placeholder figures the PDF's layout is most of a report's cost):
+  for tests that read the report's words, tables or other files. The PDF is
+  checked by tests/test_pdf_layout.py, tests/test_report.py and the fault
+  cases of tests/test_report_safety.py.
 """
 
 import dataclasses
@@ -26,6 +31,7 @@ import pytest
 from matplotlib.figure import Figure
 
 from qc_control import report as report_package
+from qc_control.cli import parser as parser_module
 from qc_control.cli import scenario as scenario_module
 
 
@@ -67,6 +73,14 @@ def use_untimed(monkeypatch) -> None:
 def untimed(monkeypatch):
     """The command's comparison without wall-time runs (the times are NaN)."""
     use_untimed(monkeypatch)
+
+
+@pytest.fixture
+def without_pdf(monkeypatch):
+    """``qc-control report`` writes its report in every format but the PDF."""
+    formats = tuple(f for f in report_package.FORMATS if f != "pdf")
+    real = parser_module.write_report
+    monkeypatch.setattr(parser_module, "write_report", functools.partial(real, formats=formats))
 
 
 def run_untimed(scenario):

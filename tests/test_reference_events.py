@@ -15,6 +15,7 @@ import warnings
 
 import numpy as np
 import pytest
+from reports_shared import quick_figures, untimed  # noqa: F401  (fixtures)
 from scipy.integrate import solve_ivp
 
 import qc_control as qc
@@ -182,6 +183,10 @@ def test_scenario_with_a_stop_of_clearance_0():
 
 
 @pytest.mark.slow
+# The claim is the exit and the report: its figures (the events' and the parting's among
+# them) are still drawn, through the same artists and layout, at 40 dpi; the wall-time runs
+# are left out (no time is read; they were a tenth of each run)
+@pytest.mark.usefixtures("quick_figures", "untimed")
 @pytest.mark.parametrize(
     "options",
     [

@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from reports_shared import placeholder_figures, untimed  # noqa: F401  (fixtures)
+from reports_shared import placeholder_figures, untimed, without_pdf  # noqa: F401  (fixtures)
 
 import qc_control as qc
 from qc_control import report as rep_package
@@ -252,7 +252,8 @@ def test_cli_refuses_foreign_directory(tmp_path, capsys):
 
 
 @pytest.mark.slow
-@pytest.mark.usefixtures("placeholder_figures", "untimed")  # its text and files
+# its text and files, not its pictures, times or PDF (which holds the same text)
+@pytest.mark.usefixtures("placeholder_figures", "untimed", "without_pdf")
 def test_road_report_has_the_ride_section(tmp_path, capsys):
     out = tmp_path / "road"
     assert (
@@ -535,8 +536,9 @@ def test_legends_never_cover_data(h):
 @pytest.mark.slow
 def test_midpoint_and_heun_are_shown_to_coincide(cmp):
     assert ("midpoint", "heun") in cmp.coincident
+    drawn = _all_figures(cmp)  # each figure made once, not all seven for each name
     for name in ("overlay", "error", "convergence", "work_precision"):
-        fig = _all_figures(cmp)[name]
+        fig = drawn[name]
         lines = {ln.get_label(): ln for ln in fig.axes[0].lines}
         mid, heun = lines["midpoint"], lines["heun"]
         assert mid.get_linestyle() == "-" and heun.get_linestyle() == "--", name

@@ -11,6 +11,7 @@ import math
 import control
 import numpy as np
 import pytest
+from reports_shared import placeholder_figures  # noqa: F401  (a fixture)
 from scipy.integrate import solve_ivp
 
 import qc_control as qc
@@ -116,6 +117,8 @@ def test_on_a_short_road_each_cheapest_run_is_within_the_target():
 
 
 @pytest.mark.slow
+# the report's section and table are checked, not its pictures (drawn by tests/test_report.py)
+@pytest.mark.usefixtures("placeholder_figures")
 def test_a_short_stiff_run_reaches_the_target_and_reports_it(tmp_path):
     # 2 s of the same road: the comparison carries the cost, the report shows it
     from qc_control.report import write_report

@@ -10,6 +10,7 @@ import control
 import numpy as np
 import pytest
 from conftest import gallery_run
+from reports_shared import placeholder_figures, untimed, without_pdf  # noqa: F401  (fixtures)
 
 import qc_control as qc
 from qc_control.cli.parser import run
@@ -88,6 +89,11 @@ def test_an_explicit_method_above_its_limit_diverges_against_the_exact_response(
 
 
 @pytest.mark.slow
+# what is checked is the scenario and the report's sections and files: its figures are
+# placeholders (this car's peers' figures are drawn by its example, in
+# test_the_example_shows_the_mount_mode below; the others by tests/test_report.py),
+# the methods' wall times are left out (none is read) and no PDF is written
+@pytest.mark.usefixtures("placeholder_figures", "untimed", "without_pdf")
 def test_stiff_scenario_kind_and_the_command_line(tmp_path):
     sc = Scenario(kind="stiff")
     assert sc.option("mount_stiffness") == 1e7 and len(sc.x0) == 5
