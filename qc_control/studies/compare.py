@@ -563,14 +563,18 @@ def _convergence_points(
 
 
 def _linear_refinement(
-    sys, X0, substeps: int, body: int, timing: bool, tab, level, T, U
+    sys, X0, substeps: int, body: int, timing: bool, exact_at: dict, tab, level, T, U
 ) -> _Refinement:
     """A method on a refined grid of a linear system, against the exact response there.
 
+    The exact response on each refined grid is the same for every method:
+    computed for the first and kept in ``exact_at`` (by level) for the others.
     Its time is a second run step by step (``engine='generic'``, whose time
     follows the RHS evaluations), as `method_timings` measures.
     """
-    exact = np.asarray(_exact(sys, T, X0, U).outputs)[body]
+    if level not in exact_at:
+        exact_at[level] = np.asarray(_exact(sys, T, X0, U).outputs)[body]
+    exact = exact_at[level]
     response = _simulate(sys, T, X0, U, tab, substeps)
     seconds = (
         best_time(lambda: _simulate(sys, T, X0, U, tab, substeps, "generic"), 1)
@@ -603,7 +607,7 @@ def convergence_study(
     """
     eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
     body = list(sys.output_labels).index(model.body_disp)
-    run = functools.partial(_linear_refinement, sys, X0, substeps, body, timing)
+    run = functools.partial(_linear_refinement, sys, X0, substeps, body, timing, {})
     points: list[ConvergencePoint] = []
     for tab in methods:
         if progress:
