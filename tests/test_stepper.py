@@ -211,6 +211,32 @@ def test_linear_input_one_and_many_agree_and_hit_the_samples():
     np.testing.assert_allclose(many[1:-1], chord, rtol=1e-15, atol=1e-16)
 
 
+def test_a_single_input_as_a_float_is_the_call_to_the_bit():
+    """`SampledInput.scalar` (the linear car's cheap right-hand side on one road) reads the
+    same slope and sample with the same operations: bit for bit the call's value, at the
+    samples, between them, before the first and past the last; more inputs are refused."""
+    T = np.linspace(0.0, 1.0, 101)
+    u = linear_input(T, np.sin(7 * T)[None])
+    one = u.scalar()
+    times = [
+        -0.5,
+        0.0,
+        1e-9,
+        0.0137,
+        0.5,
+        0.73456,
+        0.99999,
+        1.0,
+        1.5,
+        *np.random.default_rng(1).random(50),
+    ]
+    for t in times:
+        assert one(float(t)) == u(float(t))[0]  # exact: the same float operations
+        assert one(np.float64(t)) == u(float(t))[0]  # the stepper's times may be NumPy floats
+    with pytest.raises(ValueError, match="one input"):
+        linear_input(T, np.vstack([T, T])).scalar()
+
+
 def test_the_substep_rule():
     """An interval that holds h an integer number of times up to rounding: that many steps."""
     assert substeps_for(0.1, 0.001) == 100  # 0.1 / 0.001 = 100.00000000000001

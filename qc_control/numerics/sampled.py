@@ -11,6 +11,7 @@ formula, so both give the same bits.
 from __future__ import annotations
 
 import bisect
+from collections.abc import Callable
 
 import numpy as np
 
@@ -58,6 +59,35 @@ class SampledInput:
             return self._rows[0].copy()
         # np.interp's own expression, slope·(t - T_i) + U_i, so that `at` agrees to the bit
         return self._slopes[i] * (t - self._times[i]) + self._rows[i]
+
+    def scalar(self) -> Callable[[float], float]:
+        """``u(t)`` of a single input as a float: the call's value to the bit, in plain floats.
+
+        A right-hand side called once per stage (a linear car on one road,
+        ``A x + b u(t)``) spends most of its time on the few small arrays
+        the call builds; this reads the same slope and sample as Python
+        floats (the same operations in the same order) and returns a float.
+
+        Raises
+        ------
+        ValueError
+            For more than one input (`size` > 1).
+        """
+        if self.size != 1:
+            raise ValueError(f"a scalar input needs one input, this one has {self.size}")
+        times, last, bisect_right = self._times, self._last, bisect.bisect_right
+        rows, slopes = self._rows[:, 0].tolist(), self._slopes[:, 0].tolist()
+        first_row, last_row = rows[0], rows[-1]
+
+        def u(t: float) -> float:
+            i = bisect_right(times, t) - 1
+            if i > last:
+                return last_row
+            if i < 0:
+                return first_row
+            return slopes[i] * (t - times[i]) + rows[i]
+
+        return u
 
     def at(self, times) -> np.ndarray:
         """The inputs at every time of ``times`` (any shape): ``(*times.shape, k)``.

@@ -118,6 +118,9 @@ def peer_derivative(sys, T, U) -> Callable[[float, np.ndarray], np.ndarray]:
         A, B = np.asarray(sys.A, dtype=float), np.asarray(sys.B, dtype=float)
         if U is None or ninputs == 0:
             return lambda t, x: A @ x
+        if ninputs == 1:  # one road: u(t) a float, the same products to the bit, cheaper
+            u1, b = linear_input(T, U).scalar(), B[:, 0].copy()
+            return lambda t, x: A @ x + u1(t) * b
         return lambda t, x: A @ x + B @ u_of_t(t)
     compat.update_params(sys, None)
     f = compat.state_derivative(sys)
