@@ -33,7 +33,8 @@ intervals of an output grid (``substeps`` steps each, every
 
 An implicit tableau's stages depend on each other and on themselves:
 `ImplicitSteps` solves them at each step by a simplified Newton iteration
-(Hairer & Wanner, *Solving ODEs II*, §IV.8), over the same intervals.
+(Hairer & Wanner, *Solving ODEs II*, §IV.8), over the same intervals; on a
+right-hand side affine in the state, by one linear solve.
 """
 
 from __future__ import annotations
@@ -372,6 +373,17 @@ class ImplicitSteps:
     ``x + Σ d_i Z_i`` with ``dᵀ = bᵀA⁻¹`` when ``A`` is invertible (HW II,
     eq. 8.2b), else ``x + h Σ b_i f(t + c_i h, x + Z_i)``.
 
+    With ``linear=True`` the right-hand side is affine in the state,
+    ``f(t, x) = J x + g(t)`` with ``J`` the constant ``jac``: the stage
+    equations are then linear, and the iteration's first correction from
+    ``Z = 0``, ``(I - h\,a \otimes J)\,Z = h (a \otimes I) F(0)``, solves
+    them exactly (the later ones are rounding). Each step is that one
+    solve with the factors of its step size: ``s`` calls of ``f``, all at
+    the step's start, and no convergence test; without ``d`` the end's
+    stage derivatives are ``f(t + c_i h, x) + J Z_i``, without calling
+    ``f`` again. A non-finite solution raises `NewtonFailure`, as a
+    non-finite correction does.
+
     Parameters
     ----------
     tab : ButcherTableau
@@ -383,6 +395,9 @@ class ImplicitSteps:
         The grid's step if uniform (`qc_control.numerics.integrate.uniform_step`).
     jac : callable ``jac(t, x) -> (n, n)``, optional
         The Jacobian of ``f``.
+    linear : bool, default False
+        ``f`` is affine in ``x`` and ``jac`` (then required) its constant
+        Jacobian: one linear solve per step (class notes).
 
     Attributes
     ----------
@@ -392,8 +407,13 @@ class ImplicitSteps:
         Jacobians formed and Newton iterations taken.
     """
 
-    def __init__(self, tab: ButcherTableau, t, substeps: int = 1, dt=None, jac=None):
+    def __init__(
+        self, tab: ButcherTableau, t, substeps: int = 1, dt=None, jac=None, linear: bool = False
+    ):
+        if linear and jac is None:
+            raise ValueError("linear=True needs jac, the affine right-hand side's constant matrix")
         self.tab, self.t, self.substeps, self.dt, self.jac = tab, t, substeps, dt, jac
+        self.linear = linear
         self.nfev = self.jacobians = self.iterations = 0
         self._J: np.ndarray | None = None  # the Jacobian in use, and its factorisation at _lu_h
         self._lu: tuple[np.ndarray, np.ndarray] | None = None
@@ -435,6 +455,8 @@ class ImplicitSteps:
         fresh = self._J is None
         if fresh:
             self._refresh(f, t, x)
+        if self.linear:
+            return self._linear_step(f, t, x, h)
         try:
             return self._newton(f, t, x, h)
         except NewtonFailure:
@@ -448,20 +470,40 @@ class ImplicitSteps:
         self._lu_h = None
         self.jacobians += 1
 
+    def _factors(self, h: float, n: int):
+        """``(J, ha, lu, piv, getrs)``: the kept Jacobian, ``h a`` and the LU factors of
+        ``I - h a ⊗ J``, factorised once per Jacobian and step size."""
+        J = self._J
+        if J is None:  # step makes one before the first iteration
+            raise ValueError("the Newton iteration needs a Jacobian: _refresh first")
+        ha = h * self.tab.a
+        if self._lu is None or self._lu_h != h:
+            self._lu = lu_factor(np.eye(self.tab.stages * n) - np.kron(ha, J))
+            self._lu_h = h
+            funcs: Any = get_lapack_funcs(("getrs",), (self._lu[0],))  # a list, for a tuple
+            self._getrs = funcs[0]
+        return J, ha, self._lu[0], self._lu[1], self._getrs
+
+    def _linear_step(self, f, t: float, x, h: float):
+        """One step of an affine right-hand side: the linear stage equations solved once
+        (class notes); the Newton iteration's first correction, to the bit."""
+        s, n = self.tab.stages, x.size
+        J, ha, lu, piv, getrs = self._factors(h, n)
+        F = np.array([f(t + h * c, x) for c in self._c])  # stage_times' operations
+        self.nfev += s
+        self.iterations += 1
+        Z = getrs(lu, piv, (ha @ F).reshape(-1))[0].reshape(s, n)
+        if not np.isfinite(Z).all():
+            raise NewtonFailure(t, h, "a correction became non-finite")
+        if self._d is not None:
+            return x + self._d @ Z
+        return x + h * (self._b @ (F + Z @ J.T))  # f(t_i, x + Z_i) = f(t_i, x) + J Z_i
+
     def _newton(self, f, t: float, x, h: float):
         """The simplified Newton iteration of one step with the kept Jacobian."""
         s, n = self.tab.stages, x.size
         times = [t + h * c for c in self._c]  # stage_times' operations: exact input look-ups
-        ha = h * self.tab.a
-        J = self._J
-        if J is None:  # _step makes one before the first iteration
-            raise ValueError("the Newton iteration needs a Jacobian: _refresh first")
-        if self._lu is None or self._lu_h != h:  # one factorisation per Jacobian and step size
-            self._lu = lu_factor(np.eye(s * n) - np.kron(ha, J))
-            self._lu_h = h
-            funcs: Any = get_lapack_funcs(("getrs",), (self._lu[0],))  # a list, for a tuple
-            self._getrs = funcs[0]
-        (lu, piv), getrs = self._lu, self._getrs
+        J, ha, lu, piv, getrs = self._factors(h, n)
         Z = np.zeros((s, n), dtype=J.dtype)
         scale, previous, slowest = float(np.max(np.abs(x), initial=0.0)), math.inf, 0.0
         for k in range(NEWTON_MAXITER):

@@ -52,6 +52,7 @@ from ..numerics.clocked import ClockedLoop, step_clocked
 from ..numerics.integrate import (
     STEP_BLOCK,
     DivergenceWarning,
+    check_run_steps,
     check_step_memory,
     check_substeps,
     check_time_grid,
@@ -67,7 +68,7 @@ from ..numerics.lti import array_key, is_nonlinear_system, lti_states, memo
 from ..numerics.methods import TABLEAUS, ButcherTableau, get_method
 from ..numerics.sampled import linear_input
 from ..numerics.stability import max_stable_step, stability_coefficients, step_is_stable
-from ..numerics.stepper import substeps_for
+from ..numerics.stepper import ImplicitSteps, substeps_for
 from ..numerics.trajectory_stability import (
     GROWTH_FACTOR,
     fastest_changes,
@@ -364,14 +365,28 @@ def _linear_rhs(A, B, T, u_samples):
 
 
 def _generic(A, B, T, u_samples, x0, tab, substeps, warn):
-    """The generic stepper on ``f(t, x) = A x + B u(t)``."""
+    """The generic stepper on ``f(t, x) = A x + B u(t)``.
+
+    An implicit tableau's stages are linear in them here: each step is one
+    solve with the factors of ``I - h a ⊗ A`` (`ImplicitSteps` with
+    ``linear=True``, the Newton iteration's first correction, which solves
+    them exactly), its ``s`` evaluations of ``f`` counted as any method's.
+    """
     rhs = _linear_rhs(A, B, T, u_samples)
-    # an implicit tableau's Newton iteration gets the exact Jacobian, A itself
-    jac = (lambda t, x: A) if tab.implicit else None
     with warnings.catch_warnings():
         if not warn:  # the step-size warning already told the user
             warnings.simplefilter("ignore", DivergenceWarning)
-        return integrate(rhs, T, x0, tab, substeps=substeps, jac=jac)
+        if not tab.implicit:
+            return integrate(rhs, T, x0, tab, substeps=substeps)
+        check_run_steps(T.size - 1, substeps)
+        steps = ImplicitSteps(
+            tab, T.tolist(), substeps, uniform_step(T), jac=lambda t, x: A, linear=True
+        )
+
+        def run(x, out, start, stop):
+            return steps.run(rhs, x, out[start:], start, stop)
+
+        return integrate_stepper(run, T, x0, tab, substeps=substeps)
 
 
 def _not_a_method(value, name: str) -> None:
