@@ -169,6 +169,28 @@ def test_steps_compose_and_timing_is_optional():
     assert {"max |tire_defl err| [m]", "max |body_acc err| [m/s²]"} <= set(errors.columns)
 
 
+def test_a_timed_ladder_beyond_the_stability_limit_has_the_untimed_numbers():
+    """Euler on the seed car at h = 40 ms and 20 ms (beyond its 19.8 ms limit), then
+    stable: timed, the default engine's step-by-step run of an unstable step is the
+    one run, timed once (the peers' ladder takes that time, not a best of 3); every
+    number but the times is the untimed study's, to the bit (the same runs)."""
+    T = np.linspace(0, 2, 51)
+    X0 = [0.0, 0.0, 0.05, 0.0]
+    options = dict(methods=["euler", "rk4"], solvers=("RK45",), rtols=(1e-3,), repeats=1)
+    timed = qc.compare_methods(qc.QuarterCarParams(), T, X0, **options)
+    plain = qc.compare_methods(qc.QuarterCarParams(), T, X0, timing=False, **options)
+    conv = timed.convergence
+    assert (~conv["stable"]).sum() == 2  # euler at levels 0 and 1
+    pd.testing.assert_frame_equal(
+        conv.drop(columns="time"), plain.convergence.drop(columns="time"), check_exact=True
+    )
+    assert (conv["time"] > 0).all() and plain.convergence["time"].isna().all()
+    runs = timed.peers.runs[timed.peers.runs["kind"] == "method"].reset_index(drop=True)
+    unstable = ~conv["stable"].to_numpy()
+    np.testing.assert_array_equal(runs["time"][unstable], conv["time"][unstable])
+    assert (runs["time"] > 0).all()
+
+
 def test_a_cost_beyond_any_run_is_unreached_not_a_number():
     """Euler from x0 = 1e150 m errs by ~1e143 m; reaching 1e-9 m at order 1 would take
     ~1e152 RHS evaluations (e ∝ h, so n ∝ e0/tol): reported 'unreached', as for a

@@ -32,12 +32,17 @@ from ..models.quarter import (
 from ..models.registry import MODELS, model_for_params, model_for_system
 from ..models.vehicle import VehicleModel
 from ..numerics.clocked import ClockedLoop, exact_clocked
-from ..numerics.integrate import DivergenceWarning, check_time_grid, uniform_step
+from ..numerics.integrate import (
+    DivergenceWarning,
+    check_time_grid,
+    checked_uniform_step,
+    uniform_step,
+)
 from ..numerics.limits import check_memory
 from ..numerics.lti import is_nonlinear_system
 from ..numerics.methods import ButcherTableau, get_method
 from ..numerics.sampled import linear_input
-from ..numerics.stability import max_stable_step, numerical_modes
+from ..numerics.stability import max_stable_step, numerical_modes, step_is_stable
 from ..responses.timeresp import (
     check_initial_state,
     check_input_samples,
@@ -562,19 +567,34 @@ def _convergence_points(
     return points, at_h
 
 
+def _stepped_by_default(tab: ButcherTableau, T: np.ndarray, substeps: int, eig) -> bool:
+    """Whether the responses' default engine steps this run step by step: on a uniform
+    grid, exactly when the step is beyond the method's stability limit (the responses'
+    own test, `step_is_stable` on ``A``'s eigenvalues), where the LTI engine hands
+    the diverging run to the generic stepper."""
+    dt = checked_uniform_step(T)
+    return dt is not None and not step_is_stable(tab, dt / substeps, eig)
+
+
 def _linear_refinement(
-    sys, X0, substeps: int, body: int, timing: bool, exact_at: dict, tab, level, T, U
+    sys, X0, substeps: int, body: int, timing: bool, eig, exact_at: dict, tab, level, T, U
 ) -> _Refinement:
     """A method on a refined grid of a linear system, against the exact response there.
 
     The exact response on each refined grid is the same for every method:
     computed for the first and kept in ``exact_at`` (by level) for the others.
-    Its time is a second run step by step (``engine='generic'``, whose time
-    follows the RHS evaluations), as `method_timings` measures.
+    Its time is a run step by step (``engine='generic'``, whose time follows
+    the RHS evaluations), as `method_timings` measures: a second run, unless
+    the default engine steps this one step by step itself (a step beyond the
+    stability limit), when the one run is that run, timed.
     """
     if level not in exact_at:
         exact_at[level] = np.asarray(_exact(sys, T, X0, U).outputs)[body]
     exact = exact_at[level]
+    if timing and _stepped_by_default(tab, T, substeps, eig):
+        start = time.perf_counter()
+        response = _simulate(sys, T, X0, U, tab, substeps, "generic")
+        return _Refinement(response, exact, time.perf_counter() - start)
     response = _simulate(sys, T, X0, U, tab, substeps)
     seconds = (
         best_time(lambda: _simulate(sys, T, X0, U, tab, substeps, "generic"), 1)
@@ -607,7 +627,7 @@ def convergence_study(
     """
     eig = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
     body = list(sys.output_labels).index(model.body_disp)
-    run = functools.partial(_linear_refinement, sys, X0, substeps, body, timing, {})
+    run = functools.partial(_linear_refinement, sys, X0, substeps, body, timing, eig, {})
     points: list[ConvergencePoint] = []
     for tab in methods:
         if progress:
@@ -1105,13 +1125,24 @@ def compare_methods(
 
 def _engine_times(problem: ComparisonProblem, convergence: pd.DataFrame) -> pd.DataFrame:
     """The fixed-step ladder timed as a user runs it: a linear car through the LTI engine
-    (qc's default for it, the same trajectory), best of 3; a nonlinear one as stepped."""
+    (qc's default for it, the same trajectory), best of 3; a nonlinear one as stepped.
+
+    A step beyond a method's stability limit is one the default engine steps step
+    by step (a diverging run, never among the cheapest): its time is the
+    convergence study's, which timed that same run.
+    """
     if is_nonlinear_system(problem.system) or convergence["time"].isna().all():
         return convergence
     tabs = {t.name: t for t in problem.methods}
+    eig = np.linalg.eigvals(np.asarray(problem.system.A, dtype=float))
     times = []
-    for method, level in zip(convergence["method"], convergence["level"]):
+    for method, level, stepped in zip(
+        convergence["method"], convergence["level"], convergence["time"]
+    ):
         T, U = _refined(problem.T, level), _refined_input(problem.T, problem.U, level)
+        if _stepped_by_default(tabs[method], T, problem.substeps, eig):
+            times.append(stepped)
+            continue
         run = functools.partial(
             _simulate, problem.system, T, problem.X0, U, tabs[method], problem.substeps
         )
