@@ -504,13 +504,16 @@ def _culprit(values: Mapping, cls: type) -> str | None:
 _STABLE_DEFAULT_SPAN = 10.0
 
 
-def _coarse_remedy(road) -> str:
-    """What to change besides h when the road is too fine for the grid."""
+def _coarse_remedy(road, limit: float) -> str:
+    """What to change when the road is too fine for the grid: h, or the road
+    alone when its ``limit`` underflowed to 0 s (a 1e308 Hz sine), which no h meets."""
     if isinstance(road, BumpRoad):
-        return "a longer bump or a lower speed"
-    if isinstance(road, SineRoad):
-        return "a lower frequency"
-    return "narrow the band"
+        road_change = "a longer bump or a lower speed"
+    elif isinstance(road, SineRoad):
+        road_change = "a lower frequency"
+    else:
+        return "give a smaller h, or narrow the band" if limit > 0 else "narrow the band"
+    return f"give a smaller h, or {road_change}" if limit > 0 else f"give {road_change}"
 
 
 def _iso_step(limit: float) -> float:
@@ -689,7 +692,7 @@ class Scenario:
         if self.h > limit * (1 + 1e-12):
             raise ScenarioError(
                 f"h = {self.h!r} s is too coarse for {road.sampled()}: it must be <= "
-                f"{limit:.4g} s (give a smaller h, or {_coarse_remedy(road)})",
+                f"{limit:.4g} s ({_coarse_remedy(road, limit)})",
                 "scenario",
                 "h",
             )
@@ -795,7 +798,7 @@ class Scenario:
         convergence study's refinements too long a run: it is left to the
         warning (`beyond_limits`) instead.
         """
-        if h > road_limit:
+        if h > road_limit > 0:  # 0 s: no step samples the road, which the grid check refuses
             h = _iso_step(road_limit)
         stable = [limit for limit in self.step_limits().values() if 0 < limit < h]
         if not stable:
