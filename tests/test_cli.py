@@ -56,12 +56,56 @@ def test_modes_options_and_config(tmp_path, capsys):
     assert "8.66" in text
 
 
-@pytest.mark.slow
+#: What a command's start spends most of its CPU importing (about 2 s of it):
+#: the top level is answered without any of them.
+LIBRARY = ("control", "matplotlib", "pandas")
+
+
+def imported(importtime: str) -> set[str]:
+    """The modules ``python -X importtime`` lists on stderr."""
+    return {line.split("|")[-1].strip() for line in importtime.splitlines() if "|" in line}
+
+
 def test_version(capsys):
     assert main(["--version"]) == 0
     assert capsys.readouterr().out.startswith(f"qc-control {qc_control.__version__} (")
-    out = run("--version")
+    # a real process, which lists what it imports: none of the library's heavy packages
+    out = subprocess.run(
+        [sys.executable, "-X", "importtime", "-m", "qc_control.cli.console", "--version"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert out.returncode == 0 and qc_control.__version__ in out.stdout
+    assert imported(out.stderr).isdisjoint(LIBRARY), sorted(imported(out.stderr))
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["--help"], ["-h", "report"], [], ["frobnicate"], ["--bogus"], ["--model", "x"]]
+    + [["modes", "--help"], ["report", "-h", "--model", "half"]],  # the commands' own: whole
+)
+def test_the_top_level_answers_in_the_words_of_the_whole_parser(argv, capsys):
+    """The entry point answers these before loading the library; the whole
+    parser (`qc_control.cli.parser.run`) says the same, with the same status."""
+    light = main(argv), capsys.readouterr()
+    whole = cli.run(argv), capsys.readouterr()
+    assert light == whole
+    assert light[0] == 0 or light[1].err.count("\n") == 1  # help, or one error line
+
+
+def test_the_top_level_is_answered_without_the_library():
+    """--help and bad commands, in a fresh process, import none of `LIBRARY`."""
+    code = (
+        "import sys\n"
+        "from qc_control.cli.console import main\n"
+        "status = [main(a) for a in (['--help'], [], ['frobnicate'], ['--bogus', '-h'])]\n"
+        f"print(status, sorted(m for m in {LIBRARY!r} if m in sys.modules), file=sys.stderr)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.count("usage: qc-control [-h] [--version]") == 2  # --help, --bogus -h
+    assert out.stderr.splitlines()[-1] == "[0, 2, 2, 0] []", out.stderr
 
 
 @pytest.fixture
