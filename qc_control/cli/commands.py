@@ -12,6 +12,7 @@ the same. This module imports only the standard library.
 from __future__ import annotations
 
 import argparse
+import functools
 import sys
 from importlib.metadata import version
 from typing import Any
@@ -54,6 +55,7 @@ class CommandParser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
+@functools.cache  # each read scans the installed distributions: ~2 ms, once a process
 def version_line() -> str:
     """``'qc-control 0.1.0 (python-control 0.10.2)'``: both read from the installed
     distributions' metadata, so python-control is not imported for it."""
