@@ -2,6 +2,7 @@
 
 import ast
 import builtins
+import logging
 import os
 import re
 import shlex
@@ -56,12 +57,56 @@ def test_modes_options_and_config(tmp_path, capsys):
     assert "8.66" in text
 
 
-@pytest.mark.slow
+#: What a command's start spends most of its CPU importing (about 2 s of it):
+#: the top level is answered without any of them.
+LIBRARY = ("control", "matplotlib", "pandas")
+
+
+def imported(importtime: str) -> set[str]:
+    """The modules ``python -X importtime`` lists on stderr."""
+    return {line.split("|")[-1].strip() for line in importtime.splitlines() if "|" in line}
+
+
 def test_version(capsys):
     assert main(["--version"]) == 0
     assert capsys.readouterr().out.startswith(f"qc-control {qc_control.__version__} (")
-    out = run("--version")
+    # a real process, which lists what it imports: none of the library's heavy packages
+    out = subprocess.run(
+        [sys.executable, "-X", "importtime", "-m", "qc_control.cli.console", "--version"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert out.returncode == 0 and qc_control.__version__ in out.stdout
+    assert imported(out.stderr).isdisjoint(LIBRARY), sorted(imported(out.stderr))
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["--help"], ["-h", "report"], [], ["frobnicate"], ["--bogus"], ["--model", "x"]]
+    + [["modes", "--help"], ["report", "-h", "--model", "half"]],  # the commands' own: whole
+)
+def test_the_top_level_answers_in_the_words_of_the_whole_parser(argv, capsys):
+    """The entry point answers these before loading the library; the whole
+    parser (`qc_control.cli.parser.run`) says the same, with the same status."""
+    light = main(argv), capsys.readouterr()
+    whole = cli.run(argv), capsys.readouterr()
+    assert light == whole
+    assert light[0] == 0 or light[1].err.count("\n") == 1  # help, or one error line
+
+
+def test_the_top_level_is_answered_without_the_library():
+    """--help and bad commands, in a fresh process, import none of `LIBRARY`."""
+    code = (
+        "import sys\n"
+        "from qc_control.cli.console import main\n"
+        "status = [main(a) for a in (['--help'], [], ['frobnicate'], ['--bogus', '-h'])]\n"
+        f"print(status, sorted(m for m in {LIBRARY!r} if m in sys.modules), file=sys.stderr)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.count("usage: qc-control [-h] [--version]") == 2  # --help, --bogus -h
+    assert out.stderr.splitlines()[-1] == "[0, 2, 2, 0] []", out.stderr
 
 
 @pytest.fixture
@@ -102,6 +147,9 @@ BAD = [
     (["report", "--road", "wobble"], "--road must be one of step, bump, sine, iso8608 or none"),
     (["report", "--road", "iso8608", "--h", "0.01"], "--h 0.01 s is too coarse for an ISO 8608"),
     (["report", "--road", "iso8608", "--road-class", "Z"], "unknown ISO 8608 road class 'Z'"),
+    # found by tests/test_properties.py: 1/(20 × 1e308 Hz) underflows to a 0 s limit, whose
+    # log10 was a math domain error (an internal error) when the default step was lowered
+    (["report", "--road", "sine", "--road-frequency", "1e308"], "<= 0 s (give a lower freq"),
     (["report", "--road", "bump", "--speed", "0"], "--speed must be a finite number > 0 m/s"),
     (["report", "--road-band", "1,a"], "argument --road-band: expected comma-separated numbers"),
     (["report", "--ms", "1e200", "--ks", "1e200"], "time scales span more than"),
@@ -323,22 +371,41 @@ def test_report_reproduces_from_its_own_command_and_scenario_toml(files, capsys)
 # --- issue 14 item 20: warnings are summarised once, in words -----------------
 
 
+def terminal(argv: list[str], process: bool, capfd, caplog) -> tuple[int, str]:
+    """The exit status and all that ``qc-control`` shows on the terminal's stderr.
+
+    A real process's own stderr; or, in-process, the stderr file descriptor
+    (``capfd``) and its loggers' warnings (``caplog``: pytest takes the records
+    that a process's logging prints to stderr), which must be none.
+    """
+    if process:
+        done = run(*argv)
+        return done.returncode, done.stderr
+    status = main(argv)
+    logged = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
+    assert not logged, logged
+    return status, capfd.readouterr().err
+
+
 @pytest.mark.parametrize(
-    "args, words",
+    "args, words, process",
     [
-        # tiny masses: every method diverges at h = 10 ms (44 RuntimeWarnings on 95cf135)
-        (["--ms", "1e-6", "--mu", "1e-6", "--t-end", "1"], "beyond the stability limit"),
-        # undamped: Euler has no stable step ("∞% of it" and a divide-by-zero warning)
-        (["--zeta", "0", "--t-end", "1"], "Euler has no stable step"),
+        # tiny masses: every method diverges at h = 10 ms (44 RuntimeWarnings on 95cf135);
+        # a real process, as a user runs it: its stderr is all the terminal shows
+        (["--ms", "1e-6", "--mu", "1e-6", "--t-end", "1"], "beyond the stability limit", True),
+        # undamped: Euler has no stable step ("∞% of it" and a divide-by-zero warning);
+        # in-process (the process's part is the case above's)
+        (["--zeta", "0", "--t-end", "1"], "Euler has no stable step", False),
     ],
     ids=["tiny masses", "undamped"],
 )
 @pytest.mark.slow
-def test_degenerate_designs_report_without_a_warning_flood(tmp_path, args, words):
-    # a real process: pytest would otherwise capture the warnings before stderr
-    done = run("report", *args, "--quiet", "--out", str(tmp_path / "R"))
-    assert done.returncode == 0, done.stderr
-    err = done.stderr
+def test_degenerate_designs_report_without_a_warning_flood(
+    tmp_path, args, words, process, capfd, caplog
+):
+    argv = ["report", *args, "--quiet", "--out", str(tmp_path / "R")]
+    status, err = terminal(argv, process, capfd, caplog)
+    assert status == 0, err
     # --quiet: no progress; the root causes are fixed, so the only lines left are
     # the one-line warnings, given before the run, of each method beyond its limit
     lines = err.splitlines()
@@ -347,7 +414,7 @@ def test_degenerate_designs_report_without_a_warning_flood(tmp_path, args, words
     text = (tmp_path / "R" / "report.md").read_text()
     assert "∞%" not in text and "inf%" not in text  # (∞ as an error of a diverged run is right)
     assert "beyond the stability limit" in text  # the finding says what happened, in words
-    # each design's own finding, in words (the report the user gets, from the real process)
+    # each design's own finding, in words (the report the user gets)
     assert words in text
 
 

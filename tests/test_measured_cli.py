@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from reports_shared import quick_figures  # noqa: F401  (fixtures)
 
 import qc_control as qc
 from qc_control.cli.parser import run
@@ -50,6 +51,7 @@ def test_identify_bad_map_names_the_column(tmp_path, capsys):
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("quick_figures")  # the estimates, words and files, not the pictures
 def test_identify_writes_the_report_with_the_command(tmp_path, capsys):
     out = tmp_path / "report"
     argv = [

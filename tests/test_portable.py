@@ -103,7 +103,8 @@ def _run_without_posix(script: str, tmp_path: Path) -> subprocess.CompletedProce
 
 
 # a fresh interpreter imports everything and writes a whole report (~10 s); 2 s of
-# the seed's scenario run every writer, as the default 10 s do
+# the seed's scenario run every writer, as the default 10 s do, and its figures are
+# drawn at 40 dpi (`reports_shared.quick_figures`): the same artists and files
 @pytest.mark.slow
 def test_every_import_modes_and_a_report_without_posix_only_modules(tmp_path):
     modules = sorted(m.name for m in pkgutil.walk_packages(qc_control.__path__, "qc_control."))
@@ -119,6 +120,8 @@ def test_every_import_modes_and_a_report_without_posix_only_modules(tmp_path):
     for name in {modules!r}:
         importlib.import_module(name)
     print("imported", {len(modules)})
+    from qc_control import report
+    report.DPI = 40
     from qc_control.cli.console import main
     code = main(["modes"])
     print("modes exit", code)

@@ -152,6 +152,38 @@ def test_jumps_of_the_roads():
     assert qc.nonlinear_quarter_car().jumps == qc.nonlinear_quarter_car(road=False).jumps == ()
 
 
+@pytest.mark.parametrize(
+    "road",
+    [
+        StepRoad(t0=0.3),
+        StepRoad(height=-0.02, t0=0.0),
+        BumpRoad(),
+        BumpRoad(height=0.2, length=8.0, speed=20.0, t0=0.1),  # the nonlinear car's default
+        BumpRoad(height=0.1, length=1.3, speed=15.0, t0=0.2),  # no power of 2 to divide by
+        SineRoad(),
+        SineRoad(amplitude=0.03, frequency=7.3),
+    ],
+    ids=repr,
+)
+def test_a_road_at_one_time_is_its_samples_to_the_last_bit(road):
+    """The nonlinear car reads its road one time at a time (`Road.height_at`), the
+    other cars and the report on the grid (`samples`, `qc_control.ride.road`'s
+    functions): the same number at every time, bit for bit, the step's and the
+    bump's edges and the floats either side of them among the times."""
+    edges = [road.t0] if isinstance(road, StepRoad) else []
+    if isinstance(road, BumpRoad):
+        edges = [road.t0, road.t0 + road.length / road.speed]
+    near = [np.nextafter(e, d) for e in edges for d in (-np.inf, np.inf)]
+    rng = np.random.default_rng(8)
+    T = np.unique(np.concatenate([np.linspace(-1.0, 2.0, 3001), rng.uniform(-1, 2, 3000)]))
+    T = np.unique(np.concatenate([T, edges, near]))
+    scalar = np.array([road.height_at(float(t)) for t in T])
+    np.testing.assert_array_equal(scalar, road.samples(T))
+    # and the base class's fallback, which samples a grid of two times, says the same
+    fallback = np.array([super(type(road), road).height_at(t) for t in T[::50]])
+    np.testing.assert_array_equal(fallback, scalar[::50])
+
+
 @pytest.mark.parametrize("bad", [(math.nan,), (math.inf,), ("soon",), 0.5])
 def test_bad_jumps_are_named(bad):
     def road(t):

@@ -47,6 +47,8 @@ DEFERRABLE = {"matplotlib", "dask", "distributed", "panel", "bokeh"}
 #: import numba (~0.5 s), only when a batch is stepped or a stream is built.
 DEFERRED_OWN = {
     ("qc_control/cli/console.py", "qc_control.cli.parser"),
+    # and its light top level (--version, --help) first, inside the same handler
+    ("qc_control/cli/console.py", "qc_control.cli.commands"),
     ("qc_control/models/nonlinear.py", "qc_control.models.nlkernel"),
     ("qc_control/numerics/lti.py", "qc_control.numerics.recurrence"),
     # the explorer's page imports Panel (an optional extra) when it runs

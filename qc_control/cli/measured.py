@@ -22,6 +22,7 @@ from ..report.identification import write_identification_report
 from ..ride.roughness import IRISegments, iri
 from ..studies.identification import PHYSICAL, identify
 from ..studies.measurement import Measurement
+from .commands import COMMANDS
 
 __all__ = ["add_measured_commands", "CommandTools"]
 
@@ -55,11 +56,7 @@ def _names(text: str | None) -> list[str] | None:
 
 def add_measured_commands(sub, tools: CommandTools) -> None:
     """Add ``identify`` and ``iri`` to the ``qc-control`` sub-parsers."""
-    ident = sub.add_parser(
-        "identify",
-        help="fit the quarter car to measured records and write the report",
-        allow_abbrev=False,
-    )
+    ident = sub.add_parser("identify", help=COMMANDS["identify"], allow_abbrev=False)
     ident.add_argument("data", metavar="DATA.csv", help="the records to fit (CSV, a header line)")
     ident.add_argument("--time", default="t", metavar="COL", help="time column [s] (default t)")
     ident.add_argument(
@@ -85,9 +82,7 @@ def add_measured_commands(sub, tools: CommandTools) -> None:
     ident.add_argument("--out", default="identify-report", metavar="DIR", help="report directory")
     ident.set_defaults(run=functools.partial(_cmd_identify, tools=tools))
 
-    rough = sub.add_parser(
-        "iri", help="print a road profile's International Roughness Index", allow_abbrev=False
-    )
+    rough = sub.add_parser("iri", help=COMMANDS["iri"], allow_abbrev=False)
     rough.add_argument("profile", metavar="PROFILE.csv", help="the profile (CSV, a header line)")
     rough.add_argument("--x", required=True, metavar="COL", help="distance column [m]")
     rough.add_argument("--z", required=True, metavar="COL", help="elevation column [m]")

@@ -17,7 +17,6 @@ import warnings
 from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import fields
-from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +30,7 @@ from ..report import ReportError, check_target, report_lock, write_report
 from ..report.control import unavailable_designs, write_control_report
 from ..studies.compare import ReferenceBudgetError
 from ..studies.control_study import DESIGNS, compare_controllers
+from .commands import COMMANDS, PROG, UsageError, error_line, top_level
 from .measured import CommandTools as _CommandTools
 from .measured import add_measured_commands
 from .scenario import (
@@ -51,22 +51,12 @@ from .scenario import (
 
 __all__ = ["run", "build_parser", "scenario_from_args", "summarise_warnings", "UsageError"]
 
-_PROG = "qc-control"
 #: ``--bump-height`` and ``--bump-length``: the nonlinear car's words of earlier versions for
 #: the bump road's ``--road-height`` and ``--road-length`` (the same fields of the Scenario's
 #: road), read for one more release with a deprecation warning naming the new spelling.
 _BUMP_ALIASES = {"bump_height": "height", "bump_length": "length"}
 #: The models ``control-report`` compares controllers on: the quarter car's linear model.
 _CONTROL_MODELS = ("quarter",)
-
-
-class UsageError(Exception):
-    """Bad command-line input: printed as one line, exit status 2."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line, not argparse's usage block
-        raise UsageError(message)
 
 
 def _floats(text: str) -> list[float]:
@@ -272,20 +262,8 @@ def build_parser(model: str | None = None) -> argparse.ArgumentParser:
         listed, grouped by the models that take them.
     """
     shown = model if model in MODELS else DEFAULT_MODEL
-    parser = _Parser(
-        prog=_PROG,
-        description="Quarter-car suspension tools on python-control.",
-        allow_abbrev=False,  # a reproduce command must mean the same in every version
-    )
-    parser.add_argument(
-        "--version",
-        action="version",
-        version=f"{_PROG} {version('qc-control')} (python-control {version('control')})",
-    )
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    modes = sub.add_parser(
-        "modes", help="print the modal table (frequencies, damping, shapes)", allow_abbrev=False
-    )
+    parser, sub = top_level()
+    modes = sub.add_parser("modes", help=COMMANDS["modes"], allow_abbrev=False)
     _add_vehicle(modes, tuple(MODELS))
     modes.set_defaults(run=_cmd_modes)
     _add_report(sub, shown)
@@ -297,11 +275,7 @@ def build_parser(model: str | None = None) -> argparse.ArgumentParser:
 
 def _add_explore(sub) -> None:
     """``qc-control explore``: the interactive explorer, served on 127.0.0.1."""
-    explore = sub.add_parser(
-        "explore",
-        help="open the interactive explorer in a browser (needs qc-control[explore])",
-        allow_abbrev=False,
-    )
+    explore = sub.add_parser("explore", help=COMMANDS["explore"], allow_abbrev=False)
     explore.add_argument(
         "--port",
         type=_port,
@@ -340,11 +314,7 @@ def _cmd_explore(args) -> int:
 
 def _add_report(sub, shown: str) -> None:
     """``qc-control report``: the scenario's options."""
-    report = sub.add_parser(
-        "report",
-        help="compare the methods against the exact response and write the report",
-        allow_abbrev=False,
-    )
+    report = sub.add_parser("report", help=COMMANDS["report"], allow_abbrev=False)
     _add_vehicle(report, tuple(MODELS))
     sc = report.add_argument_group(f"scenario (the {shown} car's default: {_default_run(shown)})")
     sc.add_argument(
@@ -410,12 +380,7 @@ _CONTROL_OPTIONS: tuple[tuple[str, Callable[[str], Any], Any, str, str], ...] = 
 
 def _add_control_report(sub, shown: str) -> None:
     """``qc-control control-report``: the controller comparison's options."""
-    ctl = sub.add_parser(
-        "control-report",
-        help="compare passive, semi-active and active suspensions (skyhook ... H∞) and "
-        "write the report",
-        allow_abbrev=False,
-    )
+    ctl = sub.add_parser("control-report", help=COMMANDS["control-report"], allow_abbrev=False)
     _add_vehicle(ctl, _CONTROL_MODELS, "compares controllers on")
     ctl.add_argument(
         "--designs",
@@ -611,9 +576,9 @@ def _report(args, scenario: Scenario, out: Path) -> int:
 
     say = (lambda message: None) if args.quiet else _progress
     for line in beyond_limit_warnings(scenario):  # before the work, even when quiet
-        print(f"{_PROG}: warning: {line}", file=sys.stderr, flush=True)
+        print(f"{PROG}: warning: {line}", file=sys.stderr, flush=True)
     if args.h is None and scenario.step_note():
-        say(f"{_PROG}: note: {scenario.step_note()}")
+        say(f"{PROG}: note: {scenario.step_note()}")
     road = scenario.road.describe()
     say(
         f"qc-control report: {', '.join(scenario.methods)} at h = {scenario.h:g} s over "
@@ -698,7 +663,7 @@ def _cmd_control_report(args) -> int:
 def _control_report(args, params: QuarterCarParams, designs: list[str], out: Path) -> int:
     """Compare the designs and write the report into ``out`` (its lock held)."""
     for design, why in unavailable_designs(designs).items():  # listed, not silently dropped
-        print(f"{_PROG}: warning: {design} {why}", file=sys.stderr, flush=True)
+        print(f"{PROG}: warning: {design} {why}", file=sys.stderr, flush=True)
     if not args.quiet:
         _progress(f"qc-control control-report: {len(designs)} designs, bump and road runs")
     try:
@@ -754,10 +719,6 @@ def beyond_limit_warnings(scenario: Scenario) -> list[str]:
 
 def _progress(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
-
-
-def _one_line(exc: BaseException) -> str:
-    return " ".join(str(exc).split())
 
 
 #: numpy's floating-point warnings ("overflow encountered in exp"), in words
@@ -824,9 +785,9 @@ def run(argv: list[str]) -> int:
                 return args.run(args)
             finally:
                 for line in summarise_warnings(caught):
-                    print(f"{_PROG}: warning: {line}", file=sys.stderr)
+                    print(f"{PROG}: warning: {line}", file=sys.stderr)
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
     except (UsageError, ScenarioError) as exc:
-        print(f"{_PROG}: error: {_one_line(exc)}", file=sys.stderr)
+        print(error_line(exc), file=sys.stderr)
         return 2

@@ -217,6 +217,18 @@ class Road:
         """The road height zr [m] on the time grid ``T`` [s]; None for no road."""
         return None
 
+    def height_at(self, t: float) -> float:
+        """The road height zr [m] at one time ``t`` [s]: the number `samples` gives at ``t``.
+
+        The nonlinear car reads its road as a function of time at each stage of
+        every step and of its reference's solve (about 200,000 times a report);
+        the kinds of road write theirs out as one number's arithmetic,
+        operation for operation as their `samples` (tests/test_reference_road_step.py
+        checks each to the last bit). This fallback samples a grid of two times
+        (`qc_control.ride.road`'s functions take at least two).
+        """
+        return float(np.asarray(self.samples(np.array([t, t + 1.0])))[0])
+
     def describe(self) -> str:
         """The road in words, from its actual parameters; '' for no road."""
         return ""
@@ -250,6 +262,9 @@ class StepRoad(Road):
 
     def samples(self, T) -> np.ndarray:
         return roads.step(T, height=self.height, t0=self.t0)
+
+    def height_at(self, t: float) -> float:
+        return self.height if t >= self.t0 else 0.0
 
     def describe(self) -> str:
         return f"a {_length(self.height)} road step at t = {self.t0:g} s"
@@ -292,6 +307,12 @@ class BumpRoad(Road):
     def samples(self, T) -> np.ndarray:
         return roads.bump(T, height=self.height, length=self.length, speed=self.speed, t0=self.t0)
 
+    def height_at(self, t: float) -> float:
+        x = self.speed * (t - self.t0)
+        if not 0 <= x <= self.length:
+            return 0.0
+        return float(0.5 * self.height * (1 - np.cos(2 * np.pi * x / self.length)))
+
     def describe(self) -> str:
         return (
             f"a {_length(self.height)} high, {self.length:g} m long 1 − cos bump "
@@ -324,6 +345,9 @@ class SineRoad(Road):
 
     def samples(self, T) -> np.ndarray:
         return roads.sine(T, amplitude=self.amplitude, frequency=self.frequency)
+
+    def height_at(self, t: float) -> float:
+        return float(self.amplitude * np.sin(2 * np.pi * self.frequency * t))
 
     def describe(self) -> str:
         return f"a sinusoidal road, {_length(self.amplitude)} amplitude at {self.frequency:g} Hz"
@@ -504,13 +528,16 @@ def _culprit(values: Mapping, cls: type) -> str | None:
 _STABLE_DEFAULT_SPAN = 10.0
 
 
-def _coarse_remedy(road) -> str:
-    """What to change besides h when the road is too fine for the grid."""
+def _coarse_remedy(road, limit: float) -> str:
+    """What to change when the road is too fine for the grid: h, or the road
+    alone when its ``limit`` underflowed to 0 s (a 1e308 Hz sine), which no h meets."""
     if isinstance(road, BumpRoad):
-        return "a longer bump or a lower speed"
-    if isinstance(road, SineRoad):
-        return "a lower frequency"
-    return "narrow the band"
+        road_change = "a longer bump or a lower speed"
+    elif isinstance(road, SineRoad):
+        road_change = "a lower frequency"
+    else:
+        return "give a smaller h, or narrow the band" if limit > 0 else "narrow the band"
+    return f"give a smaller h, or {road_change}" if limit > 0 else f"give {road_change}"
 
 
 def _iso_step(limit: float) -> float:
@@ -689,7 +716,7 @@ class Scenario:
         if self.h > limit * (1 + 1e-12):
             raise ScenarioError(
                 f"h = {self.h!r} s is too coarse for {road.sampled()}: it must be <= "
-                f"{limit:.4g} s (give a smaller h, or {_coarse_remedy(road)})",
+                f"{limit:.4g} s ({_coarse_remedy(road, limit)})",
                 "scenario",
                 "h",
             )
@@ -795,7 +822,7 @@ class Scenario:
         convergence study's refinements too long a run: it is left to the
         warning (`beyond_limits`) instead.
         """
-        if h > road_limit:
+        if h > road_limit > 0:  # 0 s: no step samples the road, which the grid check refuses
             h = _iso_step(road_limit)
         stable = [limit for limit in self.step_limits().values() if 0 < limit < h]
         if not stable:
@@ -995,6 +1022,7 @@ class Scenario:
         """
         profile: Any = bool(road)
         if road and self.entry.road_function and not isinstance(self.road, (NoRoad, ISO8608Road)):
+            # a partial takes the jumps as an attribute, which a bound method does not
             profile = functools.partial(_road_at, self.road)
             profile.jumps = self.road.jumps()
         return self.entry.model(self.vehicle, road=profile, **self.option_arguments("build"))
@@ -1296,9 +1324,8 @@ def _cmd_quote(arg: str) -> str:
 
 
 def _road_at(road: Road, t: float) -> float:
-    """A road's height [m] at one time ``t`` [s], from its own function of time
-    (`qc_control.ride.road`'s functions take a grid of at least two times)."""
-    return float(np.asarray(road.samples(np.array([t, t + 1.0])))[0])
+    """A road's height [m] at one time ``t`` [s] (`Road.height_at`)."""
+    return road.height_at(t)
 
 
 def _option(name: str, value: str) -> list[str]:
