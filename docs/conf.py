@@ -15,11 +15,15 @@ import shutil
 import sys
 import warnings
 from pathlib import Path
+from typing import Any
 
 HERE = Path(__file__).parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(HERE / "_ext"))
+
+import numpydoc.docscrape_sphinx as numpydoc_sphinx  # noqa: E402
+from jinja2.sandbox import SandboxedEnvironment  # noqa: E402
 
 import qc_control  # noqa: E402
 
@@ -63,6 +67,29 @@ autodoc_typehints = "none"  # numpydoc's Parameters sections say it, once
 numpydoc_show_class_members = False
 numpydoc_xref_param_type = False
 default_role = "py:obj"  # `name` in a docstring links when Sphinx knows it
+
+
+class _CompiledOnce(SandboxedEnvironment):
+    """numpydoc's template environment, each template compiled once per build.
+
+    numpydoc makes a new Jinja environment for every docstring it renders and
+    every signature it reads (``numpydoc.docscrape_sphinx.get_doc_object``), and
+    so compiles its one template anew each time: 1,168 times here, 1.7 s of CPU.
+    The template is numpydoc's own (``templates_path`` sets no other), the same
+    for every object; the pages built are the same, byte for byte.
+    """
+
+    compiled: dict[str, Any] = {}
+
+    def get_template(self, name, parent=None, globals=None):
+        if parent is not None or globals is not None:
+            return super().get_template(name, parent, globals)
+        if name not in self.compiled:
+            self.compiled[name] = super().get_template(name)
+        return self.compiled[name]
+
+
+numpydoc_sphinx.SandboxedEnvironment = _CompiledOnce
 
 # --- gallery: every script in examples/, run during the build ------------------
 sphinx_gallery_conf = {

@@ -81,6 +81,13 @@ FIGURE_RATIO = 0.6
 def check_in_browser(browser, page: Path, tmp: Path, width: int, probe: str = VERDICT) -> dict:
     """Open ``page`` alone at ``width`` px with no network; the verdict (what
     ``probe`` reads), and what was blocked."""
+    return read_in_browser(browser, page, tmp, width, (probe,))[0]
+
+
+def read_in_browser(browser, page: Path, tmp: Path, width: int, probes) -> list[dict]:
+    """Open ``page`` alone at ``width`` px with no network, once, and run each of
+    ``probes`` on it (they read the page, none changes it): their verdicts, each
+    with what the load blocked."""
     folder = tmp / f"alone-{width}"
     folder.mkdir(exist_ok=True)
     alone = folder / page.name
@@ -91,11 +98,32 @@ def check_in_browser(browser, page: Path, tmp: Path, width: int, probe: str = VE
         context.route("**/*", chromium.only_local(blocked))
         tab = context.new_page()
         tab.goto(alone.as_uri(), wait_until="load")
-        verdict = tab.evaluate(probe)
+        verdicts = [tab.evaluate(probe) for probe in probes]
     finally:
         context.close()
-    verdict["blocked"] = blocked
-    return verdict
+    for verdict in verdicts:
+        verdict["blocked"] = blocked
+    return verdicts
+
+
+@pytest.fixture(scope="module")
+def opened(browser, tmp_path_factory):
+    """A report page as the browser shows it at a width: loaded once per page and
+    width for every test of this module (a load, images decoded and laid out, is
+    the costly part), and read by both probes. Returns ``(verdict, layout)``,
+    what `VERDICT` and `LAYOUT` read, each with what the load blocked."""
+    seen: dict[tuple[Path, int], tuple[dict, dict]] = {}
+    tmp = tmp_path_factory.mktemp("opened")
+
+    def open_at(page: Path, width: int) -> tuple[dict, dict]:
+        if (page, width) not in seen:
+            folder = tmp / str(len(seen))
+            folder.mkdir()
+            verdict, layout = read_in_browser(browser, page, folder, width, (VERDICT, LAYOUT))
+            seen[page, width] = verdict, layout
+        return seen[page, width]
+
+    return open_at
 
 
 @pytest.fixture(scope="module")
@@ -117,8 +145,8 @@ def road_report(tmp_path_factory):
 
 
 @pytest.mark.parametrize("width", [1280, 420])
-def test_report_html_renders_every_image_and_fits_the_page(browser, road_report, tmp_path, width):
-    verdict = check_in_browser(browser, road_report / "report.html", tmp_path, width)
+def test_report_html_renders_every_image_and_fits_the_page(opened, road_report, width):
+    verdict, _ = opened(road_report / "report.html", width)
     assert verdict["images"] == len(list(road_report.glob("*.png")))
     assert verdict["broken"] == []
     assert verdict["scrollWidth"] <= verdict["clientWidth"], verdict
@@ -140,10 +168,10 @@ def report_page(request, road_report, half_car) -> Path:
 
 
 @pytest.mark.parametrize("width", [420, 1280])
-def test_every_caption_is_in_view_and_no_matrix_row_wraps(browser, report_page, tmp_path, width):
+def test_every_caption_is_in_view_and_no_matrix_row_wraps(opened, report_page, width):
     """The issue's 420 px defects: tables scrolled with their captions cut, and
     A wrapped mid-row. A table may scroll in its own box; its caption stays put."""
-    seen = check_in_browser(browser, report_page, tmp_path, width, LAYOUT)
+    _, seen = opened(report_page, width)
     assert seen["tables"] and seen["pres"]
     for table in seen["tables"]:
         left, right = table["caption"]
@@ -156,22 +184,22 @@ def test_every_caption_is_in_view_and_no_matrix_row_wraps(browser, report_page, 
             assert pre["whiteSpace"] == "pre" and pre["drawn"] == pre["lines"], pre
 
 
-def test_at_1280_px_no_table_or_matrix_scrolls(browser, report_page, tmp_path):
+def test_at_1280_px_no_table_or_matrix_scrolls(opened, report_page):
     """The issue's Table 3 scrolled at 1280 px (1059 px in a 960 px column)."""
-    seen = check_in_browser(browser, report_page, tmp_path, 1280, LAYOUT)
+    _, seen = opened(report_page, 1280)
     for box in seen["tables"] + seen["pres"]:
         assert box["scrollWidth"] <= box["clientWidth"], box
 
 
-def test_at_420_px_figures_keep_legible_text(browser, report_page, tmp_path):
+def test_at_420_px_figures_keep_legible_text(opened, report_page):
     """The issue measured figure text of about 4 px at 420 px (each figure
     shrunk to 0.25-0.35 of its pixels); each now keeps `FIGURE_RATIO` or more,
     in a box of its own that scrolls, and the page itself does not."""
-    seen = check_in_browser(browser, report_page, tmp_path, 420, LAYOUT)
+    verdict, seen = opened(report_page, 420)
     assert seen["figures"]
     for figure in seen["figures"]:
         assert figure["ratio"] >= FIGURE_RATIO, figure
-    assert check_in_browser(browser, report_page, tmp_path, 420)["scrollWidth"] <= 420
+    assert verdict["scrollWidth"] <= 420
 
 
 def _page(folder: Path, body: str) -> Path:

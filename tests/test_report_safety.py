@@ -116,7 +116,8 @@ def test_a_fault_at_any_stage_leaves_one_complete_report(cmp, tmp_path, monkeypa
     assert files == listed and "report.md" in files
     expected = "new" if stage == "cleanup" else "old"
     assert marker_command(out) == expected
-    write_report(cmp, out, fmts, command="after")
+    # the next run, whose PDF stage is not under test (a PDF is 1.2 CPU-s of it)
+    write_report(cmp, out, ("md", "html", "csv"), command="after")
     assert marker_command(out) == "after" and litter(tmp_path, "R") == []
     assert [p.name for p in tmp_path.iterdir()] == ["R"]
 
