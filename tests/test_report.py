@@ -453,8 +453,8 @@ def test_figures_and_tables_are_numbered_as_in_the_seed(report):
 
 
 def test_seed_numbers_kept_when_only_some_seed_methods_run():
-    cmp = qc.compare_methods(
-        qc.QuarterCarParams(), np.linspace(0, 1, 101), methods=("heun", "rk4"), repeats=1
+    cmp = qc.compare_methods(  # the figures' numbers and the words: no wall time is read
+        qc.QuarterCarParams(), np.linspace(0, 1, 101), methods=("heun", "rk4"), timing=False
     )
     labels = {spec.name: spec.label for spec in figure_specs(cmp)}
     assert labels["method_rk4.png"] == "Figure 5" and labels["method_heun.png"] == "Figure 6"
@@ -467,8 +467,8 @@ def test_numbered_in_order_without_seed_methods():
     ralston = qc.ButcherTableau(
         "ralston", a=[[0, 0], [2 / 3, 0]], b=[1 / 4, 3 / 4], c=[0, 2 / 3], order=2
     )
-    cmp = qc.compare_methods(
-        qc.QuarterCarParams(), np.linspace(0, 1, 101), methods=(ralston,), repeats=1
+    cmp = qc.compare_methods(  # the figures' numbers: no wall time is read
+        qc.QuarterCarParams(), np.linspace(0, 1, 101), methods=(ralston,), timing=False
     )
     assert [s.number for s in figure_specs(cmp)] == list(range(1, 8))
     assert figure_specs(cmp)[2].label == "Figure 3" and "ralston" in figure_specs(cmp)[2].name
