@@ -84,6 +84,89 @@ def test_mypy_is_clean():
     assert run.returncode == 0, run.stdout + run.stderr
 
 
+#: Packages that [tool.mypy] types Any on purpose although qc_control imports them (the
+#: explorer's Bokeh and Panel: pyproject.toml says why); every other module it skips
+#: is one that qc_control never uses (`mypy_skipped_uses`).
+TYPED_ANY = {"bokeh", "panel", "param"}
+
+
+def _mypy_skips() -> dict[str, bool]:
+    """The modules [tool.mypy] skips, each with whether its sub-modules are skipped too
+    (``a.*``: ``a`` and below), but for `TYPED_ANY`'s."""
+    skips: dict[str, bool] = {}
+    for override in PYPROJECT["tool"]["mypy"]["overrides"]:
+        if override.get("follow_imports") == "skip":
+            for pattern in override["module"]:
+                base = pattern.removesuffix(".*")
+                if base.split(".")[0] not in TYPED_ANY:
+                    skips[base] = skips.get(base, False) or pattern.endswith(".*")
+    return skips
+
+
+def _dotted_names(tree: ast.AST) -> Iterator[tuple[ast.AST, str]]:
+    """Every module name an absolute import reads, and every dotted name ``a.b.c`` used."""
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            yield from ((node, alias.name) for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            yield node, node.module
+            yield from ((node, f"{node.module}.{alias.name}") for alias in node.names)
+        elif isinstance(node, ast.Attribute):
+            parts, base = [node.attr], node.value
+            while isinstance(base, ast.Attribute):
+                parts.append(base.attr)
+                base = base.value
+            if isinstance(base, ast.Name):
+                yield node, ".".join([base.id, *reversed(parts)])
+
+
+def mypy_skipped_uses() -> list[str]:
+    """The package's imports and dotted names of modules that mypy skips."""
+    skips, offenders = _mypy_skips(), []
+    for path, _, _ in _modules():
+        for node, name in _dotted_names(_tree(path.read_text(encoding="utf-8"))):
+            parts = name.split(".")
+            below = (skips.get(".".join(parts[:i])) for i in range(1, len(parts)))
+            if name in skips or any(below):
+                offenders.append(f"{_where(path, node)} ({name})")
+    return offenders
+
+
+def test_mypy_skips_no_module_the_package_uses():
+    """[tool.mypy] skips third-party modules that qc_control never imports, to check
+    the package sooner; were one of them used, its names would be typed Any in
+    qc_control's own code, unchecked and silently."""
+    _assert_none(mypy_skipped_uses(), "uses of modules that [tool.mypy] skips")
+
+
+def test_the_mypy_skip_rule_sees_what_it_looks_for(tmp_path, monkeypatch):
+    """An import of a skipped module, an import from one, and a skipped sub-package
+    reached as an attribute are found; the explorer's Panel and the scipy
+    sub-packages that mypy follows are not."""
+    pkg = tmp_path / "qc_control"
+    pkg.mkdir()
+    (pkg / "a.py").write_text(
+        "import jinja2\n"  # an offender
+        "import scipy\n"
+        "import panel as pn\n"  # typed Any on purpose
+        "from scipy.interpolate import CubicSpline\n"  # an offender
+        "from scipy import linalg, io\n"  # io: an offender
+        "x = scipy.spatial.distance\n"  # an offender
+        "y = scipy.linalg.expm\n"
+    )
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    monkeypatch.setattr(sys.modules[__name__], "PACKAGE", pkg)
+    assert mypy_skipped_uses() == [
+        "qc_control/a.py:1: import jinja2 (jinja2)",
+        "qc_control/a.py:4: from scipy.interpolate import CubicSpline (scipy.interpolate)",
+        "qc_control/a.py:4: from scipy.interpolate import CubicSpline "
+        "(scipy.interpolate.CubicSpline)",
+        "qc_control/a.py:5: from scipy import linalg, io (scipy.io)",
+        "qc_control/a.py:6: scipy.spatial.distance (scipy.spatial.distance)",
+        "qc_control/a.py:6: scipy.spatial (scipy.spatial)",
+    ]
+
+
 def _lint_imports() -> subprocess.CompletedProcess:
     code = "import sys; from importlinter.cli import lint_imports_command as c; sys.exit(c())"
     return _run([sys.executable, "-c", code, "--no-cache"])
@@ -216,7 +299,7 @@ def _comment_lines(source: str) -> tuple[set[int], set[int]]:
     return with_comment, comment_only
 
 
-def _where(path: Path, node: ast.stmt) -> str:
+def _where(path: Path, node: ast.stmt | ast.expr) -> str:
     return f"{path.relative_to(ROOT)}:{node.lineno}: {ast.unparse(node)}"
 
 
