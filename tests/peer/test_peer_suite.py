@@ -3,7 +3,8 @@
 The peer suite is python-control 0.10.2's test files that call its time
 responses, run by `run_peer` in a separate pytest process with the
 responses replaced by qc_control's, RK4 at ``h·|λ|max <= 0.01``. Each
-routed call is also run through python-control to measure the difference.
+routed call is also run through python-control to measure the difference
+(a call on linear systems that repeats an earlier one exactly reuses its answer).
 The denominator is the checked-in list of tests that call them, recorded
 from python-control itself: ``peer_tests.txt`` for ``initial_response`` and
 ``forced_response`` (the issue's measure), ``peer_tests_all.txt`` with
