@@ -31,7 +31,7 @@ import browser as chromium
 import numpy as np
 import pandas as pd
 import pytest
-from reports_shared import placeholder_figures, untimed  # noqa: F401  (fixtures)
+from reports_shared import placeholder_figures, untimed, without_pdf  # noqa: F401  (fixtures)
 
 import qc_control as qc
 from qc_control.cli.console import main
@@ -292,7 +292,8 @@ def test_a_new_body_mass_gives_modal_analysis_modes(page):
 
 @pytest.mark.slow
 @pytest.mark.xdist_group("explore")
-@pytest.mark.usefixtures("placeholder_figures", "untimed")  # its errors and RHS evaluations
+# its errors and RHS evaluations: no picture, wall time or PDF is read
+@pytest.mark.usefixtures("placeholder_figures", "untimed", "without_pdf")
 def test_the_exported_toml_reruns_with_the_report_and_its_errors(page, tmp_path):
     page.enter(".qc-t_end", 2.0)
     page.enter(".qc-h", 10.0)
@@ -313,8 +314,8 @@ def test_the_exported_toml_reruns_with_the_report_and_its_errors(page, tmp_path)
     config.write_text(toml, encoding="utf-8")
     # the page's command, by the entry point's function in this process: the
     # numbers are what is compared, not a new interpreter (a subprocess cost ~6 s of CPU),
-    # nor the report's figures and wall times (blank and untimed: ~6 CPU-s less; the
-    # figures are checked by tests/test_report.py and tests/test_html_browser.py)
+    # nor the report's figures, wall times and PDF (blank, untimed and left out: ~7 CPU-s
+    # less; the figures are checked by tests/test_report.py and tests/test_html_browser.py)
     status = main(["report", "--config", str(config), "--out", str(tmp_path / "r"), "-q"])
     assert status == 0
     report = pd.read_csv(tmp_path / "r" / "methods.csv", index_col=0)
