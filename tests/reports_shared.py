@@ -17,11 +17,13 @@ files are written, needs neither at full cost:
 - `untimed`: the command's comparison run without its wall-time
   measurements (``compare_methods(timing=False)``), whose columns then hold
   NaN: for tests that read no time (a rerun changes the times anyway).
-- `without_pdf`: ``qc-control report`` writes every file but ``report.pdf``
-  (with placeholder figures the PDF's layout is most of a report's cost):
-  for tests that read the report's words, tables or other files. The PDF is
-  checked by tests/test_pdf_layout.py, tests/test_report.py and the fault
-  cases of tests/test_report_safety.py.
+- `without_pdf`: ``qc-control report`` and ``qc-control control-report``
+  write every file but ``report.pdf`` (with placeholder figures the PDF's
+  layout is most of a report's cost): for tests that read the report's
+  words, tables or other files. The PDF is checked by
+  tests/test_pdf_layout.py, tests/test_report.py and the fault cases of
+  tests/test_report_safety.py; the commands write theirs in tests/test_cli.py,
+  tests/test_wheel.py and tests/test_portable.py (the last two read it).
 """
 
 import dataclasses
@@ -77,10 +79,11 @@ def untimed(monkeypatch):
 
 @pytest.fixture
 def without_pdf(monkeypatch):
-    """``qc-control report`` writes its report in every format but the PDF."""
+    """``qc-control report`` and ``control-report`` write every format but the PDF."""
     formats = tuple(f for f in report_package.FORMATS if f != "pdf")
-    real = parser_module.write_report
-    monkeypatch.setattr(parser_module, "write_report", functools.partial(real, formats=formats))
+    for name in ("write_report", "write_control_report"):
+        real = getattr(parser_module, name)
+        monkeypatch.setattr(parser_module, name, functools.partial(real, formats=formats))
 
 
 def run_untimed(scenario):

@@ -14,7 +14,7 @@ import tracemalloc
 import control
 import numpy as np
 import pytest
-from reports_shared import quick_figures  # noqa: F401  (fixtures)
+from reports_shared import quick_figures, without_pdf  # noqa: F401  (fixtures)
 
 import qc_control as qc
 from qc_control.cli.parser import run
@@ -89,7 +89,8 @@ def test_report_files_and_axes(cmp, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.usefixtures("quick_figures")  # the exit, the files and the table, not the pictures
+# the command's status, page and output, not its pictures or PDF (0.65 of its 1.5 CPU-s)
+@pytest.mark.usefixtures("quick_figures", "without_pdf")
 def test_cli_control_report(tmp_path, capsys):
     out = tmp_path / "cr"
     argv = ["control-report", "--designs", "passive (seed),skyhook", "--out", str(out)]
