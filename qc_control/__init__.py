@@ -116,6 +116,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         unregister_model,
     )
     from .models.vehicle import Corner, SignalRoles, VehicleModel
+    from .numerics.checks import ParameterError
     from .numerics.integrate import DivergenceWarning, Solution
     from .numerics.methods import METHODS, TABLEAUS, ButcherTableau, get_method
     from .numerics.stability import max_stable_step, stability_function
@@ -183,6 +184,7 @@ _LAZY: dict[str, str] = {
     "lqr_controller": "models.controllers",
     "hinf_controller": "models.controllers",
     "HinfDesign": "models.controllers",
+    "ParameterError": "numerics.checks",
     "DivergenceWarning": "numerics.integrate",
     "Solution": "numerics.integrate",
     "METHODS": "numerics.methods",
@@ -314,6 +316,7 @@ __all__ = [
     "ModelEntry",
     "ModelOption",
     "NonlinearQuarterCarBatch",
+    "ParameterError",
     "ParetoFront",
     "PiecewiseDamper",
     "QuarterCarParams",

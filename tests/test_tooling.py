@@ -211,7 +211,7 @@ def test_every_numerics_module_is_kept_from_the_vehicle():
     assert "from ." not in (PACKAGE / "compat.py").read_text(encoding="utf-8")
     numerics = {p.stem for p in (PACKAGE / "numerics").glob("*.py")} - {"__init__"}
     assert numerics == {
-        "integrate", "interconnect", "limits", "lti", "messages", "methods",
+        "checks", "integrate", "interconnect", "limits", "lti", "messages", "methods",
         "order_conditions", "recurrence", "stability", "stepper", "compiled_stepper",
         "adaptive", "sampled", "clocked", "exact", "trajectory_stability",
     }  # fmt: skip

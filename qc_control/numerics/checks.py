@@ -1,0 +1,202 @@
+"""The one set of input checks: each refusal is a `ParameterError` naming the value.
+
+Every parameter class, road kind, study and command-line option checks its
+numbers here, so a bad value is refused in the same words wherever it is
+given, and a caller (the command line, a TOML loader) reads *which*
+parameter was wrong from the error's ``.name`` instead of parsing its text.
+
+A parameter dataclass declares each field once, as a `Field` (what it is,
+its SI unit, the range it must lie in), and validates from that declaration
+with `check_fields`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "Field",
+    "ParameterError",
+    "check_fields",
+    "choice",
+    "finite",
+    "integer",
+    "nonnegative",
+    "number",
+    "positive",
+]
+
+
+class ParameterError(ValueError):
+    """A parameter's value is not one it may take.
+
+    A `ValueError`, so code that catches those catches this too.
+
+    Attributes
+    ----------
+    name : str
+        The parameter, as the user spelled it (``"ks"``, ``"road.height"``).
+    value : object
+        The value given.
+    expected : str
+        What the value must be (``"a finite number > 0 N/m"``).
+    """
+
+    def __init__(self, name: str, value: Any, expected: str, *, description: str = ""):
+        self.name = name
+        self.value = value
+        self.expected = expected
+        self.description = description
+        what = f"{name} ({description})" if description else name
+        super().__init__(f"{what} must be {expected}, got {value!r}")
+
+    def __reduce__(self):  # errors cross process boundaries in sweeps
+        return (_rebuild, (self.name, self.value, self.expected, self.description))
+
+
+def _rebuild(name, value, expected, description) -> ParameterError:
+    return ParameterError(name, value, expected, description=description)
+
+
+def _real(value) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, (bool, np.bool_)
+    )
+
+
+def _with_unit(text: str, unit: str) -> str:
+    return f"{text} {unit}" if unit else text
+
+
+def number(
+    name: str,
+    value,
+    unit: str = "",
+    *,
+    low: float | None = None,
+    high: float | None = None,
+    low_open: bool = False,
+    high_open: bool = False,
+    allow_inf: bool = False,
+    description: str = "",
+) -> float:
+    """``value`` as a float, refused unless a real number in ``[low, high]``.
+
+    Parameters
+    ----------
+    name, unit, description : str
+        How the error names the parameter and its SI unit.
+    low, high : float, optional
+        The bounds; ``low_open``/``high_open`` exclude them.
+    allow_inf : bool
+        Whether ``±inf`` is a value (a limit that is "none").
+    """
+    if low is None and high is None:
+        want = "a number" if allow_inf else "a finite number"
+    elif high is None:
+        want = f"a {'' if allow_inf else 'finite '}number {'>' if low_open else '>='} {low:g}"
+    elif low is None:
+        want = f"a {'' if allow_inf else 'finite '}number {'<' if high_open else '<='} {high:g}"
+    else:
+        lo = "(" if low_open else "["
+        hi = ")" if high_open else "]"
+        want = f"a number in {lo}{low:g}, {high:g}{hi}"
+    expected = _with_unit(want, unit)
+    if not _real(value):
+        raise ParameterError(name, value, expected, description=description)
+    v = float(value)
+    if math.isnan(v) or (math.isinf(v) and not allow_inf):
+        raise ParameterError(name, value, expected, description=description)
+    if low is not None and (v < low or (low_open and v == low)):
+        raise ParameterError(name, value, expected, description=description)
+    if high is not None and (v > high or (high_open and v == high)):
+        raise ParameterError(name, value, expected, description=description)
+    return v
+
+
+def finite(name: str, value, unit: str = "", *, description: str = "") -> float:
+    """A finite real number."""
+    return number(name, value, unit, description=description)
+
+
+def positive(
+    name: str, value, unit: str = "", *, allow_inf: bool = False, description: str = ""
+) -> float:
+    """A real number > 0 (finite unless ``allow_inf``)."""
+    return number(
+        name, value, unit, low=0.0, low_open=True, allow_inf=allow_inf, description=description
+    )
+
+
+def nonnegative(
+    name: str, value, unit: str = "", *, allow_inf: bool = False, description: str = ""
+) -> float:
+    """A real number >= 0 (finite unless ``allow_inf``)."""
+    return number(name, value, unit, low=0.0, allow_inf=allow_inf, description=description)
+
+
+def integer(name: str, value, *, minimum: int | None = None, maximum: int | None = None) -> int:
+    """A whole number (``int`` or a NumPy integer, not a bool or a float)."""
+    bounds = [] if minimum is None else [f">= {minimum}"]
+    bounds += [] if maximum is None else [f"<= {maximum}"]
+    expected = "a whole number" + (" " + " and ".join(bounds) if bounds else "")
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise ParameterError(name, value, expected)
+    v = int(value)
+    if (minimum is not None and v < minimum) or (maximum is not None and v > maximum):
+        raise ParameterError(name, value, expected)
+    return v
+
+
+def choice(name: str, value, options: Iterable[Any]) -> Any:
+    """One of ``options`` (compared by equality), returned as given."""
+    options = tuple(options)
+    try:
+        if value in options:
+            return value
+    except TypeError:  # an unhashable or uncomparable value is simply not an option
+        pass
+    listed = ", ".join(repr(o) for o in options)
+    raise ParameterError(name, value, f"one of {listed}")
+
+
+#: How a `Field` bounds its value: the checker that enforces it.
+_KINDS = {
+    "positive": positive,
+    "nonneg": nonnegative,
+    "finite": finite,
+}
+
+
+@dataclass(frozen=True)
+class Field:
+    """One parameter's declaration: what it is, its SI unit, its range.
+
+    ``kind`` is ``"positive"`` (> 0), ``"nonneg"`` (>= 0) or ``"finite"``;
+    ``optional`` lets the value be None (derived later, as ``zeta`` from ``cs``).
+    """
+
+    description: str
+    unit: str
+    kind: str = "positive"
+    optional: bool = False
+
+    def __post_init__(self):
+        choice("kind", self.kind, _KINDS)
+
+    def check(self, name: str, value) -> float | None:
+        if value is None and self.optional:
+            return None
+        return _KINDS[self.kind](name, value, self.unit, description=self.description)
+
+
+def check_fields(obj, spec: Mapping[str, Field]) -> None:
+    """Validate and coerce to float every field of a frozen dataclass ``obj``
+    declared in ``spec``, refusing the first bad one by name."""
+    for name, field in spec.items():
+        object.__setattr__(obj, name, field.check(name, getattr(obj, name)))
