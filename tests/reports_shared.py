@@ -7,7 +7,7 @@ rendering: about 3-4 CPU-s a report) and, from the command line, the
 comparison's wall-time runs. A test of what the report *says*, or of how its
 files are written, needs neither at full cost:
 
-- `quick_figures`: the figures drawn at 40 dpi instead of `report.DPI`
+- `quick_figures`: the figures drawn at 40 dpi instead of `report.writer.DPI`
   (150): the same artists, layout and files, fewer pixels.
 - `placeholder_figures`: every figure of `write_report` drawn as a small
   blank figure, under its own file name, number and caption: for the tests of
@@ -35,12 +35,13 @@ from matplotlib.figure import Figure
 from qc_control import report as report_package
 from qc_control.cli import parser as parser_module
 from qc_control.cli import scenario as scenario_module
+from qc_control.report import comparison, writer
 
 
 @pytest.fixture
 def quick_figures(monkeypatch):
     """What is checked is the text and the files, not the pictures: 40 dpi keeps it quick."""
-    monkeypatch.setattr(report_package, "DPI", 40)
+    monkeypatch.setattr(writer, "DPI", 40)
 
 
 def _blank() -> Figure:
@@ -50,13 +51,13 @@ def _blank() -> Figure:
 def use_placeholders(monkeypatch) -> None:
     """Draw each figure of `write_report` as a blank 1 x 1 in figure under its
     own name, number and caption (what `placeholder_figures` does)."""
-    real = report_package.figure_specs
+    real = comparison.figure_specs
 
     def specs(cmp):
         return [dataclasses.replace(spec, make=_blank) for spec in real(cmp)]
 
-    monkeypatch.setattr(report_package, "figure_specs", specs)
-    monkeypatch.setattr(report_package, "DPI", 40)
+    monkeypatch.setattr(comparison, "figure_specs", specs)
+    monkeypatch.setattr(writer, "DPI", 40)
 
 
 @pytest.fixture

@@ -15,7 +15,8 @@ import pytest
 from PIL import Image as PILImage
 from reports_shared import HALF_CAR_GROUP, half_car_report
 
-from qc_control.report import _matrix, build_blocks, figure_specs, pdf
+from qc_control.report import build_blocks, figure_specs, pdf
+from qc_control.report.comparison import _matrix
 from qc_control.report.document import Code, Heading, Image, Paragraph, Table
 
 

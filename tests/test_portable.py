@@ -120,8 +120,8 @@ def test_every_import_modes_and_a_report_without_posix_only_modules(tmp_path):
     for name in {modules!r}:
         importlib.import_module(name)
     print("imported", {len(modules)})
-    from qc_control import report
-    report.DPI = 40
+    from qc_control.report import writer
+    writer.DPI = 40
     from qc_control.cli.console import main
     code = main(["modes"])
     print("modes exit", code)

@@ -18,12 +18,12 @@ from matplotlib.figure import Figure
 from reports_shared import placeholder_figures, untimed, without_pdf  # noqa: F401  (fixtures)
 
 import qc_control as qc
-from qc_control import report as rep_package
 from qc_control.cli.console import main
 from qc_control.report import (
     MARKER,
     ReportError,
     build_blocks,
+    comparison,
     figure_specs,
     figures,
     write_report,
@@ -188,9 +188,9 @@ def test_a_failure_leaves_no_partial_output(cmp, tmp_path, monkeypatch):
     def broken():
         raise RuntimeError("disk full")
 
-    drawn = rep_package.figure_specs  # the last figure fails as it is drawn
+    drawn = comparison.figure_specs  # the last figure fails as it is drawn
     monkeypatch.setattr(
-        rep_package,
+        comparison,
         "figure_specs",
         lambda c: [
             dataclasses.replace(spec, make=broken) if spec.name == "stability.png" else spec

@@ -8,7 +8,7 @@ import pytest
 from reports_shared import run_untimed
 
 from qc_control.cli.scenario import Scenario
-from qc_control.report import _matrix, _system_blocks
+from qc_control.report.comparison import _matrix, _system_blocks
 from qc_control.report.document import _CSS, Code
 
 

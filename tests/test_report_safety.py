@@ -15,7 +15,7 @@ from reports_shared import use_placeholders
 
 import qc_control as qc
 from qc_control import report as rep
-from qc_control.report import MARKER, ReportError, write_report
+from qc_control.report import MARKER, ReportError, comparison, transaction, write_report, writer
 
 pytestmark = pytest.mark.slow  # each case writes whole reports (every file, the PDF)
 
@@ -58,7 +58,7 @@ def test_a_report_stranded_between_the_renames_is_never_lost(cmp, tmp_path):
     aside = tmp_path / ".R.old-xyz"
     aside.mkdir()
     out.rename(aside / "R")
-    rep._recover(out)  # what every run does first, under the lock
+    transaction._recover(out)  # what every run does first, under the lock
     assert marker_command(out) == "first" and litter(tmp_path, "R") == []
 
 
@@ -87,11 +87,11 @@ def test_a_fault_at_any_stage_leaves_one_complete_report(cmp, tmp_path, monkeypa
 
     if stage == "figure":
         spec = rep.FigureSpec("broken.png", "Figure 1", "a figure that fails", boom)
-        monkeypatch.setattr(rep, "figure_specs", lambda cmp: [spec])
+        monkeypatch.setattr(comparison, "figure_specs", lambda cmp: [spec])
     elif stage == "pdf":
-        monkeypatch.setattr(rep, "to_pdf", boom)
+        monkeypatch.setattr(writer, "to_pdf", boom)
     elif stage == "csv":
-        monkeypatch.setattr(rep, "_csv_tables", boom)
+        monkeypatch.setattr(comparison, "_csv_tables", boom)
     elif stage == "swap":  # between the two renames: the old report is aside
         real = Path.rename
         calls = []
@@ -104,7 +104,7 @@ def test_a_fault_at_any_stage_leaves_one_complete_report(cmp, tmp_path, monkeypa
 
         monkeypatch.setattr(Path, "rename", second_fails)
     else:  # removing the set-aside old report, after the swap
-        monkeypatch.setattr(rep.shutil, "rmtree", boom)
+        monkeypatch.setattr(transaction.shutil, "rmtree", boom)
     with pytest.raises(fault):
         write_report(cmp, out, fmts, command="new")
     monkeypatch.undo()
@@ -127,7 +127,7 @@ def test_a_second_run_into_the_same_place_stops_with_one_line(cmp, tmp_path):
 
     The other run is this test holding the report's lock file as a run does
     (filelock's locks exclude each other within one process too)."""
-    held = filelock.FileLock(rep._lock_file(tmp_path / "R"), timeout=0)
+    held = filelock.FileLock(transaction._lock_file(tmp_path / "R"), timeout=0)
     with held:
         with pytest.raises(ReportError, match="another qc-control run is writing a report"):
             write_report(cmp, tmp_path / "R", ("md",))
@@ -144,9 +144,9 @@ def test_a_writer_in_another_process_holds_off_a_second(cmp, tmp_path):
     script = (
         "import sys, time\n"
         "from pathlib import Path\n"
-        "from qc_control import report as rep\n"
+        "from qc_control.report import transaction\n"
         "out = Path(sys.argv[1])\n"
-        "with rep._exclusive(out):\n"
+        "with transaction._exclusive(out):\n"
         "    print('held', flush=True)\n"
         "    sys.stdin.readline()\n"
     )
@@ -171,7 +171,7 @@ def test_a_writer_in_another_process_holds_off_a_second(cmp, tmp_path):
 def test_a_lock_file_left_by_a_killed_run_is_taken_and_removed(cmp, tmp_path):
     """A run killed while holding the lock leaves its lock file, unlocked (the
     system drops the lock with the process): the next run goes ahead."""
-    rep._lock_file(tmp_path / "R").write_text("")
+    transaction._lock_file(tmp_path / "R").write_text("")
     write_report(cmp, tmp_path / "R", ("md",))
     assert [p.name for p in tmp_path.iterdir()] == ["R"]
 
@@ -213,7 +213,7 @@ def test_a_run_holding_its_lock_writes_under_it_and_others_are_refused(cmp, tmp_
             refused.append(str(exc))
 
     with rep.report_lock(out) as held:
-        assert held == out.resolve() and rep._lock_file(held).exists()
+        assert held == out.resolve() and transaction._lock_file(held).exists()
         worker = threading.Thread(target=other_thread)
         worker.start()
         worker.join()

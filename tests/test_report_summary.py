@@ -79,7 +79,7 @@ def nonlinear():
 
 
 def test_the_nonlinear_report_names_its_bump_and_its_reference(nonlinear):
-    from qc_control.report import _scenario_text
+    from qc_control.report.comparison import _scenario_text
 
     text = _scenario_text(nonlinear)
     assert "no input" not in text and "bump" in text

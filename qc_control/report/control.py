@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from ..models.controllers import HINF_AVAILABLE
-from . import FORMATS, FigureSpec, write_document
 from .document import Code, Heading, Image, Paragraph, Table
+from .writer import FORMATS, FigureSpec, write_document
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -28,8 +28,8 @@ from ..models.quarter import QuarterCarParams
 from ..models.vehicle import VehicleModel
 from ..studies.identification import OUTPUT_LABELS, Identification, nrmse_fit, simulate_quarter
 from ..studies.measurement import SIGNAL_UNITS, Measurement
-from . import FORMATS, FigureSpec, write_document
 from .document import Code, Heading, Image, Paragraph, Table
+from .writer import FORMATS, FigureSpec, write_document
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
