@@ -290,7 +290,7 @@ def test_evaluation_times_and_max_step():
         (dict(solve_ivp_method="LSODA"), "does not call solve_ivp"),
         (dict(solve_ivp_kwargs={"rtol": 1e-6}), "rtol.*do not apply to a fixed-step"),
         (dict(solve_ivp_kwargs={"method": "BDF"}), "solve_ivp method"),
-        (dict(solve_ivp_kwargs={"max_step": -1.0}), "max_step must be a positive"),
+        (dict(solve_ivp_kwargs={"max_step": -1.0}), r"max_step .*must be a finite number > 0 s"),
         (dict(evaluation_times=[0.0, 20.0]), "within"),
         (dict(X0=[np.nan, 0.0]), "X0 must be finite"),
     ],

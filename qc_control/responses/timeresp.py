@@ -48,6 +48,7 @@ from control.timeresp import forced_response as _control_forced_response
 
 from .. import compat
 from ..numerics.adaptive import check_embedded, slope_breakpoints
+from ..numerics.checks import positive
 from ..numerics.clocked import ClockedLoop, step_clocked
 from ..numerics.integrate import (
     STEP_BLOCK,
@@ -67,8 +68,15 @@ from ..numerics.limits import check_memory
 from ..numerics.lti import array_key, is_nonlinear_system, lti_states, memo
 from ..numerics.methods import TABLEAUS, ButcherTableau, get_method
 from ..numerics.sampled import linear_input
-from ..numerics.stability import max_stable_step, stability_coefficients, step_is_stable
-from ..numerics.stepper import ImplicitSteps, substeps_for
+from ..numerics.stability import max_stable_step, step_is_stable
+from ..numerics.stepper import ImplicitSteps
+from ..numerics.steps import (  # the step policy's constants, re-exported from their old home
+    AUTO_STEP_LOCAL_ERROR,  # noqa: F401
+    AUTO_STEP_STABILITY_FRACTION,  # noqa: F401
+    auto_step,
+    auto_substeps,
+    substeps_for,
+)
 from ..numerics.trajectory_stability import (
     GROWTH_FACTOR,
     fastest_changes,
@@ -88,13 +96,6 @@ __all__ = [
     "check_initial_state",
     "check_input_samples",
 ]
-
-#: Local error per step that the automatic step allows: RK4's at h|λ| = 0.1,
-#: ``0.1**5 / 5!`` (see `auto_step`).
-AUTO_STEP_LOCAL_ERROR = 0.1**5 / math.factorial(5)
-
-#: The automatic step is at most this fraction of the stability limit.
-AUTO_STEP_STABILITY_FRACTION = 0.5
 
 _ENGINES = ("auto", "lti", "generic")
 
@@ -252,90 +253,6 @@ def check_input_samples(U, ninputs: int, nsteps: int, labels=None) -> np.ndarray
         first = np.argwhere(~np.isfinite(u))[0].tolist()
         raise ValueError(f"U must be finite; first bad sample at index {first}")
     return u
-
-
-# ---------------------------------------------------------------- the automatic step
-
-
-def _error_constant(tab: ButcherTableau) -> tuple[int, float]:
-    """``(p, C)`` with ``R(z) - e^z = -C z^{p+1} + O(z^{p+2})`` on the method's R."""
-    coef = stability_coefficients(tab)
-    p = 0
-    while p + 1 < coef.size and abs(coef[p + 1] * math.factorial(p + 1) - 1) <= 1e-12:
-        p += 1
-    r_next = coef[p + 1] if p + 1 < coef.size else 0.0
-    return p, abs(r_next - 1 / math.factorial(p + 1))
-
-
-def auto_step(method, eigenvalues) -> tuple[float, str]:
-    """The step the automatic time grid allows for ``method``, and why.
-
-    Two rules; the step is the smaller:
-
-    * **accuracy** — the local error of one step on the fastest mode is at
-      most RK4's at ``h|λ|max = 0.1``. On ``x' = λx`` one step multiplies
-      by ``R(hλ)`` instead of ``e^{hλ}``, so the local error is
-      ``|R(z) - e^z| ≈ C |z|^{p+1}`` with ``z = hλ``, ``p`` the order and
-      ``C`` the error constant (Hairer, Nørsett & Wanner, *Solving ODEs I*,
-      §II.3; for the stability function, Hairer & Wanner, *Solving ODEs
-      II*, §IV.2: ``R(z) = e^z + O(z^{p+1})``). Setting
-      ``C |z|^{p+1} = 0.1⁵/5! ≈ 8.3e-8`` gives
-
-      .. math:: h\\,|\\lambda|_{max} \\le \\Big(\\frac{0.1^5/5!}{C}\\Big)^{1/(p+1)}
-
-      which is 0.1 for RK4 (``C = 1/120``), 7.9e-3 for Midpoint and Heun
-      (``C = 1/6``) and 4.1e-4 for Euler (``C = 1/2``). ``p`` and ``C`` are
-      read from the tableau's stability polynomial, so a user's tableau
-      gets its own bound.
-    * **stability** — at most half the method's stability limit
-      (`qc_control.max_stable_step`). When no step is stable (an undamped
-      mode under Euler, Midpoint or Heun) this rule is dropped, and the
-      response reports the growth (``success`` False).
-
-    The local error per step is then the same for every method; the global
-    error, about ``(t/h)`` local errors, is not. On the seed vehicle released
-    from 5 cm, over python-control's own grid (14.95 s), the states differ
-    from the exact response by 7.1e-7 (RK4), 2.0e-5 (Midpoint, Heun) and
-    3.7e-4 (Euler) of their largest value.
-
-    Parameters
-    ----------
-    method : str or ButcherTableau
-    eigenvalues : array_like
-        The continuous-time system's eigenvalues [1/s].
-
-    Returns
-    -------
-    h : float
-        ``inf`` when neither rule bounds the step (every eigenvalue is 0).
-    rule : str
-        Which rule set ``h``, in words.
-
-    Examples
-    --------
-    >>> h, rule = auto_step("rk4", [-1.0 + 10j, -1.0 - 10j])
-    >>> round(h * abs(-1 + 10j), 6), rule.split(":")[0]
-    (0.1, 'accuracy')
-    """
-    tab = get_method(method)
-    lam = np.atleast_1d(np.asarray(eigenvalues, dtype=complex))
-    p, C = _error_constant(tab)
-    rho = (AUTO_STEP_LOCAL_ERROR / C) ** (1 / (p + 1)) if C > 0 else math.inf
-    lam_max = float(np.max(np.abs(lam))) if lam.size else 0.0
-    h_acc = rho / lam_max if lam_max > 0 else math.inf
-    h_lim = max_stable_step(tab, lam) if lam_max > 0 else math.inf
-    h_stab = AUTO_STEP_STABILITY_FRACTION * h_lim if h_lim > 0 else math.inf
-    if h_acc <= h_stab:
-        if not math.isfinite(h_acc):
-            return math.inf, "none: every eigenvalue is 0, the grid's own spacing is used"
-        return h_acc, (
-            f"accuracy: h·|λ|max = {rho:.3g} for {tab.name} (order {p}, local error "
-            f"{AUTO_STEP_LOCAL_ERROR:.2g} per step on the fastest mode, |λ|max = {lam_max:.4g} 1/s)"
-        )
-    return h_stab, (
-        f"stability: half of {tab.name}'s stability limit {h_lim:.4g} s "
-        f"(the accuracy rule allowed {h_acc:.4g} s)"
-    )
 
 
 # ---------------------------------------------------------------- engines
@@ -549,9 +466,7 @@ def _linear_step(tab: ButcherTableau, A: np.ndarray, H: float, opts: _Options, a
     )
     substeps, step_rule = opts.substeps, None
     if auto and not opts.adaptive:  # an adaptive run sets its own step
-        h_rule, step_rule = auto_step(tab, eig)
-        if math.isfinite(h_rule):
-            substeps = max(substeps, substeps_for(H, h_rule))
+        substeps, step_rule = auto_substeps(tab, eig, H, substeps)
     return _Computed(tab, H / substeps, substeps, step_rule, eig)
 
 
@@ -1569,24 +1484,21 @@ def _io_step(sys, prob: _IOProblem, params, io: _IOOptions) -> _Computed:
         if eig is None:
             step_rule = f"none: the system could not be linearised at the initial point ({why})"
         else:
-            h_rule, rule = auto_step(tab, eig)
+            substeps, rule = auto_substeps(tab, eig, H, substeps)
             step_rule = f"{rule}, on the linearisation at the initial point"
-            if math.isfinite(h_rule):
-                substeps = max(substeps, substeps_for(H, h_rule))
     max_step = io.max_step
     by_max_step = 0
     if max_step is not None:
-        _check_max_step(max_step)
-        by_max_step = substeps_for(H, float(max_step))
+        by_max_step = substeps_for(H, _check_max_step(max_step))
         substeps = max(substeps, by_max_step)
     _check_io_steps(prob, io, substeps, by_max_step)
     compat.update_params(sys, params)  # linearize may have reset them
     return _Computed(tab, None, substeps, step_rule, eig)
 
 
-def _check_max_step(max_step) -> None:
-    if not (isinstance(max_step, (int, float, np.number)) and 0 < max_step < math.inf):
-        raise ValueError(f"max_step must be a positive number of seconds, got {max_step!r}")
+def _check_max_step(max_step) -> float:
+    """``solve_ivp_kwargs['max_step']`` as a step [s], refused unless a finite number > 0."""
+    return positive("max_step", max_step, "s", description="the largest step")
 
 
 def _check_io_steps(prob: _IOProblem, io: _IOOptions, substeps: int, by_max_step: int) -> None:
