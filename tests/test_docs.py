@@ -54,8 +54,8 @@ def test_docs_build_with_warnings_as_errors(site):
     ):
         assert f'id="{name}"' in api, name
     # numpydoc read FixedStepResponse's attribute section (a malformed heading dropped it)
-    fixed_step = api.split('id="qc_control.responses.timeresp.FixedStepResponse"')[1]
-    fixed_step = fixed_step.split('id="qc_control.responses.timeresp.', 1)[0]  # to the next name
+    fixed_step = api.split('id="qc_control.responses.common.FixedStepResponse"')[1]
+    fixed_step = fixed_step.split('id="qc_control.responses.common.', 1)[0]  # to the next name
     assert "Attributes" in fixed_step
     for attribute in ("max_stable_step", "step_rule", "event_labels", "success, message"):
         assert attribute in fixed_step, attribute

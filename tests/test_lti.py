@@ -50,8 +50,9 @@ def test_auto_picks_lti_on_uniform_and_generic_otherwise():
         qc.initial_response(sys, Tn, X0).states,
         qc.initial_response(sys, Tn, X0, engine="generic").states,
     )
-    with pytest.raises(ValueError, match="engine must be"):
+    with pytest.raises(qc.ParameterError, match="engine must be one of 'auto'") as err:
         qc.initial_response(sys, T, X0, engine="fast")
+    assert (err.value.name, err.value.value) == ("engine", "fast")
 
 
 def test_step_matrices_against_the_stages():

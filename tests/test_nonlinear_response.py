@@ -38,7 +38,7 @@ from scipy.integrate import solve_ivp
 
 import qc_control as qc
 from qc_control import DivergenceWarning
-from qc_control.responses import timeresp
+from qc_control.responses import iosys
 
 ORDERS = {"euler": 1, "midpoint": 2, "heun": 2, "rk4": 4}
 X0_VDP = [2.0, 0.0]
@@ -290,7 +290,7 @@ def test_evaluation_times_and_max_step():
         (dict(solve_ivp_method="LSODA"), "does not call solve_ivp"),
         (dict(solve_ivp_kwargs={"rtol": 1e-6}), "rtol.*do not apply to a fixed-step"),
         (dict(solve_ivp_kwargs={"method": "BDF"}), "solve_ivp method"),
-        (dict(solve_ivp_kwargs={"max_step": -1.0}), "max_step must be a positive"),
+        (dict(solve_ivp_kwargs={"max_step": -1.0}), r"max_step .*must be a finite number > 0 s"),
         (dict(evaluation_times=[0.0, 20.0]), "within"),
         (dict(X0=[np.nan, 0.0]), "X0 must be finite"),
     ],
@@ -468,7 +468,7 @@ def test_fused_steps_equal_the_rhs_path_for_every_tableau(method, monkeypatch):
         return law(t, x, u, p)
 
     sky.outfcn = counted
-    check = timeresp._beyond_stability_along
+    check = iosys._beyond_stability_along
 
     def uncounted(*args):
         checking[0] = True
@@ -477,7 +477,7 @@ def test_fused_steps_equal_the_rhs_path_for_every_tableau(method, monkeypatch):
         finally:
             checking[0] = False
 
-    monkeypatch.setattr(timeresp, "_beyond_stability_along", uncounted)
+    monkeypatch.setattr(iosys, "_beyond_stability_along", uncounted)
     T = grid(1e-3, 2.0)
     zr = qc.road.iso8608(T, "C", 20.0, seed=3)
     x0, params = [0.1, 0, 0.02, 0], {"c_sky": 2500.0}

@@ -419,43 +419,6 @@ def test_final_time_and_T_num_like_control():
     np.testing.assert_array_equal(sr.time, np.linspace(0, 2.0, 201))
 
 
-@pytest.mark.parametrize(
-    "method, C, p",
-    [("rk4", 1 / 120, 4), ("midpoint", 1 / 6, 2), ("heun", 1 / 6, 2), ("euler", 0.5, 1)],
-)
-def test_auto_step_accuracy_rule(method, C, p):
-    """h|λ|max = (ε/C)^(1/(p+1)), ε = 0.1⁵/5!: the local error per step is ε.
-
-    Checked on R(z) itself: at z = -h|λ|max the local error |R(z) - e^z|
-    equals ε to within its next Taylor term (≤ 2% at RK4's z = -0.1).
-    """
-    lam = np.array([-3 + 40j, -3 - 40j, -0.5])
-    h, rule = qr.auto_step(method, lam)
-    rho = (qr.AUTO_STEP_LOCAL_ERROR / C) ** (1 / (p + 1))
-    assert h * abs(lam[0]) == pytest.approx(rho, rel=1e-12)
-    assert rule.startswith("accuracy")
-    z = -h * abs(lam[0])
-    local = abs(qc.stability_function(method)(z) - math.exp(z))
-    assert local == pytest.approx(qr.AUTO_STEP_LOCAL_ERROR, rel=0.02)
-    assert {"rk4": 0.1, "midpoint": 7.94e-3, "heun": 7.94e-3, "euler": 4.08e-4}[method] == (
-        pytest.approx(rho, rel=1e-3)
-    )
-
-
-def test_auto_step_stability_rule_and_edge_cases():
-    # Euler on a mode damped at zeta = 1e-5 is stable only below 2 zeta/|λ|:
-    # half of that is far below the accuracy rule's 4.1e-4/|λ|
-    zeta, w = 1e-5, 10.0
-    lam = w * np.array([-zeta + 1j * math.sqrt(1 - zeta**2), -zeta - 1j * math.sqrt(1 - zeta**2)])
-    h, rule = qr.auto_step("euler", lam)
-    assert h == pytest.approx(0.5 * qc.max_stable_step("euler", lam), rel=1e-12)
-    assert h == pytest.approx(zeta / w, rel=1e-6) and rule.startswith("stability")
-    # an undamped mode under Heun: no step is stable, the accuracy rule alone decides
-    assert qr.auto_step("heun", [1j, -1j])[1].startswith("accuracy")
-    # only integrators: nothing bounds the step
-    assert qr.auto_step("rk4", [0.0, 0.0])[0] == math.inf
-
-
 # ------------------------------------------------------------------ step and impulse responses
 
 

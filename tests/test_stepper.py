@@ -24,7 +24,7 @@ import qc_control as qc
 from qc_control.models.nonlinear import NonlinearQuarterCarBatch
 from qc_control.numerics import interconnect
 from qc_control.numerics.sampled import linear_input
-from qc_control.numerics.stepper import GridSteps, stage_plan, substeps_for
+from qc_control.numerics.stepper import GridSteps, stage_plan
 from qc_control.studies.nlsweep import simulate_batch
 
 # Kutta's third-order method (Hairer, Nørsett & Wanner, Solving ODEs I, table II.1.1)
@@ -235,13 +235,6 @@ def test_a_single_input_as_a_float_is_the_call_to_the_bit():
         assert one(np.float64(t)) == u(float(t))[0]  # the stepper's times may be NumPy floats
     with pytest.raises(ValueError, match="one input"):
         linear_input(T, np.vstack([T, T])).scalar()
-
-
-def test_the_substep_rule():
-    """An interval that holds h an integer number of times up to rounding: that many steps."""
-    assert substeps_for(0.1, 0.001) == 100  # 0.1 / 0.001 = 100.00000000000001
-    assert substeps_for(0.01, 0.003) == 4
-    assert substeps_for(0.001, 0.01) == 1
 
 
 _CACHED_RUN = """

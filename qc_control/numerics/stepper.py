@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -58,7 +59,6 @@ __all__ = [
     "affine_rk_steps",
     "GridSteps",
     "sample_steps",
-    "substeps_for",
     "ImplicitSteps",
     "NewtonFailure",
     "NEWTON_RTOL",
@@ -66,23 +66,23 @@ __all__ = [
     "NEWTON_REFRESH_RATE",
 ]
 
-#: Relative slack of `substeps_for`: an interval that holds the step an integer
-#: number of times up to rounding is split into exactly that many steps.
-_SUBSTEP_SLACK = 1e-12
 
+def __getattr__(name: str):
+    """``substeps_for`` moved to `qc_control.numerics.steps`, the one step policy:
+    the old name still answers, with a `DeprecationWarning` naming the new one."""
+    if name == "substeps_for":
+        warnings.warn(
+            "qc_control.numerics.stepper.substeps_for moved to "
+            "qc_control.numerics.steps.substeps_for",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        # deferred: steps reads stability limits (python-control), which
+        # `import qc_control` must not load
+        from .steps import substeps_for
 
-def substeps_for(H: float, h: float) -> int:
-    """The fewest equal steps, at least 1, that split an interval ``H`` into steps ``<= h``.
-
-    ``ceil(H/h (1 - 1e-12))``: an ``H`` that is ``h`` times an integer up
-    to rounding (``0.1 / 0.001``) gives that integer, not one more.
-
-    Examples
-    --------
-    >>> substeps_for(0.01, 0.001), substeps_for(0.01, 0.003)
-    (10, 4)
-    """
-    return max(1, math.ceil(H / h * (1 - _SUBSTEP_SLACK)))
+        return substeps_for
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @dataclass(frozen=True, eq=False)

@@ -35,8 +35,8 @@ from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
 from ..models.vehicle import VehicleModel
 from ..numerics.integrate import check_time_grid
 from ..numerics.limits import check_memory
-from ..numerics.stepper import substeps_for
-from ..responses.timeresp import auto_step, forced_response, input_output_response
+from ..numerics.steps import auto_substeps
+from ..responses.timeresp import forced_response, input_output_response
 from ..ride import road
 from ..ride.comfort import ride_metrics
 from ..ride.metrics import mean_square
@@ -224,7 +224,8 @@ def _exact_table(linear: dict[str, VehicleModel], road_spec) -> pd.DataFrame:
 
 
 def _run(model: VehicleModel, T, U, method: str):
-    """A fixed-step run; a linear loop is substepped to `auto_step`'s accuracy rule.
+    """A fixed-step run; a linear loop is substepped to `auto_step`'s rule
+    (`qc_control.numerics.steps.auto_substeps`).
 
     (An H∞ loop has poles near -700 1/s, beyond RK4's stability at 5 ms.)
     A semi-active loop steps at the grid's spacing: its fastest mode is the
@@ -232,8 +233,7 @@ def _run(model: VehicleModel, T, U, method: str):
     (-314 1/s), within RK4's stability limit at 5 ms.
     """
     if isinstance(model.system, control.StateSpace):
-        h, _ = auto_step(method, model.system.poles())
-        substeps = substeps_for(float(T[1] - T[0]), h)
+        substeps, _ = auto_substeps(method, model.system.poles(), float(T[1] - T[0]))
         return forced_response(model.system, T, U, method=method, substeps=substeps)
     return input_output_response(model.system, T, U, method=method)
 
