@@ -61,9 +61,6 @@ from importlib.metadata import PackageNotFoundError
 from importlib.metadata import version as _distribution_version
 from typing import TYPE_CHECKING, Any
 
-# Bound eagerly: the module needs only numpy.
-from .numerics.integrate import integrate
-
 try:
     # The version is written once, in pyproject.toml; this reads it back
     # from the installed distribution's metadata.
@@ -117,7 +114,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     )
     from .models.vehicle import Corner, SignalRoles, VehicleModel
     from .numerics.checks import ParameterError
-    from .numerics.integrate import DivergenceWarning, Solution
+    from .numerics.integrate import DivergenceWarning, Solution, integrate
     from .numerics.methods import METHODS, TABLEAUS, ButcherTableau, get_method
     from .numerics.stability import max_stable_step, stability_function
     from .report import write_report
@@ -167,6 +164,9 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
 #: tests/test_tooling.py checks that this map, the TYPE_CHECKING imports above
 #: and ``__all__`` name the same things.
 _LAZY: dict[str, str] = {
+    # the fixed-step integrator; lazy too, so that ``import qc_control`` and the
+    # command line's --help load no scipy
+    "integrate": "numerics.integrate",
     "road": "ride.road",
     "MethodComparison": "studies.compare",
     "compare_methods": "studies.compare",
@@ -280,7 +280,9 @@ if not TYPE_CHECKING:  # hidden from type checkers, so a misspelt name stays an 
         except KeyError:
             raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
         module = importlib.import_module(f"{__name__}.{module_name}")
-        value = module if module_name.endswith(f".{name}") else getattr(module, name)
+        # a module's own name (``road``) is the module, unless the module defines
+        # it (``integrate``, the function of qc_control.numerics.integrate)
+        value = getattr(module, name, module)
         globals()[name] = value  # later lookups find it without this hook
         return value
 

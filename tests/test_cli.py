@@ -59,7 +59,9 @@ def test_modes_options_and_config(tmp_path, capsys):
 
 #: What a command's start spends most of its CPU importing (about 2 s of it):
 #: the top level is answered without any of them.
-LIBRARY = ("control", "matplotlib", "pandas")
+#: What the command line's top level (--help, --version, a bad command) never
+#: loads: each costs a tenth of a second or more on a cold start.
+LIBRARY = ("scipy", "control", "matplotlib", "pandas")
 
 
 def imported(importtime: str) -> set[str]:

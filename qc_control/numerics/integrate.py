@@ -23,7 +23,6 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .adaptive import SCIPY_CONTROLLER, StepController, adaptive_solve, check_embedded
 from .limits import check_memory
@@ -790,6 +789,10 @@ class _EventSteps:
         step; a function already on its new side at ``ta`` (rounding) only
         has its sign updated.
         """
+        # scipy.optimize costs a third of a second to import; only runs with
+        # contact events need its root finder, so they pay for it.
+        from scipy.optimize import brentq
+
         ga = self.switch(ta, x)
         roots = []
         for k in changed.tolist():
