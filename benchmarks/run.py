@@ -14,10 +14,12 @@ slow machine.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime as dt
 import os
 import platform
 import statistics
+import subprocess
 import sys
 import time
 import tracemalloc
@@ -29,6 +31,7 @@ import scipy
 from scipy.integrate import solve_ivp
 
 import qc_control as qc
+from qc_control.numerics import threads
 from qc_control.studies.compare import best_time
 from qc_control.studies.sweeps import DEFAULT_METRICS, design_grid, sweep
 
@@ -859,6 +862,128 @@ def explore_benchmark(quick: bool) -> tuple[list[str], list[list[str]]]:
     return head, rows
 
 
+@contextlib.contextmanager
+def other_cores_busy(busy: bool):
+    """One CPU-bound process on each core but this one (at least one), as a
+    laptop with a browser and a build open; nothing when ``busy`` is false."""
+    hogs = []
+    if busy:
+        spin = [sys.executable, "-c", "while True: pass"]
+        hogs = [subprocess.Popen(spin) for _ in range(max(1, (os.cpu_count() or 2) - 1))]
+        time.sleep(0.3)  # every hog running before the first timed call
+    try:
+        yield
+    finally:
+        for hog in hogs:
+            hog.kill()
+            hog.wait()
+
+
+@contextlib.contextmanager
+def blas_threads_of_the_machine():
+    """The library's one-BLAS-thread limit (qc_control.numerics.threads) turned
+    off, so that the choice it makes is measured beside it."""
+    one = threads._OneThread
+    enter, leave = one.__enter__, one.__exit__
+    one.__enter__, one.__exit__ = (lambda self: self), (lambda self, *exc: False)
+    try:
+        yield
+    finally:
+        one.__enter__, one.__exit__ = enter, leave
+
+
+def interleaved(fns: dict, rounds: int, calls: int) -> dict:
+    """Per function, the median over ``rounds`` of the best of ``calls`` wall
+    times; the functions take turns within each round (`round_times`' reasoning)."""
+    if WARMUP:
+        for fn in fns.values():
+            fn()
+    times: dict = {name: [] for name in fns}
+    for r in range(rounds):
+        order = list(fns) if r % 2 == 0 else list(reversed(fns))
+        for name in order:
+            times[name].append(min(wall_time(fns[name]) for _ in range(calls)))
+    return {name: statistics.median(ts) for name, ts in times.items()}
+
+
+def busy_benchmark(quick: bool):
+    """A single response and a 1,000-design sweep, quiet and with the other cores
+    busy, each with the library's one BLAS thread and with the machine's count.
+
+    Returns the section's markdown lines, the table, and the targets missed:
+    on the busy machine each keeps 2/3 of its quiet speed, and one response
+    stays ≥ 60× control.forced_response measured beside it (issue 40).
+    """
+    n = 1001 if quick else 10001
+    T = np.linspace(0.0, 10.0, n)
+    U = np.where(T >= 0.5, 0.05, 0.0)
+    car = qc.quarter_car(road=True)
+    side = (4, 5) if quick else (40, 25)
+    grid = {"ks": np.linspace(15e3, 45e3, side[0]), "zeta": np.linspace(0.1, 0.6, side[1])}
+    designs = side[0] * side[1]
+    rounds, calls = (1, 1) if quick else (7, 5)
+    work = {
+        "response": lambda: qc.forced_response(car, T, U, np.zeros(4), method="rk4"),
+        "control": lambda: control.forced_response(car, T, U, np.zeros(4)),
+        "sweep": lambda: sweep(grid, T, np.zeros(4), U=U, progress=False),
+    }
+    light = {"response": work["response"], "sweep": work["sweep"]}
+    found: dict = {}
+    for busy in (False, True):
+        with other_cores_busy(busy):
+            found[busy, "one"] = interleaved(work, rounds, calls if not quick else 1)
+            with blas_threads_of_the_machine():
+                found[busy, "all"] = interleaved(light, rounds, calls)
+    cores = os.cpu_count() or 2
+    rows, missed = [], []
+    for key, label in (
+        ("response", "qc.forced_response, RK4"),
+        ("sweep", f"qc.sweep, {designs:,} designs"),
+    ):
+        for limit, how in (
+            ("one", "one BLAS thread (the library's)"),
+            ("all", f"{cores} BLAS threads"),
+        ):
+            quiet, loaded = found[False, limit][key], found[True, limit][key]
+            kept = quiet / loaded
+            target = "≥ 0.67" if limit == "one" else ""
+            rows.append([label, how, g(quiet * 1e3), g(loaded * 1e3), g(kept), target])
+            if limit == "one" and not quick and kept < 2 / 3:
+                missed.append(
+                    f"{label} kept {g(kept)} of its quiet speed when busy (target ≥ 0.67)"
+                )
+    ratio = {b: found[b, "one"]["control"] / found[b, "one"]["response"] for b in (False, True)}
+    rows.append(
+        ["control.forced_response", "", g(found[False, "one"]["control"] * 1e3),
+         g(found[True, "one"]["control"] * 1e3), "", ""]
+    )  # fmt: skip
+    rows.append(
+        [
+            "× control (response)",
+            "one BLAS thread",
+            g(ratio[False]),
+            g(ratio[True]),
+            "",
+            "≥ 60 busy",
+        ]
+    )
+    if not quick and ratio[True] < 60:
+        missed.append(f"one response on a busy machine: {g(ratio[True])}× control (target ≥ 60)")
+    head = ["workload", "BLAS", "quiet [ms]", "busy [ms]", "speed kept", "target"]
+    lines = [
+        "### Quiet and busy",
+        "",
+        f"The road step on {n:,} samples; busy: one CPU-bound process on each of the "
+        f"other {max(1, cores - 1)} core(s). Median of {rounds} rounds, the best of "
+        f"{calls} calls in each, the workloads in turns. 'speed kept' is quiet time / "
+        "busy time.",
+        "",
+        table(head, rows),
+        "",
+    ]
+    return lines, head, rows, missed
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smoke mode: small sizes, 1 repeat")
@@ -876,7 +1001,7 @@ def main(argv=None) -> int:
     )
     ap.add_argument(
         "--only",
-        choices=["interconnect", "mpc", "identify", "peers", "explore"],
+        choices=["interconnect", "mpc", "identify", "peers", "explore", "busy"],
         default=None,
         help="run one benchmark alone and print its table (writes nothing); "
         "'interconnect': car + clipped skyhook, qc RK4 against control.input_output_response",
@@ -891,6 +1016,7 @@ def main(argv=None) -> int:
         "identify": lambda: table(*identification_benchmark(quick)[1:3]),
         "peers": lambda: table(*work_precision_benchmark(quick)[1:]),
         "explore": lambda: table(*explore_benchmark(quick)),
+        "busy": lambda: table(*busy_benchmark(quick)[1:3]),
     }
     if args.only is not None:
         print(alone[args.only]())
@@ -1224,6 +1350,11 @@ def main(argv=None) -> int:
         for row in rows[:-1]
         if not quick and float(row[3]) < 1000
     ]
+
+    lines, head, rows, late = busy_benchmark(quick)
+    md += lines
+    say("\n" + table(head, rows))
+    missed += late
 
     lines, head, rows, late = identification_benchmark(quick)
     md += lines

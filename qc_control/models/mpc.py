@@ -68,6 +68,7 @@ import osqp
 import scipy.linalg
 import scipy.sparse as sp
 
+from ..numerics.threads import one_blas_thread
 from .controllers import DEFAULT_LQR_WEIGHTS, lqr_weights, relative_coordinates
 from .vehicle import VehicleModel
 
@@ -249,6 +250,7 @@ class MPCController(control.NonlinearIOSystem):
     def _output(self, t, x, u, params):
         return self.solve(np.asarray(u, float), None).moves[:1]
 
+    @one_blas_thread
     def solve(self, x, road_ahead=None) -> MPCSolution:
         """Plan from the car's state ``x`` with the road ``road_ahead``.
 

@@ -34,6 +34,7 @@ import numpy as np
 from .integrate import DivergenceWarning, Solution, check_substeps, check_time_grid, uniform_step
 from .methods import ButcherTableau, get_method
 from .stability import stability_coefficients
+from .threads import one_blas_thread
 
 __all__ = [
     "step_matrices",
@@ -266,6 +267,7 @@ def _input_offsets(E, U, N: int, L: int, nb: int) -> np.ndarray:
     return (windows @ E).reshape(E.shape[:-2] + (nb, L, n))
 
 
+@one_blas_thread
 def affine_scan(
     phi: np.ndarray,
     x0: np.ndarray,

@@ -34,6 +34,7 @@ import numpy as np
 import scipy.linalg
 
 from ..models.vehicle import VehicleModel
+from ..numerics.threads import one_blas_thread
 from . import road
 from .iso2631 import wk_filter
 from .metrics import metric_columns
@@ -529,6 +530,7 @@ SPECTRAL_METRICS = ("rms_body_acc", "rms_susp_travel", "rms_tire_load / static")
 SPECTRAL_CAPABLE = ("rms_body_acc", "rms_body_acc_wk", "rms_susp_travel", "rms_tire_load / static")
 
 
+@one_blas_thread
 def spectral_metrics(
     model: VehicleModel, intensity: float, names=SPECTRAL_METRICS, batch=None
 ) -> dict:

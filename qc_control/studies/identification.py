@@ -48,6 +48,7 @@ import scipy.stats
 from ..models.quarter import QuarterCarParams, quarter_car_abcd, quarter_car_model
 from ..models.vehicle import VehicleModel
 from ..numerics.exact import exact_outputs
+from ..numerics.threads import one_blas_thread
 from .frequency_identification import (
     Transmissibility,
     bin_weights,
@@ -377,6 +378,7 @@ def _scale_free(base, free, gains, measurement) -> bool:
     return not pinned and not force_known
 
 
+@one_blas_thread
 def identify(
     measurement: Measurement,
     model: str = "quarter",

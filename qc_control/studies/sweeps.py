@@ -23,6 +23,7 @@ from ..numerics.limits import check_memory
 from ..numerics.lti import OutputStream, TailBound, affine_scan, step_matrices
 from ..numerics.methods import ButcherTableau, get_method
 from ..numerics.stability import step_is_stable
+from ..numerics.threads import one_blas_thread
 from ..responses.timeresp import check_initial_state, check_input_samples
 from ..ride.iso2631 import wk_discrete
 from ..ride.metrics import (
@@ -547,6 +548,7 @@ def _metric_items(metrics, roles: SignalRoles) -> list:
     return [(col, metric.name, i) for col, metric, i in metric_columns(list(metrics), roles)]
 
 
+@one_blas_thread
 def sweep(
     designs,
     T=None,
