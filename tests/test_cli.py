@@ -135,6 +135,7 @@ BAD = [
     (["modes", "--config", "wheelbase.toml"], "'wheelbase'"),
     (["modes", "--bogus"], "unrecognized arguments: --bogus"),
     ([], "command"),
+    (["report", "--out", ""], "the report folder (--out) is empty"),
     (["report", "--h", "1e-320"], "more than 1.8e308 steps per method"),
     (["report", "--t-end", "1e308", "--h", "1"], "1e+308 steps per method"),
     (["report", "--t-end", "1e6", "--h", "0.01"], "1e+08 steps per method"),
@@ -227,7 +228,7 @@ def test_unwritable_out_is_refused_before_computing(files, monkeypatch, capsys):
     # an earlier report inside a read-only parent cannot be replaced either
     report = files / "rodir" / "R"
     report.mkdir()
-    (report / ".qc-control-report").write_text("qc-control report\n")
+    (report / ".qc-control-report").write_text("qc-control report\n\nfiles:\n")
     assert main(["report", "--out", "rodir/R"]) == 2
     assert "cannot be replaced:" in capsys.readouterr().err
 

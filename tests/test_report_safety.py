@@ -221,3 +221,50 @@ def test_a_run_holding_its_lock_writes_under_it_and_others_are_refused(cmp, tmp_
         write_report(cmp, out, ("md",), command="mine")  # re-entrant in its own thread
     assert marker_command(out) == "mine"
     assert [p.name for p in tmp_path.iterdir()] == ["R"]  # no lock file left behind
+
+
+def test_a_marker_without_its_file_list_keeps_the_users_files(cmp, tmp_path):
+    """Issue 39 item 1: an older qc-control's marker lists no files, so which
+    files are the report's cannot be proved; the run refuses and deletes nothing."""
+    legacy = tmp_path / "legacy"
+    legacy.mkdir()
+    (legacy / MARKER).write_text("qc-control report\n")
+    (legacy / "thesis_notes.txt").write_text("notes")
+    with pytest.raises(ReportError, match=r"legacy.*does not list the files"):
+        write_report(cmp, legacy, ("md",))
+    assert sorted(p.name for p in legacy.iterdir()) == [MARKER, "thesis_notes.txt"]
+    assert (legacy / "thesis_notes.txt").read_text() == "notes"
+
+
+def test_a_folder_name_with_glob_characters_touches_no_other_report(cmp, tmp_path):
+    """Issue 39 item 2: the recovery of 'r*' globbed '.r*.old-*' unescaped, and
+    deleted the only copy of the report 'report', moved aside by a killed swap."""
+    write_report(cmp, tmp_path / "report", ("md",), command="first")
+    stranded = tmp_path / ".report.old-x"
+    stranded.mkdir()
+    (tmp_path / "report").rename(stranded / "report")
+    partial = tmp_path / ".report.partial-y"  # another run's working copy
+    partial.mkdir()
+    write_report(cmp, tmp_path / "r*", ("md",), command="second")
+    assert marker_command(stranded / "report") == "first"
+    assert partial.is_dir()
+    assert marker_command(tmp_path / "r*") == "second"
+
+
+@pytest.mark.parametrize("out", ["", "  "])
+def test_an_empty_report_folder_is_refused(cmp, tmp_path, monkeypatch, out):
+    """``--out ''`` wrote the report's files into the working directory."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ReportError, match=r"--out\) is empty"):
+        write_report(cmp, out, ("md",))
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="Windows cannot remove a process's cwd")
+def test_a_removed_working_directory_is_a_clear_refusal(cmp, tmp_path, monkeypatch):
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    with pytest.raises(ReportError, match="working directory no longer exists"):
+        write_report(cmp, "report", ("md",))

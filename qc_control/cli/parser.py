@@ -26,7 +26,7 @@ from ..models.controllers import HINF_AVAILABLE
 from ..models.modal import modal_analysis
 from ..models.quarter import QuarterCarParams
 from ..models.registry import MODELS, ModelOption, get_model, parameter_help, parameter_keys
-from ..report import ReportError, check_target, report_lock, write_report
+from ..report import ReportError, check_target, report_lock, report_path, write_report
 from ..report.control import unavailable_designs, write_control_report
 from ..studies.compare import ReferenceBudgetError
 from ..studies.control_study import DESIGNS, compare_controllers
@@ -508,7 +508,10 @@ def _check_out(out: str) -> Path:
     rule), or not exist yet; the directory that will hold it (the nearest
     existing ancestor) must be a directory this user can write in.
     """
-
+    try:
+        report_path(out)  # an empty name, a removed working directory
+    except ReportError as exc:
+        raise UsageError(str(exc)) from None
     path = Path(os.path.abspath(out))
     writable = lambda d: os.access(d, os.W_OK | os.X_OK)  # noqa: E731
     try:

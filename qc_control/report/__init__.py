@@ -27,11 +27,12 @@ from .comparison import (
 from .document import Code, Heading, Image, Paragraph, Table, fmt
 from .findings import findings
 from .summary import summary
-from .transaction import MARKER, ReportError, check_target, report_lock
+from .transaction import MARKER, ReportError, check_target, report_lock, report_path
 from .writer import DPI, FORMATS, FigureSpec, write_document
 
 __all__ = [
     "check_target",
+    "report_path",
     "report_lock",
     "write_report",
     "report_title",

@@ -12,6 +12,7 @@ replaced only if it is an earlier report holding nothing foreign
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 import shutil
 import signal
@@ -22,7 +23,9 @@ from pathlib import Path
 
 import filelock
 
-__all__ = ["MARKER", "ReportError", "check_target", "report_lock", "replace_folder"]
+__all__ = [
+    "MARKER", "ReportError", "check_target", "report_lock", "replace_folder", "report_path"
+]  # fmt: skip
 
 #: A file that marks a directory as a qc-control report (safe to replace).
 MARKER = ".qc-control-report"
@@ -34,10 +37,31 @@ class ReportError(ValueError):
 
 def _manifest(out: Path) -> set[str] | None:
     """The files an earlier report says it wrote (None for a report without a list)."""
-    lines = (out / MARKER).read_text(encoding="utf-8", errors="replace").splitlines()
+    try:
+        lines = (out / MARKER).read_text(encoding="utf-8", errors="replace").splitlines()
+    except OSError as exc:
+        raise ReportError(
+            f"refusing to replace the report in {str(out)!r}: its {MARKER} cannot be read "
+            f"({exc.strerror or exc})"
+        ) from None
     if "files:" not in lines:
         return None
     return set(lines[lines.index("files:") + 1 :])
+
+
+def report_path(out_dir) -> Path:
+    """``out_dir`` as an absolute path; `ReportError` for an empty name (which
+    would put the report's files in the working directory) or a relative one
+    from a working directory that was removed."""
+    if not str(out_dir).strip():
+        raise ReportError("the report folder (--out) is empty: name a folder, e.g. --out report")
+    try:
+        return Path(out_dir).resolve()
+    except OSError as exc:
+        raise ReportError(
+            f"cannot place the report folder {str(out_dir)!r}: the working directory no "
+            f"longer exists ({exc.strerror or exc}); cd to a folder that does"
+        ) from None
 
 
 def check_target(out_dir, overwrite: bool = True) -> Path:
@@ -48,7 +72,7 @@ def check_target(out_dir, overwrite: bool = True) -> Path:
     inside it is never deleted. Raises `ReportError` naming the path, or the
     first foreign file.
     """
-    out = Path(out_dir).resolve()
+    out = report_path(out_dir)
     if out.exists():
         if not out.is_dir():
             raise ReportError(f"{str(out)!r} exists and is not a directory")
@@ -61,13 +85,21 @@ def check_target(out_dir, overwrite: bool = True) -> Path:
             if not overwrite:
                 raise ReportError(f"{str(out)!r} already holds a report")
             listed = _manifest(out)
-            if listed is not None:
-                foreign = sorted(p.name for p in out.iterdir() if p.name not in listed | {MARKER})
-                if foreign:
-                    raise ReportError(
-                        f"refusing to replace the report in {str(out)!r}: it holds "
-                        f"{foreign[0]!r}, which qc-control did not write; move it out first"
-                    )
+            if listed is None:
+                # a marker from before the files were listed: which of the files are
+                # the report's cannot be proved, so none is removed
+                raise ReportError(
+                    f"refusing to replace the report in {str(out)!r}: its {MARKER} does not "
+                    "list the files qc-control wrote (an older qc-control's), so a file of "
+                    "yours cannot be told from the report's; move what you keep, or choose "
+                    "another --out"
+                )
+            foreign = sorted(p.name for p in out.iterdir() if p.name not in listed | {MARKER})
+            if foreign:
+                raise ReportError(
+                    f"refusing to replace the report in {str(out)!r}: it holds "
+                    f"{foreign[0]!r}, which qc-control did not write; move it out first"
+                )
     return out
 
 
@@ -185,9 +217,11 @@ def _recover(out: Path) -> None:
     for a swap (``.NAME.old-*/NAME``) is put back when ``out`` is missing,
     and removed when the swap had completed: it is never lost.
     """
-    for partial in out.parent.glob(f".{out.name}.partial-*"):
+    # the name is escaped: a folder called 'r*' must not match another report's copies
+    name = glob.escape(out.name)
+    for partial in out.parent.glob(f".{name}.partial-*"):
         shutil.rmtree(partial, ignore_errors=True)
-    for old in sorted(out.parent.glob(f".{out.name}.old-*")):
+    for old in sorted(out.parent.glob(f".{name}.old-*")):
         if (old / out.name).is_dir() and not out.exists():
             (old / out.name).rename(out)
         shutil.rmtree(old, ignore_errors=True)
