@@ -11,6 +11,8 @@ from pathlib import Path
 import filelock
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from reports_shared import use_placeholders
 
 import qc_control as qc
@@ -268,3 +270,43 @@ def test_a_removed_working_directory_is_a_clear_refusal(cmp, tmp_path, monkeypat
     gone.rmdir()
     with pytest.raises(ReportError, match="working directory no longer exists"):
         write_report(cmp, "report", ("md",))
+
+
+_names = st.text(alphabet="abcxyz*?[]._- 0123", min_size=1, max_size=12).filter(
+    lambda n: n.strip(" .") == n and n not in {MARKER, "."} and not n.startswith(".qc")
+)
+
+
+@settings(
+    max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    user_files=st.dictionaries(_names, st.binary(max_size=64), min_size=1, max_size=4),
+    marker=st.sampled_from(["none", "no list", "listed report", "lists nothing"]),
+    name=st.sampled_from(["R", "r*", "[R]", "R?"]),
+)
+def test_whatever_a_user_put_in_the_folder_is_kept_byte_for_byte(
+    cmp, tmp_path_factory, user_files, marker, name
+):
+    """Issue 39: a run into a folder holding files the user put there, with an
+    earlier report's marker of any kind or none, completes or refuses, and
+    leaves each of those files as it was."""
+    parent = tmp_path_factory.mktemp("folders")
+    out = parent / name
+    out.mkdir()
+    for file, data in user_files.items():
+        (out / file).write_bytes(data)
+    marker_text = {
+        "none": None,
+        "no list": "qc-control report\n",
+        "listed report": "qc-control report\n\nfiles:\nreport.md\n",
+        "lists nothing": "qc-control report\n\nfiles:\n",
+    }[marker]
+    if marker_text is not None:
+        (out / MARKER).write_text(marker_text)
+    try:
+        write_report(cmp, out, ("md",))
+    except ReportError:
+        pass
+    for file, data in user_files.items():
+        assert (out / file).read_bytes() == data, file
