@@ -27,9 +27,14 @@ def car():
 
 def _discrete(car):
     """``(A_d, B_d)`` of the car's force held over ``DT``, by python-control."""
+    return _discrete_at(car, DT)
+
+
+def _discrete_at(car, dt):
+    """``(A_d, B_d)`` of the car's force held over ``dt``, by python-control."""
     sys = car.system
     j = sys.input_labels.index("fa")
-    d = control.c2d(control.ss(sys.A, sys.B[:, [j]], np.eye(sys.nstates), 0), DT, "zoh")
+    d = control.c2d(control.ss(sys.A, sys.B[:, [j]], np.eye(sys.nstates), 0), dt, "zoh")
     return np.asarray(d.A), np.asarray(d.B)
 
 
@@ -237,3 +242,28 @@ def test_sweep_takes_a_sampled_loop(car):
     travel = r.outputs[r.output_labels.index("susp_travel")]
     peak = res.metrics["peak_susp_travel [m]"].iloc[0]
     assert peak == pytest.approx(np.max(np.abs(travel)), rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "dt, label", [(0.01, "10 ms"), (0.0025, "2500 µs"), (0.0005, "500 µs"), (0.00125, "1250 µs")]
+)
+def test_a_controller_of_any_period_can_be_closed(car, dt, label):
+    """Issue 39 item 8: a 400 Hz controller (2.5 ms) raised python-control's
+    "invalid system name ... ('.' not allowed)". The loop of each period runs,
+    and its one tick equals the ZOH equivalent at that period."""
+    Ad, Bd = _discrete_at(car, dt)
+    K, _, _ = control.dlqr(Ad, Bd, Q, 1e-6)
+    law = control.ss([], [], [], -K, dt=dt, inputs=list(car.system.state_labels), outputs=["fa"])
+    loop = qc.closed_loop(car, law)
+    assert loop.system.name.endswith(f"@ {label}") and "." not in loop.system.name
+    T = np.array([0.0, dt])
+    r = qc.input_output_response(loop.system, T, 0.0, X0=X0, substeps=100)
+    # RK4 at h = dt/100 over one tick: within 1e-9 of the exact ZOH step (local error h^5)
+    np.testing.assert_allclose(r.states[:4, 1], Ad @ X0 - Bd[:, 0] * (K @ X0)[0], atol=1e-9)
+
+
+def test_periods_of_no_whole_microsecond_are_named_by_their_rate():
+    from qc_control.models.sampled_loop import period_label
+
+    assert period_label(1 / 3000) == "3000 Hz"
+    assert period_label(1 / 3001.5) == "~3002 Hz"

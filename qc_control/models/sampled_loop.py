@@ -16,7 +16,7 @@ import numpy as np
 from ..numerics.clocked import ClockedLoop, DiscreteLaw
 from .vehicle import VehicleModel
 
-__all__ = ["sampled_loop", "check_delay"]
+__all__ = ["sampled_loop", "check_delay", "period_label"]
 
 
 def check_delay(delay) -> int:
@@ -31,6 +31,17 @@ def _law(controller):
     if callable(getattr(controller, "tick", None)):
         return controller
     return DiscreteLaw(controller)
+
+
+def period_label(dt: float) -> str:
+    """A controller period as a system name may hold it: python-control refuses
+    a '.' in a name, so 2.5 ms is '2500 µs', and a period of no whole number of
+    microseconds is named by its rate ('3000 Hz', or '~1234 Hz' rounded)."""
+    for scale, unit in ((1e3, "ms"), (1e6, "µs")):
+        if abs(dt * scale - round(dt * scale)) <= 1e-9 * dt * scale:
+            return f"{round(dt * scale)} {unit}"
+    rate = 1.0 / dt
+    return f"{round(rate)} Hz" if abs(rate - round(rate)) <= 1e-9 * rate else f"~{round(rate)} Hz"
 
 
 def sampled_loop(car: VehicleModel, controller, plant, delay: int, name, rebuild) -> VehicleModel:
@@ -69,7 +80,7 @@ def sampled_loop(car: VehicleModel, controller, plant, delay: int, name, rebuild
         dt,
         delay,
         labels,
-        name or f"{car.name} + {controller.name} @ {dt * 1e3:g} ms",
+        name or f"{car.name} + {controller.name} @ {period_label(dt)}",
     )
     units = dict(car.units)
     units["fa"] = "N"
