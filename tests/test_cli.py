@@ -626,3 +626,32 @@ def test_control_report_of_a_semi_active_design_alone(files, capsys):
 def test_control_report_empty_designs_are_refused(files, no_work, capsys, designs, words):
     assert main(["control-report", "--designs", designs, "-q"]) == 2
     assert words in one_line_error(capsys)
+
+
+@pytest.mark.parametrize(
+    "argv", [["--help"], ["report", "--help"], ["identify", "--help"], ["modes"]]
+)
+def test_output_survives_a_terminal_that_cannot_encode_it(argv):
+    """Issue 39 item 9: Windows gives a piped or redirected stdout cp1252, which
+    has no ∞ or √, and --help ended in a UnicodeEncodeError. In a fresh process
+    with that encoding, each command exits 0 and what cannot be shown is spelt
+    out (∞ as 'inf')."""
+    env = {**os.environ, "PYTHONIOENCODING": "cp1252"}
+    code = "import sys; from qc_control.cli.console import main; sys.exit(main(sys.argv[1:]))"
+    out = subprocess.run(
+        [sys.executable, "-c", code, *argv], capture_output=True, timeout=300, env=env
+    )
+    assert out.returncode == 0, out.stderr.decode("cp1252", "replace")
+    text = out.stdout.decode("cp1252")  # every byte is cp1252
+    assert text.strip() and b"Traceback" not in out.stderr
+
+
+def test_characters_a_code_page_lacks_are_spelt_out():
+    from qc_control.cli.console import SPELLED
+
+    line = "h ≤ 2.8/λ, ζ = 0.3, ‖e‖∞ < 1e−3 ⁻¹ ☃"
+    assert line.encode("cp1252", "qc-control-spell") == (
+        b"h <= 2.8/lambda, zeta = 0.3, ||e||inf < 1e-3 ^-1 ?"
+    )
+    # every spelling is itself plain ASCII
+    assert all(v.isascii() for v in SPELLED.values())

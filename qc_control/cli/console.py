@@ -10,10 +10,47 @@ the library. This module imports only the standard library at its top.
 
 from __future__ import annotations
 
+import codecs
 import sys
 import traceback
 
-__all__ = ["main"]
+__all__ = ["main", "SPELLED"]
+
+#: How a character the terminal cannot show is spelt instead. Windows gives a
+#: piped or redirected stdout (``| more``, ``> help.txt``) the ANSI code page,
+#: cp1252, which has no ∞, √ or ζ: the help and the tables would end in a
+#: UnicodeEncodeError. Characters not listed become '?'.
+SPELLED = {
+    "∞": "inf", "√": "sqrt", "ζ": "zeta", "ω": "omega", "λ": "lambda", "σ": "sigma",
+    "π": "pi", "Δ": "Delta", "Σ": "Sum", "Φ": "Phi", "Γ": "Gamma", "≤": "<=", "≥": ">=",
+    "≠": "!=", "≈": "~", "−": "-", "–": "-", "—": "-", "→": "->", "←": "<-", "⇔": "<=>",
+    "‖": "||", "·": "*", "×": "x", "²": "^2", "³": "^3", "⁻¹": "^-1", "ᵀ": "^T", "⚠": "!",
+    "…": "...", "µ": "u",
+}  # fmt: skip
+_LONGEST = max(map(len, SPELLED))
+
+
+def _spell(error: UnicodeError) -> tuple[str, int]:
+    """The codec error handler ``qc-control-spell``: `SPELLED`, else '?'."""
+    if not isinstance(error, UnicodeEncodeError):
+        raise error
+    text = error.object
+    for size in range(_LONGEST, 0, -1):
+        piece = text[error.start : error.start + size]
+        if piece in SPELLED:
+            return SPELLED[piece], error.start + size
+    return "?", error.start + 1
+
+
+codecs.register_error("qc-control-spell", _spell)
+
+
+def _terminal_safe() -> None:
+    """Let stdout and stderr write every character, whatever they encode to."""
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)
+        if reconfigure is not None and getattr(stream, "errors", "strict") == "strict":
+            reconfigure(errors="qc-control-spell")
 
 #: qc_control.cli.commands.PROG, spelled here too: the Ctrl-C line must print even when a
 #: Ctrl-C stops that import
@@ -23,6 +60,7 @@ PROG = "qc-control"
 def main(argv=None) -> int:
     """Entry point of ``qc-control``; returns the exit status (see `qc_control.cli.parser`)."""
     words = sys.argv[1:] if argv is None else list(argv)
+    _terminal_safe()
     try:
         # deferred, light (the standard library only): --version, --help and a missing or
         # unknown command are answered before the library loads
