@@ -8,6 +8,7 @@ import math
 import control
 import numpy as np
 import pytest
+import scipy.linalg
 
 import qc_control as qc
 
@@ -106,3 +107,77 @@ def test_iso8608_class_iri_is_the_profiles_mean(road_class):
     for seed in range(3):
         x, z = qc.road.iso8608_profile(3000.0, 0.05, road_class, seed=seed)
         assert qc.road.iri(x, z) == pytest.approx(expected, rel=0.03)
+
+
+# --- ASTM E1926 at every sample interval (issue 39 item 5) -----------------------
+
+
+def _astm_e1926(y: np.ndarray, dx: float) -> float:
+    """IRI [m/km] as ASTM E1926 computes it (after Sayers' program in TRR 1501,
+    1995), written here from the standard: the profile's slope over the base
+    ``NINT(0.25/dx)·dx`` drives the Golden Car, whose states are slopes, stepped
+    by its transition matrix with the slope held over each interval; both
+    masses start at the slope over the first 11 m (``NINT(11/dx)`` samples);
+    the IRI is the mean rectified stroke slope |z1 - z3|."""
+    nint = lambda v: int(math.floor(v + 0.5))  # noqa: E731  (Fortran NINT, v > 0)
+    base_n = max(1, nint(0.25 / dx))
+    base = base_n * dx
+    A = np.array(
+        [[0, 1, 0, 0], [-K2, -C, K2, C], [0, 0, 0, 1], [K2 / MU, C / MU, -(K1 + K2) / MU, -C / MU]]
+    )
+    B = np.array([0.0, 0.0, 0.0, K1 / MU])
+    dt = dx / V
+    ST = scipy.linalg.expm(A * dt)
+    PR = np.linalg.solve(A, (ST - np.eye(4)) @ B)
+    i11 = nint(11.0 / dx)
+    z = np.array([(y[i11] - y[0]) / 11.0, 0.0, (y[i11] - y[0]) / 11.0, 0.0])
+    total, count = 0.0, 0
+    for i in range(y.size - base_n):
+        slope = (y[i + base_n] - y[i]) / base
+        z = ST @ z + PR * slope
+        total += abs(z[0] - z[2])
+        count += 1
+    return 1000.0 * total / count
+
+
+def _probe_profile(dx_fine: float = 0.01, length: float = 1000.0):
+    """A 1 km profile with a rough random part and a 1 m wavelength (where the
+    sample count matters most), sampled at 10 mm."""
+    x = np.arange(0.0, length + dx_fine / 2, dx_fine)
+    rng = np.random.default_rng(8)
+    z = np.cumsum(rng.normal(scale=1.5e-4, size=x.size)) + 0.001 * np.sin(2 * math.pi * x)
+    return x, z
+
+
+@pytest.mark.parametrize("dx", [0.25, 0.1, 0.05, 0.02])
+def test_iri_equals_astm_e1926_at_every_sample_interval(dx):
+    """At 0.1 m and 0.02 m the base is NINT(2.5) = 3 and NINT(12.5) = 13 samples;
+    Python's round gave 2 and 12 (2.8 % and 0.57 % high on this profile).
+    Measured within 1e-5 (the issue asks 0.1 %): both are exact for a slope
+    held over each interval and differ only in where the stroke sum starts and
+    ends (a few samples of 4,000-50,000), so 1e-4 leaves a factor 10."""
+    x, z = _probe_profile()
+    every = round(dx / 0.01)
+    xs, zs = x[::every], z[::every]
+    assert qc.road.iri(xs, zs) == pytest.approx(_astm_e1926(zs, dx), rel=1e-4)
+
+
+def test_long_intervals_warn_or_are_refused():
+    x = np.arange(0.0, 200.0, 0.5)
+    with pytest.warns(UserWarning, match="over ASTM E1926's 0.3 m"):
+        qc.road.iri(x, 0.001 * np.sin(x))
+    x = np.arange(0.0, 200.0, 1.0)
+    with pytest.raises(ValueError, match="sample interval is 1 m"):
+        qc.road.iri(x, np.zeros_like(x))
+
+
+def test_a_profile_in_millimetres_is_warned():
+    x, z = _probe_profile(0.05, 200.0)
+    with pytest.warns(UserWarning, match="in millimetres"):
+        qc.road.iri(x, 1000.0 * z)
+
+
+def test_a_segment_shorter_than_a_sample_is_refused_before_any_work():
+    x = np.arange(0, 20, 0.1)
+    with pytest.raises(ValueError, match="at least the sample interval 0.1 m, got 1e-09"):
+        qc.road.iri(x, np.zeros_like(x), segment=1e-9)

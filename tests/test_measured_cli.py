@@ -40,6 +40,16 @@ def test_iri_bad_input_is_one_line_and_status_2(tmp_path, capsys):
     assert "x must increase" in capsys.readouterr().err
     assert run(["iri", str(path), "--x", "dist", "--z", "z"]) == 2
     assert "column 'dist' is not among" in capsys.readouterr().err
+    x = np.arange(0.0, 50.0, 0.1)
+    pd.DataFrame({"x": x, "z": 0.001 * np.sin(x)}).to_csv(path, index=False)
+    for words, said in [
+        (["--z-scale", "0"], "--z-scale must be a finite factor to metres, not 0"),
+        (["--z-scale", "nan"], "--z-scale must be a finite factor"),
+        (["--segment", "1e-9"], "segment must be a length of at least the sample interval"),
+    ]:
+        assert run(["iri", str(path), "--x", "x", "--z", "z", *words]) == 2
+        err = capsys.readouterr().err
+        assert said in err and err.count("\n") == 1, err
 
 
 def test_identify_bad_map_names_the_column(tmp_path, capsys):

@@ -52,6 +52,7 @@ def _terminal_safe() -> None:
         if reconfigure is not None and getattr(stream, "errors", "strict") == "strict":
             reconfigure(errors="qc-control-spell")
 
+
 #: qc_control.cli.commands.PROG, spelled here too: the Ctrl-C line must print even when a
 #: Ctrl-C stops that import
 PROG = "qc-control"

@@ -11,6 +11,7 @@ command (`qc_control.cli.parser`).
 from __future__ import annotations
 
 import functools
+import math
 import shlex
 from collections.abc import Callable
 from pathlib import Path
@@ -149,6 +150,11 @@ def _cmd_identify(args, tools: CommandTools) -> int:
 
 def _cmd_iri(args, tools: CommandTools) -> int:
     try:
+        if not math.isfinite(args.z_scale) or args.z_scale == 0:
+            raise ValueError(
+                f"--z-scale must be a finite factor to metres, not 0 (mm: 0.001), "
+                f"got {args.z_scale!r}"
+            )
         try:
             frame = pd.read_csv(Path(args.profile), comment="#")
         except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:

@@ -24,6 +24,7 @@ True
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -46,6 +47,19 @@ IRI_SPEED = 80.0 / 3.6
 SMOOTHING_BASE = 0.25
 #: The length [m] over which the initial slope is taken (ASTM E1926, 11 m).
 INITIAL_LENGTH = 11.0
+#: The longest sample interval [m] ASTM E1926 accepts (300 mm), and the one
+#: from which the smoothing no longer works at all (Sayers' code refuses 1 m).
+LONGEST_INTERVAL, REFUSED_INTERVAL = 0.3, 1.0
+#: An IRI above this [m/km] is no road's (a rough unpaved road is ~20): the
+#: profile is probably in millimetres.
+IMPLAUSIBLE_IRI = 50.0
+
+
+def nint(value: float) -> int:
+    """Fortran's NINT, as ASTM E1926 and Sayers' code count samples: the nearest
+    integer, halves away from zero (Python's ``round`` takes 2.5 to 2)."""
+    # the 1e-9 absorbs a quotient such as 0.25/0.1 landing a hair below the half
+    return int(math.floor(abs(value) + 0.5 + 1e-9)) * (1 if value >= 0 else -1)
 
 
 def golden_car_matrices() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -111,6 +125,18 @@ def _check_profile(x, profile) -> tuple[np.ndarray, np.ndarray, float]:
             f"the IRI needs a uniform sample interval (ASTM E1926); x[{i}] - x[{i - 1}] = "
             f"{dx[i - 1]:.6g} m against {step:.6g} m: resample the profile"
         )
+    if step >= REFUSED_INTERVAL:
+        raise ValueError(
+            f"the profile's sample interval is {step:.6g} m: the IRI needs at most "
+            f"{LONGEST_INTERVAL:g} m (ASTM E1926), and at {REFUSED_INTERVAL:g} m or more it "
+            "misses the wavelengths it weighs most"
+        )
+    if step > LONGEST_INTERVAL:
+        warnings.warn(
+            f"the profile's sample interval is {step:.6g} m, over ASTM E1926's "
+            f"{LONGEST_INTERVAL:g} m: the IRI misses short wavelengths and reads low",
+            stacklevel=3,
+        )
     if x[-1] - x[0] < INITIAL_LENGTH:
         raise ValueError(
             f"the profile is {x[-1] - x[0]:.6g} m long: the IRI needs more than its "
@@ -121,11 +147,11 @@ def _check_profile(x, profile) -> tuple[np.ndarray, np.ndarray, float]:
 
 def _stroke_slopes(z: np.ndarray, dx: float) -> np.ndarray:
     """``|zs' - zu'| / V`` at each sample of the smoothed profile after the first."""
-    k = max(1, round(SMOOTHING_BASE / dx))
+    k = max(1, nint(SMOOTHING_BASE / dx))
     # the moving average of k samples (ASTM's slope over the base length is its rate)
     cumulative = np.concatenate([[0.0], np.cumsum(z)])
     smooth = (cumulative[k:] - cumulative[:-k]) / k
-    a = min(round(INITIAL_LENGTH / dx), smooth.size - 1)
+    a = min(nint(INITIAL_LENGTH / dx), smooth.size - 1)
     slope0 = (smooth[a] - smooth[0]) / (a * dx)
     A, B, C = golden_car_matrices()
     # both masses moving with the mean slope, springs undeflected (ASTM E1926, 8.3)
@@ -157,15 +183,42 @@ def iri(x, profile, *, segment: float | None = None) -> float | IRISegments:
     ------
     ValueError
         For a non-finite value, x not increasing or not uniform (naming the
-        row), a profile shorter than 11 m, or a segment <= 0.
+        row), a sample interval of 1 m or more, a profile shorter than 11 m,
+        or a segment shorter than the sample interval.
+
+    Warns
+    -----
+    UserWarning
+        For a sample interval over ASTM's 0.3 m (the IRI reads low), and an
+        IRI over 50 m/km (a profile in millimetres, most likely).
+
+    Notes
+    -----
+    The moving average spans ``NINT(0.25 m / dx)`` samples and the initial
+    slope ``NINT(11 m / dx)``, with NINT rounding halves up as ASTM E1926 and
+    Sayers' code do: at dx = 0.1 m the base is 3 samples (0.3 m), not 2.
     """
     x, z, dx = _check_profile(x, profile)
+    if segment is not None:
+        # checked before the work: a segment shorter than a sample would make one
+        # bin per sample at best, and a tiny one terabytes of empty bins
+        segment = float(segment)
+        if not math.isfinite(segment) or segment < dx:
+            raise ValueError(
+                f"segment must be a length of at least the sample interval {dx:.6g} m, "
+                f"got {segment!r}"
+            )
     slopes = _stroke_slopes(z, dx)
+    overall = float(1000.0 * np.mean(slopes))
+    if overall > IMPLAUSIBLE_IRI:
+        warnings.warn(
+            f"IRI {overall:.4g} m/km is more than any road's (a rough unpaved road is about "
+            "20): is the profile in millimetres? Elevations are in metres (--z-scale 0.001 "
+            "converts mm)",
+            stacklevel=2,
+        )
     if segment is None:
-        return float(1000.0 * np.mean(slopes))
-    segment = float(segment)
-    if not math.isfinite(segment) or segment <= 0:
-        raise ValueError(f"segment must be a length > 0 [m], got {segment!r}")
+        return overall
     # each stroke sample belongs to the interval that ends at it
     position = dx * np.arange(1, slopes.size + 1)
     index = np.minimum((position - 1e-9 * dx) // segment, np.inf).astype(int)
@@ -174,6 +227,4 @@ def iri(x, profile, *, segment: float | None = None) -> float | IRISegments:
     keep = count > 0
     starts = x[0] + segment * np.flatnonzero(keep)
     ends = np.minimum(starts + segment, x[0] + position[-1])
-    return IRISegments(
-        starts, ends, 1000.0 * total[keep] / count[keep], float(1000.0 * np.mean(slopes))
-    )
+    return IRISegments(starts, ends, 1000.0 * total[keep] / count[keep], overall)
