@@ -115,11 +115,13 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from .models.vehicle import Corner, SignalRoles, VehicleModel
     from .numerics.checks import ParameterError
     from .numerics.integrate import DivergenceWarning, Solution, integrate
+    from .numerics.limits import ResourceLimitError
     from .numerics.methods import METHODS, TABLEAUS, ButcherTableau, get_method
     from .numerics.stability import max_stable_step, stability_function
     from .report import write_report
     from .report.identification import MeasurementComparison, compare_to_measurement
     from .report.plotting import plot_outputs
+    from .report.transaction import ReportError
     from .responses.timeresp import (
         FixedStepResponse,
         forced_response,
@@ -185,6 +187,9 @@ _LAZY: dict[str, str] = {
     "hinf_controller": "models.controllers",
     "HinfDesign": "models.controllers",
     "ParameterError": "numerics.checks",
+    # the errors a user catches: a run too large for the machine, a report folder refused
+    "ResourceLimitError": "numerics.limits",
+    "ReportError": "report.transaction",
     "DivergenceWarning": "numerics.integrate",
     "Solution": "numerics.integrate",
     "METHODS": "numerics.methods",
@@ -319,6 +324,8 @@ __all__ = [
     "ModelOption",
     "NonlinearQuarterCarBatch",
     "ParameterError",
+    "ReportError",
+    "ResourceLimitError",
     "ParetoFront",
     "PiecewiseDamper",
     "QuarterCarParams",

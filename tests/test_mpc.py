@@ -257,12 +257,32 @@ def test_preview_does_not_make_the_class_c_road_worse(car):
         ({"limits": {"travel": 0.1}}, "unknown limit 'travel'"),
         ({"Q": np.eye(3)}, "Q must be (4, 4)"),
         ({"solver": "quadprog"}, "solver must be 'osqp'"),
+        ({"travel_penalty": (-1.0, 1e4)}, "travel_penalty must be (rho_1, rho_2)"),
+        ({"travel_penalty": (float("nan"), 1e4)}, "travel_penalty must be (rho_1, rho_2)"),
+        ({"travel_penalty": (0.0, 0.0)}, "not both 0"),
+        ({"travel_penalty": 5.0}, "travel_penalty must be (rho_1, rho_2)"),
     ],
 )
 def test_bad_arguments_are_refused_naming_the_value(car, kwargs, words):
     with pytest.raises(ValueError) as info:
         qc.mpc_controller(car, DT, 50, **kwargs)
     assert words in str(info.value)
+
+
+def test_a_nan_state_is_refused_naming_it(car):
+    """Issue 39 item 6: NaN moves came back with the status 'unconstrained'."""
+    mpc = qc.mpc_controller(car, DT, N, Q=Q, R=R, limits={"fa": LIMIT})
+    with pytest.raises(ValueError, match=r"x must be finite, got xs = nan"):
+        mpc.solve([0.0, 0.0, float("nan"), 0.0])
+
+
+def test_a_horizon_too_large_for_memory_is_refused_before_allocating(car, monkeypatch):
+    """Issue 39 item 7: a horizon of 6,000 died of memory building its matrices.
+    Under a 100 MB limit it is refused at once, naming the horizon; 50 passes."""
+    monkeypatch.setenv("QC_CONTROL_MAX_MEMORY", "100MB")
+    with pytest.raises(qc.ResourceLimitError, match="an MPC of horizon 6,000"):
+        qc.mpc_controller(car, 0.001, 6000)
+    qc.mpc_controller(car, 0.01, 50)
 
 
 @pytest.mark.parametrize("dt, horizon", [(0.0, 20), (DT, 0), (DT, 2.5)])

@@ -68,6 +68,7 @@ import osqp
 import scipy.linalg
 import scipy.sparse as sp
 
+from ..numerics.limits import check_memory
 from ..numerics.threads import one_blas_thread
 from .controllers import DEFAULT_LQR_WEIGHTS, lqr_weights, relative_coordinates
 from .vehicle import VehicleModel
@@ -271,6 +272,11 @@ class MPCController(control.NonlinearIOSystem):
             raise ValueError(
                 f"x must hold the car's {self.ninputs} states {self.input_labels}, got {x.size}"
             )
+        bad = np.flatnonzero(~np.isfinite(x))
+        if bad.size:  # a NaN state would plan NaN moves and call them 'unconstrained'
+            raise ValueError(
+                f"x must be finite, got {self.input_labels[bad[0]]} = {float(x[bad[0]])!r}"
+            )
         road = np.zeros(1) if road_ahead is None else np.atleast_1d(np.asarray(road_ahead, float))
         if road.ndim != 1 or road.size == 0 or not np.all(np.isfinite(road)):
             raise ValueError(f"road_ahead must be finite road heights [m], got {road_ahead!r}")
@@ -429,6 +435,34 @@ def _check_limits(limits) -> dict:
     return out
 
 
+def _check_penalty(travel_penalty) -> tuple[float, float]:
+    """``(ρ_1, ρ_2)``: two finite weights >= 0, not both 0 (a soft limit with
+    no cost would not limit; a negative or NaN one makes the QP unbounded)."""
+    try:
+        rho = tuple(float(p) for p in travel_penalty)
+    except (TypeError, ValueError):
+        rho = ()
+    if len(rho) != 2 or not all(math.isfinite(p) and p >= 0 for p in rho) or not any(rho):
+        raise ValueError(
+            "travel_penalty must be (rho_1, rho_2), two finite weights >= 0 and not both 0, "
+            f"got {travel_penalty!r}"
+        )
+    return rho
+
+
+def _check_size(N: int, nz: int, n: int, dt: float) -> None:
+    """Refuse a horizon whose condensed matrices would not fit in memory, before
+    any is made: the dense output weight Ω is (N·nz + n)², the block matrices
+    diag(C_z) and G (N·nz) × (N·n) and N × (N·nz + n); 8 bytes each entry."""
+    rows = N * nz + n
+    nbytes = 8.0 * (rows * rows + 2 * (N * nz) * (N * n) + 3 * N * rows)
+    check_memory(
+        nbytes,
+        f"an MPC of horizon {N:,} ({N * dt:g} s at dt = {dt:g} s)",
+        "use a shorter horizon or a longer dt",
+    )
+
+
 def _preview_ticks(preview, dt: float, horizon: int) -> int:
     if preview is None or preview == 0:
         return 0
@@ -524,7 +558,8 @@ def mpc_controller(
     if "susp_travel" in lim:
         row = model.output("susp_travel")
         travel = np.asarray(sys.C, float)[[row]]
-    penalty = tuple(float(p) for p in travel_penalty)
+    penalty = _check_penalty(travel_penalty)
+    _check_size(N, stage[0].shape[0], sys.nstates, dt)
     qp = _CondensedQP(_foh_model(model, dt), stage, N, Pf, lim, penalty, travel)
     what = (
         f"N = {N} × {dt * 1e3:g} ms"
