@@ -429,7 +429,7 @@ def test_without_panel_the_command_says_which_extra_to_install(monkeypatch, caps
     assert main(["explore", "--no-browser"]) == 2
     assert capsys.readouterr().err.strip().splitlines() == [
         "qc-control: error: qc-control explore needs Panel, which is not installed: "
-        "pip install 'qc-control[explore]'"
+        'pip install "qc-control[explore]" (from a clone: pip install -e ".[explore]")'
     ]
 
 

@@ -9,7 +9,7 @@ import pytest
 from qc_control.cli import parser
 from qc_control.report import control as control_report
 
-HINT = "pip install 'qc-control[robust]'"
+HINT = 'pip install "qc-control[robust]" (from a clone: pip install -e ".[robust]")'
 
 
 @pytest.fixture

@@ -143,3 +143,20 @@ def test_every_import_modes_and_a_report_without_posix_only_modules(tmp_path):
     assert linked and all((report / name).exists() for name in linked)
     # nothing left beside the report: no working copy, no lock file
     assert [p.name for p in tmp_path.iterdir()] == ["rep"]
+
+
+def test_install_hints_work_in_cmd_exe():
+    """Issue 39 item 11: cmd.exe passes single quotes on, so ``pip install
+    'qc-control[robust]'`` fails there; every hint the package, README and
+    guide give uses double quotes, which cmd.exe, PowerShell and POSIX shells
+    all take."""
+    root = Path(qc_control.__file__).parents[1]
+    texts = [*Path(qc_control.__file__).parent.rglob("*.py"), root / "README.md"]
+    texts += [*(root / "docs").rglob("*.md"), *(root / "docs").rglob("*.rst")]
+    single = [
+        f"{p.relative_to(root)}:{i}"
+        for p in texts
+        for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+        if "pip install '" in line or "pip install -e '" in line
+    ]
+    assert not single, single

@@ -16,7 +16,7 @@ The figures are Bokeh's (Panel's own), updated in place: a redraw sends
 new columns to the browser, and no image is rendered on the server. Every
 script, style and font is served by the local Panel server: the page needs
 no internet. Panel is imported only here, when the page is made
-(``pip install 'qc-control[explore]'``); the rest of the package does not
+(``pip install "qc-control[explore]"``); the rest of the package does not
 need it.
 """
 
@@ -36,6 +36,7 @@ import pandas as pd
 
 from ..models.modal import modal_analysis
 from ..models.quarter import QuarterCarParams
+from ..numerics.messages import install_hint
 from ..numerics.methods import TABLEAUS
 from ..numerics.stability import stability_boundary
 from ..studies.compare import DEFAULT_METHODS
@@ -85,7 +86,7 @@ _COLORS = ("#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e
 
 
 class ExplorerUnavailable(ImportError):
-    """Panel is not installed: ``pip install 'qc-control[explore]'``."""
+    """Panel is not installed: ``pip install "qc-control[explore]"``."""
 
 
 def _panel():
@@ -94,8 +95,7 @@ def _panel():
         import panel as pn  # the explore extra: only the page needs it
     except ImportError:
         raise ExplorerUnavailable(
-            "qc-control explore needs Panel, which is not installed: "
-            "pip install 'qc-control[explore]'"
+            f"qc-control explore needs Panel, which is not installed: {install_hint('explore')}"
         ) from None
     return pn
 

@@ -26,6 +26,7 @@ from ..models.controllers import HINF_AVAILABLE
 from ..models.modal import modal_analysis
 from ..models.quarter import QuarterCarParams
 from ..models.registry import MODELS, ModelOption, get_model, parameter_help, parameter_keys
+from ..numerics.messages import install_hint
 from ..report import ReportError, check_target, report_lock, report_path, write_report
 from ..report.control import unavailable_designs, write_control_report
 from ..studies.compare import ReferenceBudgetError
@@ -630,7 +631,7 @@ def _designs(text: str | None) -> list[str]:
     if unknown:
         raise UsageError(f"--designs: unknown design {unknown[0]!r}; choose from {list(DESIGNS)}")
     if "H∞" in names and not HINF_AVAILABLE:
-        raise UsageError("--designs: H∞ needs slycot: pip install 'qc-control[robust]'")
+        raise UsageError(f"--designs: H∞ needs slycot: {install_hint('robust')}")
     return names
 
 

@@ -55,6 +55,7 @@ from typing import Any
 import control
 import numpy as np
 
+from ..numerics.messages import install_hint
 from .sampled_loop import sampled_loop
 from .vehicle import VehicleModel
 
@@ -693,7 +694,7 @@ def hinf_controller(
     Raises
     ------
     ImportError
-        Without slycot (``pip install 'qc-control[robust]'``).
+        Without slycot (``pip install "qc-control[robust]"``).
     """
     w = MATLAB_ACTIVE_SUSPENSION if weights is None else weights
     P = hinf_plant(car, beta, w)
@@ -701,7 +702,7 @@ def hinf_controller(
     if not 0 < _positive("rtol", rtol, "") < 1:
         raise ValueError(f"rtol (relative width of the γ bracket) must be in (0, 1), got {rtol!r}")
     if slycot is None:
-        raise ImportError("hinf_controller needs slycot: pip install 'qc-control[robust]'")
+        raise ImportError(f"hinf_controller needs slycot: {install_hint('robust')}")
     best = _hinf_attempt(P, gamma_max, 1, 2)
     if best is None:
         raise ValueError(

@@ -6,7 +6,7 @@ import reprlib
 
 import numpy as np
 
-__all__ = ["show"]
+__all__ = ["show", "install_hint"]
 
 _REPR = reprlib.Repr()
 _REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = 6
@@ -33,3 +33,18 @@ def show(value) -> str:
         return _REPR.repr(value)
     name = type(value).__name__
     return f"{'an' if name[:1].lower() in 'aeiou' else 'a'} {name}"
+
+
+def install_hint(extra: str) -> str:
+    """How to install an optional extra, in quotes every shell takes.
+
+    Single quotes fail in Windows' cmd.exe (``'qc-control[robust]'`` is
+    passed on with its quotes); double quotes work there, in PowerShell and
+    in POSIX shells. From a clone, the README's editable install.
+
+    Examples
+    --------
+    >>> install_hint("robust")
+    'pip install "qc-control[robust]" (from a clone: pip install -e ".[robust]")'
+    """
+    return f'pip install "qc-control[{extra}]" (from a clone: pip install -e ".[{extra}]")'

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from ..models.controllers import HINF_AVAILABLE
+from ..numerics.messages import install_hint
 from .document import Code, Heading, Image, Paragraph, Table
 from .writer import FORMATS, FigureSpec, write_document
 
@@ -86,7 +87,7 @@ def unavailable_designs(run: Iterable[str] = ()) -> dict[str, str]:
     each with the install hint: a report lists them rather than drop them."""
     if HINF_AVAILABLE or "H∞" in run:
         return {}
-    return {"H∞": "not run: it needs slycot, pip install 'qc-control[robust]'"}
+    return {"H∞": f"not run: it needs slycot, {install_hint('robust')}"}
 
 
 def _design_table(cmp) -> pd.DataFrame:
