@@ -30,7 +30,21 @@ UV  := $(BIN)/python -m uv pip install --python $(BIN)/python --quiet
 
 # The venv's own pip only installs uv, which does the rest: upgrading pip first cost
 # 4 s of every fresh install. Where uv has no wheel, pip is brought up to date.
+# qc_control needs Python 3.10 or newer (pyproject.toml's requires-python). A .venv
+# made by an older one (a first `make` with macOS's Python 3.9) would be reused by
+# every later `make ... PYTHON=python3.12` and fail the same way: it is made again,
+# saying so. $(PYTHON) itself is checked before a .venv is made with it.
+NEEDS := 3.10
+OLD_PYTHON := import sys; sys.exit(sys.version_info < (3, 10))
+ifneq ($(wildcard $(BIN)/python),)
+ifneq ($(shell $(BIN)/python -c '$(OLD_PYTHON)' >/dev/null 2>&1 && echo ok),ok)
+$(info make: $(VENV) was made by a Python older than $(NEEDS) (or no longer runs); making it again with $(PYTHON))
+$(shell rm -rf $(VENV))
+endif
+endif
+
 $(BIN)/python:
+	@$(PYTHON) -c '$(OLD_PYTHON)' 2>/dev/null || { echo "make: $(PYTHON) is not Python $(NEEDS) or newer ($$($(PYTHON) --version 2>&1)); give one: make ... PYTHON=python3.12" >&2; exit 2; }
 	$(PYTHON) -m venv $(VENV)
 	$(PIP) uv || $(PIP) --upgrade pip
 

@@ -71,3 +71,52 @@ def test_the_readme_says_how_to_reach_the_installed_tools():
     ):
         assert words in readme, words
     assert re.search(r"times are (from )?one machine", readme)  # timings flagged
+
+
+def _copy_makefile(tmp_path: Path) -> Path:
+    (tmp_path / "Makefile").write_text((ROOT / "Makefile").read_text(encoding="utf-8"))
+    (tmp_path / "pyproject.toml").write_text("")
+    return tmp_path
+
+
+def _fake_python(path: Path, version: str) -> Path:
+    """A ``python`` that says it is ``version`` (major.minor) and runs nothing else."""
+    major, minor = version.split(".")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(
+        "#!/bin/sh\n"
+        f'case "$1" in --version) echo "Python {version}.0";; '
+        f"-c) [ {major}{minor.zfill(2)} -ge 310 ];; esac\n"
+    )
+    path.chmod(0o755)
+    return path
+
+
+@pytest.mark.skipif(shutil.which("sh") is None, reason="needs a POSIX shell")
+def test_a_venv_of_a_too_old_python_is_made_again(tmp_path):
+    """Issue 39 item 10: a .venv made by Python 3.9 was reused by every later
+    make; it is removed, saying so, before anything is installed in it."""
+    here = _copy_makefile(tmp_path)
+    _fake_python(here / ".venv" / "bin" / "python", "3.9")
+    run = subprocess.run(["make", "-n", "report"], cwd=here, capture_output=True, text=True)
+    assert "was made by a Python older than 3.10" in run.stdout + run.stderr
+    assert not (here / ".venv").exists()
+
+
+@pytest.mark.skipif(shutil.which("sh") is None, reason="needs a POSIX shell")
+def test_a_too_old_python_is_refused_before_making_the_venv(tmp_path):
+    here = _copy_makefile(tmp_path)
+    old = _fake_python(tmp_path / "bin" / "python3.9", "3.9")
+    run = subprocess.run(
+        ["make", ".venv/bin/python", f"PYTHON={old}"], cwd=here, capture_output=True, text=True
+    )
+    assert run.returncode != 0
+    assert "is not Python 3.10 or newer (Python 3.9.0)" in run.stderr
+    assert "PYTHON=python3.12" in run.stderr and not (here / ".venv").exists()
+
+
+def test_a_venv_of_a_recent_python_is_kept(tmp_path):
+    here = _copy_makefile(tmp_path)
+    _fake_python(here / ".venv" / "bin" / "python", "3.11")
+    run = subprocess.run(["make", "-n", "report"], cwd=here, capture_output=True, text=True)
+    assert "older than" not in run.stdout + run.stderr and (here / ".venv").exists()
