@@ -57,9 +57,13 @@ that needs them is used.
 from __future__ import annotations
 
 import importlib
+import sys as _sys
 from importlib.metadata import PackageNotFoundError
 from importlib.metadata import version as _distribution_version
+from types import ModuleType as _ModuleType
 from typing import TYPE_CHECKING, Any
+
+from . import _moved
 
 try:
     # The version is written once, in pyproject.toml; this reads it back
@@ -399,3 +403,23 @@ __all__ = [
     "compare_to_measurement",
     "MeasurementComparison",
 ]
+
+
+class _Package(_ModuleType):
+    """The package's module type: importing one of 0.1's module paths
+    (`qc_control._moved`) binds that module on the package, as every import of
+    a submodule does; where the path is also a public name (``integrate``, the
+    function; ``road``, the new module), the public name stays."""
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if (
+            name in _LAZY
+            and isinstance(value, _ModuleType)
+            and value.__name__ == f"{__name__}.{name}"
+        ):
+            return
+        super().__setattr__(name, value)
+
+
+_sys.modules[__name__].__class__ = _Package
+_moved.install()
