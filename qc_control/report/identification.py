@@ -19,13 +19,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-import control
 import numpy as np
 import pandas as pd
 import scipy.signal
 
 from ..models.quarter import QuarterCarParams
 from ..models.vehicle import VehicleModel
+from ..numerics.reference import exact_response
 from ..studies.identification import OUTPUT_LABELS, Identification, nrmse_fit, simulate_quarter
 from ..studies.measurement import SIGNAL_UNITS, Measurement
 from .document import Code, Heading, Image, Paragraph, Table
@@ -132,8 +132,7 @@ def _linear_outputs(model: VehicleModel, measurement: Measurement, outputs) -> n
             for k in sys.input_labels
         ]
     )
-    x0 = -np.linalg.solve(sys.A, sys.B @ U[:, 0]) if U.size else 0.0
-    response = control.forced_response(sys, measurement.t, U, X0=x0)
+    response = exact_response(sys, measurement.t, U=U, at_rest=bool(U.size))
     rows = [list(sys.output_labels).index(k) for k in outputs]
     return np.atleast_2d(response.outputs)[rows]
 

@@ -16,6 +16,7 @@ import control
 import numpy as np
 
 from ..numerics.methods import get_method
+from ..numerics.reference import exact_response
 from ..responses.timeresp import forced_response, initial_response
 from .document import fmt
 from .figures import body_wheel_road
@@ -89,14 +90,14 @@ def _error_at(cmp, method, steps: int, body: str) -> float:
         warnings.simplefilter("ignore")  # a check step past a limit shows as a large error
         if cmp.U is None:
             run = initial_response(cmp.system, T, cmp.X0, method=method)
-            exact = output_signal(control.initial_response(cmp.system, T, cmp.X0), body)
+            exact = output_signal(exact_response(cmp.system, T, cmp.X0), body)
         else:
             run = forced_response(cmp.system, T, _input_on(cmp, T), cmp.X0, method=method)
             # a uniform grid holding both (python-control's exact solver needs one)
             fine_steps = cmp.T.size - 1
             common = math.lcm(fine_steps, steps)
             union = np.linspace(cmp.T[0], cmp.T[-1], common + 1)
-            fine = control.forced_response(cmp.system, union, _input_on(cmp, union), cmp.X0)
+            fine = exact_response(cmp.system, union, cmp.X0, _input_on(cmp, union))
             exact = output_signal(fine, body)[:: common // steps]
     with np.errstate(invalid="ignore", over="ignore"):
         return float(np.max(np.abs(output_signal(run, body) - exact)))

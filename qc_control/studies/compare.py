@@ -41,6 +41,7 @@ from ..numerics.integrate import (
 from ..numerics.limits import check_memory
 from ..numerics.lti import is_nonlinear_system
 from ..numerics.methods import ButcherTableau, get_method
+from ..numerics.reference import exact_response
 from ..numerics.sampled import linear_input
 from ..numerics.stability import max_stable_step, numerical_modes, step_is_stable
 from ..responses.timeresp import (
@@ -300,12 +301,6 @@ def _simulate(sys, T, X0, U, method, substeps, engine="auto"):
         return forced_response(sys, T, U, X0, method=method, substeps=substeps, engine=engine)
 
 
-def _exact(sys, T, X0, U):
-    if U is None:
-        return control.initial_response(sys, T, X0)
-    return control.forced_response(sys, T, U, X0)
-
-
 def _observed_order(hs, errors, floor: float = _ROUNDING_FLOOR) -> float:
     hs, errors = np.asarray(hs), np.asarray(errors)
     ok = np.isfinite(errors) & (errors > floor)
@@ -414,7 +409,7 @@ def exact_reference(sys, T, X0, U=None, *, outputs=None, repeats: int = 0) -> Re
     solution for an input linear between samples. ``repeats > 0`` also
     times ``control``'s call (best of ``repeats``).
     """
-    reference = _exact(sys, T, X0, U)
+    reference = exact_response(sys, T, X0, U)
     A, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.C, sys.D))
     if U is None:
         lam, V = np.linalg.eig(A)
@@ -430,7 +425,7 @@ def exact_reference(sys, T, X0, U=None, *, outputs=None, repeats: int = 0) -> Re
     rows = [labels.index(label) for label in (labels if outputs is None else outputs)]
     ours = np.asarray(reference.outputs).reshape(other.shape)
     error = float(np.max(np.abs(ours[rows] - other[rows])))
-    elapsed = best_time(lambda: _exact(sys, T, X0, U), repeats) if repeats else math.nan
+    elapsed = best_time(lambda: exact_response(sys, T, X0, U), repeats) if repeats else math.nan
     name = (
         f"control.{'initial' if U is None else 'forced'}_response "
         f"(python-control {control.__version__})"
@@ -589,7 +584,7 @@ def _linear_refinement(
     stability limit), when the one run is that run, timed.
     """
     if level not in exact_at:
-        exact_at[level] = np.asarray(_exact(sys, T, X0, U).outputs)[body]
+        exact_at[level] = np.asarray(exact_response(sys, T, X0, U).outputs)[body]
     exact = exact_at[level]
     if timing and _stepped_by_default(tab, T, substeps, eig):
         start = time.perf_counter()

@@ -48,6 +48,7 @@ import scipy.stats
 from ..models.quarter import QuarterCarParams, quarter_car_abcd, quarter_car_model
 from ..models.vehicle import VehicleModel
 from ..numerics.exact import exact_outputs
+from ..numerics.reference import rest_state
 from ..numerics.threads import one_blas_thread
 from .frequency_identification import (
     Transmissibility,
@@ -191,7 +192,7 @@ def simulate_quarter(
             U[i] = gains.get(label, 1.0) * measurement[label]
     rows = [OUTPUT_LABELS.index(k) for k in outputs]
     if x0 is None:  # at rest: x' = 0 under the first input
-        x0 = -np.linalg.solve(A, B @ U[:, 0])
+        x0 = rest_state(A, B, U[:, 0])
     y = exact_outputs(A, B, C[rows], D[rows], measurement.dt, U, x0)
     if values["cu"] and "wheel_acc" in outputs:
         # the wheel's acceleration is q' + (cu/mu) zr' (the state q hides the road's rate):
@@ -478,7 +479,7 @@ def _rest_state(problem: _Problem, theta: np.ndarray) -> np.ndarray:
     A, B, _, _ = _quarter_matrices(values)
     signals = problem.measurement.signals
     u0 = [gains.get(k, 1.0) * signals[k][0] if k in signals else 0.0 for k in INPUT_LABELS]
-    return -np.linalg.solve(A, B @ np.array(u0))
+    return rest_state(A, B, u0)
 
 
 def _covariance(n_out: int, J: np.ndarray, residual: np.ndarray):

@@ -27,6 +27,7 @@ from ..models.vehicle import VehicleModel
 from ..numerics.exact import exact_outputs
 from ..numerics.integrate import uniform_step
 from ..numerics.methods import get_method
+from ..numerics.reference import exact_response
 from ..numerics.stability import step_verdict
 from .compare import Reference, error_table, max_error, method_responses, mode_errors
 
@@ -127,10 +128,7 @@ def quick_comparison(
         raise ValueError("T must be a uniform grid: its spacing is the step")
     X0 = np.asarray(X0, dtype=float)
     tabs = tuple(get_method(m) for m in methods)
-    if U is None:
-        exact = control.initial_response(sys, T, X0)
-    else:
-        exact = control.forced_response(sys, T, U, X0)
+    exact = exact_response(sys, T, X0, U)
     reference = Reference(exact, math.nan, "", f"python-control {control.__version__}")
     responses = method_responses(sys, T, X0, U, tabs)
     modes = modal_analysis(model)
