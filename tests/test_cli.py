@@ -136,7 +136,7 @@ BAD = [
     (["modes", "--bogus"], "unrecognized arguments: --bogus"),
     ([], "command"),
     (["report", "--out", ""], "the report folder (--out) is empty"),
-    (["report", "--road", "step", "--road-t0", "20"], "--road-t0 20 s is not before the run's end"),
+    (["report", "--road", "step", "--road-t0", "20"], "--road-t0 20 s is after the run's end"),
     (["report", "--h", "1e-320"], "more than 1.8e308 steps per method"),
     (["report", "--t-end", "1e308", "--h", "1"], "1e+308 steps per method"),
     (["report", "--t-end", "1e6", "--h", "0.01"], "1e+08 steps per method"),

@@ -51,18 +51,36 @@ def test_the_summary_opens_the_report(seed):
     assert isinstance(blocks[1], Paragraph) and blocks[1].text.startswith("As run (h = 0.01 s)")
 
 
-def test_the_seed_cars_answer_is_rk4_checked_by_a_run(seed):
+def test_the_seed_cars_answer_is_rk4_confirmed_by_a_run(seed):
     text = summary(seed)[-1]
-    assert text.startswith("To reach 1 mm in xs for the fewest RHS evaluations: rk4 at h ≈")
-    # the issue's regression: the estimate from the order (492) gives 1.31 mm
-    assert "about 492 evaluations" in text and "missed it" in text
+    assert text.startswith("To reach 1 mm in xs for the fewest RHS evaluations: rk4 at h =")
+    # the issue's regression: the estimate from the order (492) gives 1.31 mm; the
+    # summary says so, and quotes the confirmed count instead
+    missed = re.search(r"about 492 evaluations, missed it: a run there gives ([0-9.]+) mm", text)
+    assert rk4_error(math.ceil(492 / 4)) == pytest.approx(float(missed.group(1)) * 1e-3, rel=1e-3)
     assert rk4_error(math.ceil(492 / 4)) == pytest.approx(1.31e-3, rel=0.01)
-    evaluations = int(re.search(r"\((\d+) evaluations\) a run gives", text).group(1))
-    h = float(re.search(r"at h = ([0-9.]+) s \(", text).group(1))
+    evaluations = int(re.search(r"s, (\d+) evaluations, confirmed", text).group(1))
+    h = float(re.search(r"rk4 at h = ([0-9.]+) s,", text).group(1))
     # the confirmed step reaches 1 mm by the independent RK4, and costs within
     # 5 % of the least (131 steps, 524 evaluations: tests/test_exercises.py)
     assert rk4_error(round(10.0 / h)) <= 1e-3
     assert 524 <= evaluations <= 1.05 * 524
+
+
+def test_the_summary_findings_and_tables_quote_one_count(seed):
+    """Issue 38: the summary, the findings and the cost table quote the same
+    count for the same target, and it is the study's confirmed one."""
+    from qc_control.report.findings import findings
+
+    cost = int(seed.cost.loc[1e-3, "rk4"])
+    assert seed.cost_kind.loc[1e-3, "rk4"] == "confirmed"
+    assert f"{cost} evaluations" in summary(seed)[-1]
+    (line,) = [f for f in findings(seed) if f.startswith("Cheapest to reach 0.001 m")]
+    assert f"about {cost} RHS evaluations (confirmed by a run at that count)" in line
+    (reach,) = [
+        b for b in build_blocks(seed) if "RHS evaluations to reach" in getattr(b, "caption", "")
+    ]
+    assert reach.frame.loc["rk4", "to 0.001 m"] == f"{cost} (c)"
 
 
 def test_a_method_past_its_limit_is_the_summarys_first_word():

@@ -714,12 +714,12 @@ class Scenario:
         put("max_steps", int(m))
         self._check_grid(chosen, given_end)
         t0 = getattr(road, "t0", None)
-        if t0 is not None and t0 >= self.t_end:
+        if t0 is not None and t0 > self.t_end:
             # the run would end before the car meets the road: every figure flat, every
             # error 0, and a report that says nothing happened
             raise ScenarioError(
-                f"t0 = {t0:g} s is not before the run's end t_end = {self.t_end:g} s: the "
-                "car would never meet the road; use an earlier t0 or a longer t_end",
+                f"t0 = {t0:g} s is after the run's end t_end = {self.t_end:g} s: the car "
+                "would never meet the road; use an earlier t0 or a longer t_end",
                 _ROAD_SECTION,
                 "t0",
             )

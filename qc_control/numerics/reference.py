@@ -7,6 +7,11 @@ Workman, *Digital Control of Dynamic Systems*, 3rd ed., §6.3). Every error a
 study, a report or an exercise quotes is a distance to this response, so it
 is computed here, one way, for all of them.
 
+On long grids (a check of a cost under a road input is solved on a grid of
+up to 200,000 samples) `exact_output_samples` gives the same outputs by the
+modal recurrence of `qc_control.numerics.exact`, in milliseconds instead of
+python-control's second (tests/test_reference.py holds the two to 1e-12).
+
 A run "at rest" starts where the car sits still under its first input
 sample: ``x' = 0 = A x_0 + B u_0``, so ``x_0 = -A⁻¹ B u_0`` (`rest_state`),
 as a rig record starts.
@@ -17,7 +22,9 @@ from __future__ import annotations
 import control
 import numpy as np
 
-__all__ = ["exact_response", "rest_state"]
+from .exact import exact_outputs
+
+__all__ = ["exact_response", "exact_output_samples", "rest_state"]
 
 
 def rest_state(A, B, u0) -> np.ndarray:
@@ -71,3 +78,25 @@ def exact_response(sys, T, X0=None, U=None, *, at_rest: bool = False) -> control
     if U is None:
         return control.initial_response(sys, T, X0)
     return control.forced_response(sys, T, U, X0)
+
+
+def exact_output_samples(sys, T, X0, U) -> np.ndarray:
+    """The outputs of `exact_response` under an input, by the modal recurrence.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+    T : array_like
+        A uniform grid [s].
+    X0 : array_like
+    U : array_like, shape (ninputs, len(T))
+        Linear between samples.
+
+    Returns
+    -------
+    ndarray, shape (noutputs, len(T))
+    """
+    T = np.asarray(T, dtype=float)
+    U = np.asarray(U, dtype=float).reshape(sys.ninputs, -1)
+    H = (T[-1] - T[0]) / (T.size - 1)
+    return exact_outputs(sys.A, sys.B, sys.C, sys.D, H, U, np.asarray(X0, dtype=float))

@@ -487,8 +487,9 @@ def _reach_table(cmp) -> Table:
     return Table(
         reach,
         f"RHS evaluations to reach each max |{_body(cmp)} error| "
-        "(i: interpolated between refinements, e: extrapolated with "
-        "e = C·h^p, never beyond h_max)",
+        "(c: confirmed by a run at that count; estimates no run checked: i: interpolated "
+        "between refinements, e: extrapolated with e = C·h^p, never beyond h_max; "
+        "m: missed by the runs from its estimate, u: unreached)",
     )
 
 

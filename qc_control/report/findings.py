@@ -9,8 +9,10 @@ from .document import fmt
 __all__ = ["findings", "coincidence_groups"]
 
 _KIND = {
-    "interpolated": "interpolated",
-    "extrapolated": "extrapolated from its order",
+    "confirmed": "confirmed by a run at that count",
+    "interpolated": "interpolated, not checked by a run",
+    "extrapolated": "extrapolated from its order, not checked by a run",
+    "missed": "not reached by the runs from its estimate",
     "unreached": "not reached",
 }
 

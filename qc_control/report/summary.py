@@ -4,31 +4,22 @@
 first any method run beyond its stability limit; then the errors of the run
 as given; then the method that reaches the asked accuracy (1 mm in the body
 displacement by default) for the fewest right-hand-side evaluations, at
-which step, and one run at that step that checks the estimate.
+which step, and the run that confirmed that cost (made by the study,
+`qc_control.studies.confirm`: the summary only words it).
 """
 
 from __future__ import annotations
 
 import math
-import warnings
-
-import control
-import numpy as np
 
 from ..numerics.methods import get_method
-from ..numerics.reference import exact_response
-from ..responses.timeresp import forced_response, initial_response
 from .document import fmt
 from .figures import body_wheel_road
-from .plotting import output_signal
 
-__all__ = ["summary", "checked_step"]
+__all__ = ["summary"]
 
 #: The accuracy the summary answers for [m], in the body displacement.
 SUMMARY_TOLERANCE = 1e-3
-#: Runs the check may take: the estimate, then a step predicted from the
-#: measured error and the order, confirmed; then that step shortened again.
-_CHECK_RUNS = 3
 
 
 def _limits(cmp) -> list[str]:
@@ -54,55 +45,6 @@ def _as_run(cmp, body: str) -> str:
     return f"As run (h = {fmt(cmp.h)} s), the largest |{body} error| of each method: {listed}."
 
 
-def _input_on(cmp, T: np.ndarray) -> np.ndarray:
-    """The comparison's input, linearly interpolated between its samples, on ``T``."""
-    U = np.atleast_2d(np.asarray(cmp.U, dtype=float))
-    return np.array([np.interp(T, cmp.T, row) for row in U])
-
-
-#: The largest grid the exact reference of a check is solved on, under an
-#: input: it must hold both the comparison's grid and the check's.
-_MAX_COMMON_STEPS = 400_000
-
-
-def _carried(cmp, steps: int) -> int:
-    """``steps``, or the next count whose grid and the comparison's fit in one
-    uniform grid of at most `_MAX_COMMON_STEPS` steps (only under an input)."""
-    if cmp.U is None:
-        return steps
-    fine = cmp.T.size - 1
-    for n in range(steps, steps + fine + 1):
-        if math.lcm(fine, n) <= _MAX_COMMON_STEPS:
-            return n
-    return fine  # the comparison's own grid always fits
-
-
-def _error_at(cmp, method, steps: int, body: str) -> float:
-    """Largest |body error| of ``method`` in ``steps`` steps against the exact response.
-
-    The method sees the input only at its own steps, as a run at that step
-    would; the exact response (python-control's) is the one to the whole
-    input, solved on the union of both grids so that a road shorter than
-    the step is not lost from the reference too.
-    """
-    T = np.linspace(cmp.T[0], cmp.T[-1], steps + 1)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # a check step past a limit shows as a large error
-        if cmp.U is None:
-            run = initial_response(cmp.system, T, cmp.X0, method=method)
-            exact = output_signal(exact_response(cmp.system, T, cmp.X0), body)
-        else:
-            run = forced_response(cmp.system, T, _input_on(cmp, T), cmp.X0, method=method)
-            # a uniform grid holding both (python-control's exact solver needs one)
-            fine_steps = cmp.T.size - 1
-            common = math.lcm(fine_steps, steps)
-            union = np.linspace(cmp.T[0], cmp.T[-1], common + 1)
-            fine = exact_response(cmp.system, union, cmp.X0, _input_on(cmp, union))
-            exact = output_signal(fine, body)[:: common // steps]
-    with np.errstate(invalid="ignore", over="ignore"):
-        return float(np.max(np.abs(output_signal(run, body) - exact)))
-
-
 def _tableau(cmp, name: str):
     """The comparison's own tableau of that name (a custom one is in no catalogue)."""
     for tab in getattr(cmp, "methods", ()):
@@ -111,30 +53,22 @@ def _tableau(cmp, name: str):
     return get_method(name)
 
 
-def checked_step(cmp, method: str, cost: float, tol: float = SUMMARY_TOLERANCE):
-    """Check an estimated cost by running ``method`` at the step it implies.
+_HOW = {
+    "interpolated": "interpolated between the refinements",
+    "extrapolated": "extrapolated from its order",
+}
 
-    Returns ``(steps, error, runs)``: the steps of the last run over the
-    span, its largest body-displacement error [m], and how many runs were
-    needed. When the estimate misses ``tol``, the step is shortened by the
-    error model ``e = C h^p`` (2 % margin) and run again, up to
-    `_CHECK_RUNS` runs. ``(None, nan, 0)`` on a system python-control cannot
-    solve exactly (a nonlinear one).
-    """
-    if not isinstance(cmp.system, control.StateSpace):
-        return None, math.nan, 0
-    tab = _tableau(cmp, method)
-    body = body_wheel_road(cmp)[0]
-    steps = _carried(cmp, max(2, math.ceil(cost / tab.stages)))
-    for run in range(1, _CHECK_RUNS + 1):
-        error = _error_at(cmp, tab, steps, body)
-        if error <= tol or not math.isfinite(error) or run == _CHECK_RUNS:
-            return steps, error, run
-        steps = _carried(cmp, math.ceil(steps * (error / tol) ** (1 / tab.order) * 1.02))
-    raise AssertionError("unreachable")  # pragma: no cover
+
+def _check_of(cmp, method: str, tol: float):
+    for check in cmp.cost_checks or ():
+        if check.method == method and check.tolerance == tol:
+            return check
+    return None
 
 
 def _cheapest(cmp, body: str, tol: float) -> list[str]:
+    """The cheapest method for ``tol``, with the run that confirmed its cost
+    (`qc_control.studies.confirm`); this only words the comparison's numbers."""
     if tol not in cmp.cost.index:
         return []
     costs = cmp.cost.loc[tol].dropna().sort_values()
@@ -142,36 +76,33 @@ def _cheapest(cmp, body: str, tol: float) -> list[str]:
         return [f"No method reaches {fmt(tol * 1e3)} mm in {body} at a step it can run."]
     best, cost = costs.index[0], float(costs.iloc[0])
     span = float(cmp.T[-1] - cmp.T[0])
-    tab = _tableau(cmp, best)
-    h_est = span / math.ceil(cost / tab.stages)
-    kind = cmp.cost_kind.loc[tol, best]
-    how = (
-        "interpolated between the refinements"
-        if kind == "interpolated"
-        else f"{kind} from its order"
-    )
-    text = (
-        f"To reach {fmt(tol * 1e3)} mm in {body} for the fewest RHS evaluations: {best} at "
-        f"h ≈ {fmt(h_est)} s, about {fmt(int(cost))} evaluations ({how})."
-    )
-    steps, error, runs = checked_step(cmp, best, cost, tol)
-    if steps is None:
-        return [text + " Not checked by a run: the exact reference needs a linear system."]
-    h = span / steps
-    if runs == 1 and error <= tol:
-        verdict = f"One run at that step confirms it: its error is {fmt(error * 1e3)} mm."
-    elif error <= tol:
-        verdict = (
-            f"One run at that step missed it (the estimate is optimistic); at h = {fmt(h)} s "
-            f"({fmt(steps * tab.stages)} evaluations) a run gives {fmt(error * 1e3)} mm, "
-            f"within {fmt(tol * 1e3)} mm."
+    target = f"To reach {fmt(tol * 1e3)} mm in {body} for the fewest RHS evaluations: {best}"
+    check = _check_of(cmp, best, tol)
+    if check is None or check.verdict != "confirmed":
+        h_est = span / math.ceil(cost / _tableau(cmp, best).stages)
+        why = (
+            "the exact reference needs a linear system"
+            if check is None
+            else "a run that long is not made"
         )
-    else:
-        verdict = (
-            f"Not confirmed: a run at h = {fmt(h)} s still gives {fmt(error * 1e3)} mm; "
-            "take a smaller step."
-        )
-    return [text + " " + verdict]
+        kind = check.estimate_kind if check is not None else cmp.cost_kind.loc[tol, best]
+        return [
+            f"{target} at h ≈ {fmt(h_est)} s, about {fmt(int(cost))} evaluations "
+            f"({_HOW.get(kind, kind)}). Not checked by a run: {why}."
+        ]
+    h = span / check.steps
+    stated = f"{target} at h = {fmt(h)} s, {fmt(int(cost))} evaluations"
+    if check.runs == 1:
+        return [
+            f"{stated} ({_HOW.get(check.estimate_kind, check.estimate_kind)}); a run at that "
+            f"step confirms it: its error is {fmt(check.error * 1e3)} mm."
+        ]
+    return [
+        f"{stated}, confirmed by a run: its error is {fmt(check.error * 1e3)} mm. The estimate "
+        f"{_HOW.get(check.estimate_kind, check.estimate_kind)}, about "
+        f"{fmt(int(check.estimate))} evaluations, missed it: a run there gives "
+        f"{fmt(check.estimate_error * 1e3)} mm."
+    ]
 
 
 def summary(cmp, tol: float = SUMMARY_TOLERANCE) -> list[str]:

@@ -52,6 +52,7 @@ from ..responses.timeresp import (
     input_output_response,
 )
 from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
+from .confirm import CostCheck, confirmed_costs
 from .peers import RTOLS, WorkPrecision, check_solvers, work_precision
 from .ride_cost import RideCost
 
@@ -173,10 +174,13 @@ class MethodComparison(ComparisonProblem):
         RHS evaluations needed to reach each accuracy in `TOLERANCES`
         (index, max |xs error| in m) per method (columns).
     cost_kind : pandas.DataFrame
-        For each entry of `cost`: ``'interpolated'`` (log-log, between two
-        refinements that bracket it) or ``'extrapolated'`` (``e = C h^p``
-        with the method's order p from the nearest refinement, and never
-        a step beyond ``h_max``).
+        For each entry of `cost`: ``'confirmed'`` (a run at that count
+        reaches the accuracy, `cost_checks`), ``'missed'`` (runs from the
+        estimate on did not: no cost), or the kind of an estimate no run
+        checked (a nonlinear car; a run too long): ``'interpolated'``
+        (log-log, between two refinements that bracket it) or
+        ``'extrapolated'`` (``e = C h^p`` with the method's order p from
+        the nearest refinement, and never a step beyond ``h_max``).
     coincident : dict
         ``{(a, b): max |x_a - x_b|}`` [m] over the states, for each pair of
         methods whose trajectories agree to 1e-12 m (e.g. Midpoint and
@@ -214,6 +218,10 @@ class MethodComparison(ComparisonProblem):
         Set by the stiff car's run (`qc_control.studies.ride_cost`): each
         method's and peer's cheapest setting whose ride metric is within a
         target of the exact one, with its evaluations and time.
+    cost_checks : list of CostCheck or None
+        On a linear car: the run that checked each estimate of `cost`
+        (`qc_control.studies.confirm`); `cost` then holds the confirmed
+        counts, and `cost_kind` says 'confirmed' or 'missed' for them.
     """
 
     table: pd.DataFrame
@@ -239,6 +247,7 @@ class MethodComparison(ComparisonProblem):
     peers: WorkPrecision | None = None
     sampled_car: control.StateSpace | None = None
     ride_cost: RideCost | None = None
+    cost_checks: list[CostCheck] | None = None
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""
@@ -925,6 +934,12 @@ def _comparison(
     cost, cost_kind = cost_to_reach(
         measured.convergence, tabs, span, stability["h_max [s]"].to_dict()
     )
+    checks = None
+    if isinstance(problem.system, control.StateSpace):  # an exact reference to run against
+        cost, cost_kind, checks = confirmed_costs(
+            problem.system, problem.T, problem.X0, problem.U, tabs, cost, cost_kind,
+            problem.model.body_disp,
+        )  # fmt: skip
     table = pd.concat(
         [
             _cost_columns(problem, responses),
@@ -947,6 +962,7 @@ def _comparison(
         convergence=measured.convergence,
         cost=cost,
         cost_kind=cost_kind,
+        cost_checks=checks,
         coincident=_coincident(responses),
         reference=reference.response,
         reference_error=reference.error,
