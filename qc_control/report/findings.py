@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from ..studies.timing import same_work
 from .document import fmt
 
 __all__ = ["findings", "coincidence_groups"]
@@ -199,10 +200,29 @@ def _ride(cmp) -> list[str]:
     ]
 
 
+def _same_work(cmp) -> list[str]:
+    out = []
+    for pair in same_work(cmp.table):
+        a, b = (f"{fmt(t * 1e3)} ms" for t in pair.times)
+        head = (
+            f"{pair.first} and {pair.second} make the same {fmt(pair.evaluations)} RHS "
+            f"evaluations; their wall times ({a} and {b}) "
+        )
+        out.append(
+            head + "differ by less than the spread of the timing rounds: the difference is "
+            "the machine's noise, not the methods'."
+            if pair.noise
+            else head + "differ by more than the spread of the timing rounds: the work "
+            "besides the evaluations (each method's arithmetic) differs."
+        )
+    return out
+
+
 def findings(cmp) -> list[str]:
     """Sentences that state what the numbers of ``cmp`` show."""
     return (
         _cheapest(cmp)
+        + _same_work(cmp)
         + _step_limits(cmp)
         + _coincidence(cmp)
         + _damping(cmp)

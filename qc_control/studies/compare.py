@@ -55,6 +55,7 @@ from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
 from .confirm import CostCheck, confirmed_costs
 from .peers import RTOLS, WorkPrecision, check_solvers, work_precision
 from .ride_cost import RideCost
+from .timing import TIME_COLUMNS, interleaved_times
 
 __all__ = [
     "ReferenceBudgetError",
@@ -726,14 +727,25 @@ def ride_comparison(
 def method_timings(
     sys, T, X0, U, methods: Sequence[ButcherTableau], substeps: int, repeats: int
 ) -> pd.DataFrame:
-    """Best wall time [ms] of each method step by step (``engine='generic'``, the
-    seed's loop, whose time follows the RHS evaluations) and with the LTI engine."""
-    rows = {}
-    for tab in methods:
-        generic = best_time(lambda: _simulate(sys, T, X0, U, tab, substeps, "generic"), repeats)
-        lti = best_time(lambda: _simulate(sys, T, X0, U, tab, substeps), repeats)
-        rows[tab.name] = {"wall time [ms]": 1e3 * generic, "LTI engine [ms]": 1e3 * lti}
-    return pd.DataFrame.from_dict(rows, orient="index")
+    """Median wall time [ms] of each method step by step (``engine='generic'``, the
+    seed's loop, whose time follows the RHS evaluations) and with the LTI engine,
+    over ``repeats`` interleaved rounds (`qc_control.studies.timing`)."""
+    runs = {
+        (tab.name, engine): functools.partial(_simulate, sys, T, X0, U, tab, substeps, engine)
+        for tab in methods
+        for engine in ("generic", "auto")
+    }
+    times = interleaved_times(runs, max(1, repeats))
+    return pd.DataFrame.from_dict(
+        {
+            tab.name: {
+                "wall time [ms]": 1e3 * times[tab.name, "generic"].wall,
+                "LTI engine [ms]": 1e3 * times[tab.name, "auto"].wall,
+            }
+            for tab in methods
+        },
+        orient="index",
+    )
 
 
 def _as_model(sys, U, params) -> tuple[control.NonlinearIOSystem, VehicleModel | None, Any]:
@@ -858,17 +870,69 @@ def _on_road(problem: ComparisonProblem) -> bool:
     return problem.U is not None and bool(roads) and list(problem.system.input_labels) == roads
 
 
-def _linear_times(
-    problem: ComparisonProblem, reference: Reference, repeats: int, timing: bool
+#: Rounds the convergence ladder is timed in: its 24 runs take a second a round on
+#: the seed's grid, and the median of 3 already sets Midpoint and Heun (the same
+#: evaluations) within their spread of each other.
+LADDER_ROUNDS = 3
+
+
+def _timed_ladder(
+    problem: ComparisonProblem, convergence: pd.DataFrame, rounds: int
 ) -> pd.DataFrame:
-    """The wall-time columns of a linear comparison (NaN without ``timing``)."""
+    """The convergence study's runs timed step by step (``engine='generic'``, the
+    seed's loop, whose time follows the RHS evaluations), all of them in
+    interleaved rounds (`qc_control.studies.timing`): the one measurement the
+    cost table (level 0) and the work-precision figure both quote."""
+    tabs = {t.name: t for t in problem.methods}
+    sys, X0, substeps = problem.system, problem.X0, problem.substeps
+    runs = {
+        (method, level): functools.partial(
+            _simulate, sys, _refined(problem.T, level), X0,
+            _refined_input(problem.T, problem.U, level), tabs[method], substeps, "generic",
+        )
+        for method, level in zip(convergence["method"], convergence["level"])
+    }  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DivergenceWarning)
+        # no warm-up: the convergence study has just made each run
+        times = interleaved_times(runs, max(1, rounds), warmup=False)
+    keyed = [times[key] for key in zip(convergence["method"], convergence["level"])]
+    return convergence.assign(
+        time=[t.wall for t in keyed],
+        time_low=[t.low for t in keyed],
+        time_high=[t.high for t in keyed],
+        cpu_time=[t.cpu for t in keyed],
+    )
+
+
+def _linear_times(
+    problem: ComparisonProblem,
+    reference: Reference,
+    repeats: int,
+    timing: bool,
+    convergence: pd.DataFrame,
+) -> pd.DataFrame:
+    """The wall-time columns of a linear comparison (NaN without ``timing``): the
+    step-by-step times are the ladder's at h (`_timed_ladder`), the LTI engine's
+    `method_timings`'."""
     names = [t.name for t in problem.methods]
     if not timing:
-        return pd.DataFrame(
-            math.nan, index=names, columns=["wall time [ms]", "LTI engine [ms]", "time / control"]
-        )
+        return pd.DataFrame(math.nan, index=names, columns=TIME_COLUMNS)
+    at_h = convergence[convergence["level"] == 0].set_index("method").reindex(names)
     sys, T, X0, U = problem.system, problem.T, problem.X0, problem.U
-    times = method_timings(sys, T, X0, U, problem.methods, problem.substeps, repeats)
+    lti = method_timings(sys, T, X0, U, problem.methods, problem.substeps, repeats)[
+        "LTI engine [ms]"
+    ]
+    times = pd.DataFrame(
+        {
+            "wall time [ms]": 1e3 * at_h["time"],
+            "wall min [ms]": 1e3 * at_h["time_low"],
+            "wall max [ms]": 1e3 * at_h["time_high"],
+            "CPU time [ms]": 1e3 * at_h["cpu_time"],
+            "LTI engine [ms]": lti,
+        },
+        index=names,
+    )
     times["time / control"] = times["wall time [ms]"] / (1e3 * reference.time)
     return times
 
@@ -891,9 +955,13 @@ def _measure_linear(
         problem.h,
         problem.substeps,
         model,
-        timing=timing,
+        timing=False,  # timed below, every run of the ladder in turns
         progress=progress,
     )
+    if timing:
+        convergence = _timed_ladder(problem, convergence, min(repeats, LADDER_ROUNDS))
+    else:
+        convergence = convergence.assign(time_low=math.nan, time_high=math.nan, cpu_time=math.nan)
     # one road input: the quarter car's transmissibility (a car on several axles
     # needs the speed for its wheelbase delay: qc.transmissibility(model, speed=V))
     one_road = _on_road(problem) and len(model.road_inputs()) == 1
@@ -904,7 +972,7 @@ def _measure_linear(
         modes,
         convergence,
         observed_orders(convergence).to_frame(),
-        _linear_times(problem, reference, repeats, timing),
+        _linear_times(problem, reference, repeats, timing, convergence),
         transmissibility(sys) if one_road and problem.params is not None else None,
     )
 
