@@ -182,7 +182,9 @@ def test_the_measured_problem_matches_python_control_and_an_independent_solve(ca
     assert sol.cost <= pc.cost * (1 + 1e-9)
     ref_cost = float(np.sum((A @ ref.x - b) ** 2))
     assert sol.cost == pytest.approx(ref_cost, rel=1e-6)
-    np.testing.assert_allclose(sol.moves, ref.x, rtol=0, atol=1e-3 * LIMIT)
+    # the plan itself to 1e-6 N (issue 40; measured 3e-12 to 1.2e-11 N: OSQP's
+    # polished solution solves the same active set's equations)
+    np.testing.assert_allclose(sol.moves, ref.x, rtol=0, atol=1e-6)
 
 
 def test_the_measured_problem_equals_the_independent_solve(car):
@@ -191,8 +193,9 @@ def test_the_measured_problem_equals_the_independent_solve(car):
     sol = qc.mpc_controller(car, DT, N, Q=Q, R=R, limits={"fa": LIMIT}).solve(x0)
     A, b = _dense_problem(car, x0)
     ref = lsq_linear(A, b, bounds=(-LIMIT, LIMIT), method="bvls", tol=1e-14)
-    assert np.any(np.abs(ref.x) == LIMIT)  # the limit is active: a real QP
+    assert np.sum(np.abs(ref.x) == LIMIT) >= 10  # the limit binds on most moves: a real QP
     assert sol.cost == pytest.approx(float(np.sum((A @ ref.x - b) ** 2)), rel=1e-6)
+    np.testing.assert_allclose(sol.moves, ref.x, rtol=0, atol=1e-6)  # [N], as above
 
 
 def test_solve_reports_the_plan_cost_and_time(car):
