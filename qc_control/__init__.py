@@ -143,6 +143,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         wk_filter,
         wk_weighted,
     )
+    from .ride.iso2631 import weighted, weighting
     from .ride.metrics import Metric, RideSignals
     from .ride.spectral import (
         ISO8608Road,
@@ -236,6 +237,9 @@ _LAZY: dict[str, str] = {
     "ride_metrics_spectral": "ride.comfort",
     "transmissibility": "ride.comfort",
     "wk_filter": "ride.comfort",
+    # ISO 2631-1's weightings (Annex A): the transfer function, the weighted signal
+    "weighting": "ride.iso2631",
+    "weighted": "ride.iso2631",
     "wk_weighted": "ride.comfort",
     "max_stable_step": "numerics.stability",
     "numerical_modes": "models.modal",
@@ -390,6 +394,8 @@ __all__ = [
     "unregister_model",
     "white_velocity_variances",
     "wk_filter",
+    "weighting",
+    "weighted",
     "wk_weighted",
     "write_report",
     # sampled-data and predictive control
