@@ -65,6 +65,13 @@ def wk(zeta):
     return m[[k for k in m.index if "wk" in k.lower()][0]]
 
 
+def right_zeta_h() -> float:
+    """Euler's ζ_h of body bounce at h = 0.01 s: ln(1 + hλ)/h's damping ratio."""
+    body, _ = modes()
+    lam_h = np.log(1 + 0.01 * body) / 0.01
+    return float(-lam_h.real / abs(lam_h))
+
+
 def right_answers():
     body, _ = modes()
     lam = np.array(modes())
@@ -98,6 +105,8 @@ def wrong_answers():
         (3, (1e-4, 2.0), "a guessed error"),
         (4, -body.real / abs(body), "the exact modal ζ, not Euler's"),
         (4, 0.25, "the nominal ζ"),
+        (4, (-right_zeta_h(), "less"), "a pair with the wrong ζ_h"),
+        (4, (right_zeta_h(), "more"), "Euler's ζ_h is less than the exact ζ"),
         (5, 0.25, "the seed's own ζ"),
         (5, 1 / math.sqrt(2), "the textbook 0.707"),
         (5, 1.0, "critical damping"),
@@ -118,6 +127,17 @@ def test_every_check_accepts_the_right_answer(right, capsys):
     for n, answer in right.items():
         assert check(n, answer) is True, (n, answer)
         assert capsys.readouterr().out.strip() == f"Exercise {n}: correct"
+
+
+def test_exercise_4_takes_both_of_its_answers(right, capsys):
+    """Issue 39 item 13: it asks ζ_h and 'more or less than exact?', and refused
+    the pair it asked for. Euler's ζ_h (0.034) is less than the exact 0.068."""
+    body, _ = modes()
+    assert right[4] < -body.real / abs(body)
+    assert check(4, (right[4], "less")) is True
+    assert check(4, [right[4], " Less"]) is True
+    assert check(4, (right[4], "maybe")) is False
+    assert "give a pair" in capsys.readouterr().out
 
 
 def test_answers_read_off_as_printed_are_accepted(right, capsys):

@@ -212,16 +212,25 @@ def _euler_zeta_h(h: float = 0.01) -> float:
 
 def _judge_4(answer) -> str | None:
     # Closed form or qc.numerical_modes: exact to rounding; 1 % for copying.
+    # The question asks "more or less than exact?" too: a pair (ζ_h, "less")
+    # answers both, and ζ_h alone the first part.
+    body, _ = _upper_modes()
+    exact = -body.real / abs(body)
+    if isinstance(answer, tuple | list):
+        form = '(ζ_h, "less" or "more"), e.g. (0.2, "more")'
+        value, word = _pair(answer, form)
+        value = _number(value, form)
+        if not isinstance(word, str) or word.strip().lower() not in ("less", "more"):
+            raise _WrongType(f"give a pair {form}.")
+        truth = "less" if _euler_zeta_h() < exact else "more"
+        if _near(value, _euler_zeta_h(), 1e-2) and word.strip().lower() != truth:
+            return f"ζ_h is right; compare it with the exact modal ζ = {exact:.4f} again."
+        answer = value
     value = _number(answer)
     if _near(value, _euler_zeta_h(), 1e-2):
         return None
-    body, _ = _upper_modes()
     wrong = [
-        (
-            -body.real / abs(body),
-            1e-2,
-            "that is the exact modal ζ; asked is the ζ_h Euler's step gives.",
-        ),
+        (exact, 1e-2, "that is the exact modal ζ; asked is the ζ_h Euler's step gives."),
         (
             _nominal_zeta(),
             1e-2,
