@@ -103,6 +103,9 @@ sphinx_gallery_conf = {
     "remove_config_comments": True,
     "line_numbers": False,
     "min_reported_time": 1e9,  # machine-dependent times stay out of the pages
+    # nor a page of them: it loads jQuery and DataTables from CDNs, and the site
+    # must work offline
+    "write_computation_times": False,
     # the examples run side by side on a parallel build (sphinx-build -j)
     "parallel": True,
 }

@@ -175,3 +175,48 @@ def test_formulas_render_offline(site, browser, name):  # noqa: F811
     assert verdict["errors"] == 0
     for raw in ("\\frac", "$$", "\\(", "\\[", "\\lambda", "\\sqrt"):
         assert raw not in verdict["text"], f"raw TeX {raw!r} on {name}"
+
+
+def _code_cells(page: Path) -> list[list[str]]:
+    """The lines of each ``{code-cell}`` of a MyST page."""
+    cells, inside = [], None
+    for line in page.read_text(encoding="utf-8").splitlines():
+        if inside is None and line.startswith("```{code-cell}"):
+            inside = []
+        elif inside is not None and line.startswith("```"):
+            cells.append(inside)
+            inside = None
+        elif inside is not None:
+            inside.append(line)
+    return cells
+
+
+def test_a_cell_that_draws_a_figure_shows_it():
+    """Issue 39 item 12: the Roads page's transmissibility figure was missing,
+    its cell ending in ``fig = ...figure()``: a cell shows only its last value.
+    No guide cell ends by assigning a figure it then never shows."""
+    hidden = []
+    for page in sorted((DOCS / "guide").glob("*.md")):
+        for cell in _code_cells(page):
+            code = [ln for ln in cell if ln.strip() and not ln.lstrip().startswith(("#", ":"))]
+            if not code:
+                continue
+            last = code[-1]
+            if re.match(r"\s*\w+\s*=.*(figure\(|subplots\(|_figure\()", last):
+                hidden.append(f"{page.name}: {last.strip()}")
+    assert not hidden, hidden
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("docs")
+def test_the_site_loads_nothing_from_the_internet(site):
+    """Issue 39 item 12: a generated timing page loaded jQuery from a CDN. No page
+    of the built site has a script, style sheet or image from another host."""
+    remote = re.compile(r'<(?:script|link|img)\b[^>]*(?:src|href)="(?:https?:)?//[^"]*"')
+    found = []
+    for page in sorted(site.rglob("*.html")):
+        for tag in remote.findall(page.read_text(encoding="utf-8")):
+            if "<link" in tag and 'rel="canonical"' in tag:
+                continue
+            found.append(f"{page.relative_to(site)}: {tag[:100]}")
+    assert not found, found[:10]
