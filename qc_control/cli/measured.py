@@ -21,7 +21,7 @@ import pandas as pd
 
 from ..report.identification import write_identification_report
 from ..ride.roughness import IRISegments, iri
-from ..studies.identification import PHYSICAL, identify
+from ..studies.identification import DEFAULT_FREE, PHYSICAL, identify
 from ..studies.measurement import Measurement
 from .commands import COMMANDS
 
@@ -74,7 +74,11 @@ def add_measured_commands(sub, tools: CommandTools) -> None:
     ident.add_argument("--fix", metavar="ms=320,...", help="parameters held at known values")
     ident.add_argument("--start", metavar="ks=25000,...", help="start values")
     ident.add_argument(
-        "--free", metavar="NAME,...", help=f"parameters fitted, of {','.join(PHYSICAL)}"
+        "--free",
+        metavar="NAME,...",
+        help=f"parameters fitted, of {','.join(PHYSICAL)} (default {','.join(DEFAULT_FREE)}: "
+        "the tire damping cu stays at its start, 0, unless freed; a rig's tire has some, "
+        "and a fit without it reports intervals marked unreliable)",
     )
     ident.add_argument("--outputs", metavar="LABEL,...", help="outputs fitted (default all)")
     ident.add_argument(

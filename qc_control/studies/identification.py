@@ -534,6 +534,29 @@ def _ratios(table: pd.DataFrame, ms: float) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=columns).set_index("ratio")
 
 
+def _intervals_trusted(table: pd.DataFrame, white: pd.DataFrame, problem: _Problem, notes) -> None:
+    """Mark the intervals unreliable when a residual is not white.
+
+    The 95 % intervals assume residuals that are independent noise; a residual
+    whose autocorrelation leaves the band (`whiteness`) holds what the model
+    cannot represent, and the intervals are then too narrow: the shipped rig
+    record fitted with its tire damping fixed at 0 puts mu at 40.7 kg within
+    [40.62, 40.76] kg, the truth being 45. The table's ``intervals`` column
+    and a note say so, and name the parameters held fixed that could be freed.
+    """
+    coloured = [k for k, row in white.iterrows() if not bool(row["white"])]
+    table["intervals"] = "unreliable" if coloured else "95 %"
+    if not coloured:
+        return
+    held = [n for n in PHYSICAL if n not in problem.free]
+    notes.append(
+        f"the residuals of {', '.join(coloured)} are not white: the model misses something "
+        "the records hold, so the 95 % intervals are too narrow to trust"
+        + (f"; free a parameter held fixed ({', '.join(held)}), " if held else "; ")
+        + "or check the records' units and channels"
+    )
+
+
 def _result(problem: _Problem, solution, pinned_for_scale, notes, covariance=None):
     """The `Identification` of a solved problem; ``covariance`` is ``(cov,
     undetermined)`` when the fit was not this problem's (the frequency domain)."""
@@ -557,6 +580,7 @@ def _result(problem: _Problem, solution, pinned_for_scale, notes, covariance=Non
     whiteness_table = pd.DataFrame(
         white, index=list(problem.outputs), columns=["lags_outside", "white"]
     )
+    _intervals_trusted(table, whiteness_table, problem, notes)
     undetermined_names = [n for n, u in zip(names, undetermined) if u]
     ratios = None
     if pinned_for_scale:
