@@ -190,6 +190,15 @@ def test_bad_arguments_name_the_value():
         qc.identify({"zr": zr})
     with pytest.raises(ValueError, match="no input"):
         qc.identify(qc.Measurement(t, body_acc=np.sin(t)))
+    # issue 39 item 4: accepted before, and fitted
+    with pytest.raises(ValueError, match="free parameter 'ks' is given twice"):
+        qc.identify(m, free=["ks", "ks"])
+    dead = qc.Measurement(t, zr=zr, body_acc=np.sin(t), susp_travel=np.full(t.size, 0.01))
+    with pytest.raises(ValueError, match=r"output 'susp_travel' is constant \(0.01 throughout\)"):
+        qc.identify(dead)
+    for units in ({"zr": 0}, {"zr": float("nan")}):
+        with pytest.raises(ValueError, match="factor to SI of 'zr' must be a finite number other"):
+            qc.Measurement(t, units=units, zr=zr, body_acc=np.sin(t))
 
 
 def test_nrmse_fit_and_whiteness():

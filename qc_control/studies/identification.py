@@ -323,9 +323,11 @@ class Identification:
 
 def _as_names(values: Iterable[str] | None, what: str, allowed: Sequence[str]) -> tuple[str, ...]:
     names = tuple(values or ())
-    for name in names:
+    for i, name in enumerate(names):
         if name not in allowed:
             raise ValueError(f"{what} {name!r} is not one of {', '.join(allowed)}")
+        if name in names[:i]:
+            raise ValueError(f"{what} {name!r} is given twice")
     return names
 
 
@@ -361,6 +363,13 @@ def _setup(measurement, free, fixed, start, gains, outputs) -> tuple[dict, tuple
         raise ValueError(
             f"the measurement has no output the model gives; expected one of {OUTPUT_LABELS}"
         )
+    for k in outs:
+        x = measurement[k]
+        if np.ptp(x) == 0:  # nothing to fit to, and a whiteness test of a constant
+            raise ValueError(
+                f"output {k!r} is constant ({float(x[0]):.6g} throughout): a dead sensor? "
+                "leave it out (outputs=[...], --outputs)"
+            )
     seed = QuarterCarParams()
     base = {n: float(getattr(seed, n)) for n in PHYSICAL}
     if "cu" in free_names:

@@ -12,6 +12,7 @@ uneven (a logger's jitter) is resampled to uniform, with a note.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -110,6 +111,11 @@ def _check_signal(label: str, values, n: int, column: str, first_row: int, t) ->
 
 def _unit_factor(label: str, unit: Any) -> float:
     if isinstance(unit, (int, float)) and not isinstance(unit, bool):
+        # a factor of 0 turns the record into zeros, NaN into NaN: a fit to nothing
+        if not math.isfinite(unit) or unit == 0:
+            raise ValueError(
+                f"the factor to SI of {label!r} must be a finite number other than 0, got {unit!r}"
+            )
         return float(unit)
     if unit not in UNIT_FACTORS:
         raise ValueError(
@@ -228,7 +234,9 @@ class Measurement:
         for label, factor in (scale or {}).items():
             if label not in columns:
                 raise ValueError(f"scale given for {label!r}, which is not among the signals")
-            factors[label] = _unit_factor(label, factors.get(label, 1.0)) * float(factor)
+            factors[label] = _unit_factor(label, factors.get(label, 1.0)) * _unit_factor(
+                label, float(factor)
+            )
         signals = {label: pd.to_numeric(frame[c], errors="coerce") for label, c in columns.items()}
         self = cls.__new__(cls)
         t = pd.to_numeric(frame[time], errors="coerce").to_numpy(dtype=float)
