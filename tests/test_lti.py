@@ -208,3 +208,36 @@ def test_remembered_step_maps_serve_the_right_system_and_cannot_be_changed():
         ours = qc.forced_response(road, h_grid, u, X0)
         generic = qc.forced_response(road, h_grid, u, X0, engine="generic")
         assert rel(ours.states, generic.states) < 1e-12
+
+
+def test_the_numpy_carries_are_the_compiled_loops_bits():
+    """A cold process steps a small sweep's carries with NumPy, loading no numba
+    (issue 40 item 5); the sums are the compiled loop's, in its order: equal to
+    the bit on designs of 4, 6 and 14 states."""
+    from qc_control.numerics.lti import carry_scan_numpy
+    from qc_control.numerics.recurrence import carry_scan
+
+    rng = np.random.default_rng(0)
+    for m, n, S in [(7, 4, 50), (300, 6, 200), (1, 14, 31)]:
+        Q, V = 0.3 * rng.normal(size=(m, n, n)), rng.normal(size=(m, n, S))
+        compiled, plain = V.copy(), V.copy()
+        carry_scan(Q, compiled)
+        carry_scan_numpy(Q, plain)
+        assert np.array_equal(compiled, plain), (m, n, S)
+
+
+def test_a_first_small_sweep_loads_no_numba():
+    code = (
+        "import sys, numpy as np, qc_control as qc\n"
+        "T = np.linspace(0, 5, 2001)\n"
+        "qc.sweep({'ks': [2e4, 3e4]}, T, [0, 0, 0.05, 0], U=None, progress=False)\n"
+        "U = np.where(T > 1, 0.05, 0.0)\n"
+        "qc.sweep({'ks': [2e4, 3e4]}, T, np.zeros(4), U=U, progress=False)\n"
+        "print('numba' in sys.modules)\n"
+    )
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "False"

@@ -22,6 +22,7 @@ over steps or blocks, only over the log2 rounds of the scans.
 from __future__ import annotations
 
 import math
+import sys
 import threading
 import warnings
 from collections import OrderedDict
@@ -265,6 +266,29 @@ def _input_offsets(E, U, N: int, L: int, nb: int) -> np.ndarray:
     padded[:N] = U.T
     windows = padded[np.arange(nb)[:, None] * L + np.arange(L + 1)].reshape(nb, (L + 1) * k)
     return (windows @ E).reshape(E.shape[:-2] + (nb, L, n))
+
+
+#: For a process's first this many design-blocks (designs x blocks of a run), while
+#: numba is not loaded, a stream's carries are stepped with NumPy over the designs,
+#: one block at a time (`carry_scan_numpy`, the same bits as the compiled loop): the
+#: first sweeps of a process then load no numba, 0.3 s of import and cache load, 40x
+#: the warm sweep of a hundred designs. NumPy costs ~0.6 µs a design-block more than
+#: the compiled loop: past this much work (0.3 s more in all) the loop pays its load.
+NUMPY_CARRY_WORK = 500_000
+_numpy_carry_work = 0
+
+
+def carry_scan_numpy(Q: np.ndarray, V: np.ndarray) -> None:
+    """`qc_control.numerics.recurrence.carry_scan` in NumPy, the same sums in the
+    same order: in place, ``V[:, :, b+1] += Q @ V[:, :, b]``, each row's sum taken
+    term by term from the first column, as the compiled loop takes it."""
+    _, n, S = V.shape
+    for b in range(S - 1):
+        v = V[:, :, b]
+        acc = Q[:, :, 0] * v[:, 0, None]
+        for c in range(1, n):
+            acc += Q[:, :, c] * v[:, c, None]
+        V[:, :, b + 1] += acc
 
 
 @one_blas_thread
@@ -584,7 +608,12 @@ class OutputStream:
         V[:, :, 0] = c
         if self._forced:
             V[:, :, 1:] = np.matmul(self._E_mat, self._window(b0, b1))
-        # numba: ~0.5 s to import, needed only by a stream (sweeps)
+        global _numpy_carry_work
+        if "numba" not in sys.modules and _numpy_carry_work < NUMPY_CARRY_WORK:
+            _numpy_carry_work += V.shape[0] * V.shape[2]
+            carry_scan_numpy(self._Q, V)  # a cold process pays no numba for a small sweep
+            return V
+        # numba: ~0.5 s to import, needed only by a long stream
         from .recurrence import carry_scan
 
         carry_scan(self._Q, V)  # c_{b+1} = Q c_b + w_{b+1}, a compiled loop per design

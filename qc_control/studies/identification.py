@@ -553,7 +553,7 @@ def _intervals_trusted(table: pd.DataFrame, white: pd.DataFrame, problem: _Probl
     [40.62, 40.76] kg, the truth being 45. The table's ``intervals`` column
     and a note say so, and name the parameters held fixed that could be freed.
     """
-    coloured = [k for k, row in white.iterrows() if not bool(row["white"])]
+    coloured = [str(k) for k, row in white.iterrows() if not bool(row["white"])]
     table["intervals"] = "unreliable" if coloured else "95 %"
     if not coloured:
         return
