@@ -77,7 +77,7 @@ def test_comfort_optimum_is_the_published_closed_form():
 )
 def test_closed_form_optimum_agrees_with_scipy_on_the_spectral_metric(objective):
     closed = qc.optimal_damping(SEED, objective, road=("C", 20.0))
-    numeric = qc.optimal_damping(SEED, objective, road=("C", 20.0), method="numerical")
+    numeric = qc.optimal_damping(SEED, objective, road=("C", 20.0), solver="numerical")
     assert numeric.method == "scipy.optimize"
     assert math.isclose(closed.cs, numeric.cs, rel_tol=1e-6)
     assert closed.value <= numeric.value * (1 + 1e-12)
@@ -149,7 +149,7 @@ def test_pareto_marks_controllers():
         (lambda: qc.optimal_damping(SEED, "travel"), "no finite"),
         (lambda: qc.optimal_damping(SEED, "speed"), "objective must be one of"),
         (lambda: qc.optimal_damping(SEED, {"comfort": -1.0}), "weight of 'comfort'"),
-        (lambda: qc.optimal_damping(SEED, "comfort_wk", method="closed form"), "no closed form"),
+        (lambda: qc.optimal_damping(SEED, "comfort_wk", solver="closed form"), "no closed form"),
         (lambda: qc.optimal_damping(SEED, travel_limit=-1.0), "travel_limit"),
         (lambda: qc.pareto_front(SEED, objectives=["comfort"]), "two or more"),
         (lambda: qc.pareto_front(SEED, {"cx": [1.0]}), "cx"),
@@ -158,3 +158,12 @@ def test_pareto_marks_controllers():
 def test_bad_input_names_the_parameter(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_the_old_method_keyword_warns_and_means_solver():
+    """Issue 38 item 7: ``method`` names an integration method everywhere else."""
+    with pytest.warns(DeprecationWarning, match=r"use solver=\.\.\."):
+        old = qc.optimal_damping(SEED, "comfort", method="closed form")
+    assert old.cs == qc.optimal_damping(SEED, "comfort", solver="closed form").cs
+    with pytest.raises(ValueError, match="give solver alone"):
+        qc.optimal_damping(SEED, method="numerical", solver="numerical")

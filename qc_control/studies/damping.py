@@ -37,6 +37,7 @@ vehicle other than the quarter car) are minimised by
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -231,8 +232,9 @@ def optimal_damping(
     road=None,
     travel_limit: float | None = None,
     sigmas: float = 1.0,
-    method: str = "auto",
+    solver: str = "auto",
     bounds: tuple[float, float] | None = None,
+    method: str | None = None,
 ) -> DampingOptimum:
     """The passive damping ``cs`` that minimises a ride objective on a random road.
 
@@ -253,12 +255,16 @@ def optimal_damping(
         Rattle space [m]: ``sigmas`` times the RMS travel must stay within it.
     sigmas : float, default 1
         1 for an RMS limit, 3 for a 3σ limit.
-    method : 'auto', 'closed form' or 'numerical'
+    solver : 'auto', 'closed form' or 'numerical'
         ``'auto'`` uses the closed form where one exists (the quarter car,
         any weights without ``comfort_wk``).
     bounds : (float, float), optional
         The numerical search's ``cs`` interval [N·s/m]; default 0.01 to 100
         times the critical damping ``2√(ks·ms)``.
+    method : str, optional
+        Deprecated spelling of ``solver`` (a ``method`` elsewhere in
+        qc_control is an integration method): it warns and is read as
+        ``solver``.
 
     Returns
     -------
@@ -275,8 +281,19 @@ def optimal_damping(
             "travel alone falls monotonically with cs ((ms + mu)/(2 cs)): it has no finite "
             "optimum; weigh it with comfort or road_holding, or give it as travel_limit"
         )
+    if method is not None:
+        if solver != "auto":
+            raise ValueError("method is the old name of solver: give solver alone")
+        warnings.warn(
+            "optimal_damping(method=...) is deprecated and will be removed in the next minor "
+            "release: use solver=... (method names an integration method elsewhere)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        solver = method
+    method = solver
     if method not in ("auto", "closed form", "numerical"):
-        raise ValueError(f"method must be 'auto', 'closed form' or 'numerical', got {method!r}")
+        raise ValueError(f"solver must be 'auto', 'closed form' or 'numerical', got {method!r}")
     sigmas = positive("sigmas", sigmas, "")
     q = _intensity(road)
     model = (
@@ -296,7 +313,7 @@ def optimal_damping(
     if method == "closed form" and not closed:
         raise ValueError(
             "no closed form for this objective or vehicle (Wk weighting, or not a quarter "
-            "car): use method='numerical' or 'auto'"
+            "car): use solver='numerical' or 'auto'"
         )
     use_closed = closed and method != "numerical"
     wk = "comfort_wk" in weights
