@@ -76,7 +76,7 @@ def test_the_summary_findings_and_tables_quote_one_count(seed):
     assert seed.cost_kind.loc[1e-3, "rk4"] == "confirmed"
     assert f"{cost} evaluations" in summary(seed)[-1]
     (line,) = [f for f in findings(seed) if f.startswith("Cheapest to reach 0.001 m")]
-    assert f"about {cost} RHS evaluations (confirmed by a run at that count)" in line
+    assert f"rk4, {cost} RHS evaluations (confirmed by a run at that count)" in line
     (reach,) = [
         b for b in build_blocks(seed) if "RHS evaluations to reach" in getattr(b, "caption", "")
     ]

@@ -28,10 +28,11 @@ def _cheapest(cmp) -> list[str]:
         others = ", ".join(f"{m} {fmt(int(v))}" for m, v in costs.iloc[1:].items())
         tied = [m for m, v in costs.items() if v == costs.iloc[0]]
         who = " and ".join(tied) if len(tied) > 1 else best
+        kind = cmp.cost_kind.loc[tol, best]
         out.append(
-            f"Cheapest to reach {fmt(tol)} m (max |xs error|): {who}, about "
-            f"{fmt(int(costs.iloc[0]))} RHS evaluations "
-            f"({_KIND[cmp.cost_kind.loc[tol, best]]})"
+            f"Cheapest to reach {fmt(tol)} m (max |xs error|): {who}, "
+            + ("" if kind == "confirmed" else "about ")
+            + f"{fmt(int(costs.iloc[0]))} RHS evaluations ({_KIND[kind]})"
             + (f"; the others need {others}." if others else ".")
         )
     return out
