@@ -136,6 +136,7 @@ BAD = [
     (["modes", "--bogus"], "unrecognized arguments: --bogus"),
     ([], "command"),
     (["report", "--out", ""], "the report folder (--out) is empty"),
+    (["report", "--mount-stiffness", "1e6", "--zeta", "0"], "a damper top mount needs a damper"),
     (["report", "--road", "step", "--road-t0", "20"], "--road-t0 20 s is after the run's end"),
     (["report", "--h", "1e-320"], "more than 1.8e308 steps per method"),
     (["report", "--t-end", "1e308", "--h", "1"], "1e+308 steps per method"),

@@ -191,6 +191,11 @@ def test_bad_arguments_name_the_value():
     with pytest.raises(ValueError, match="no input"):
         qc.identify(qc.Measurement(t, body_acc=np.sin(t)))
     # issue 39 item 4: accepted before, and fitted
+    with pytest.raises(ValueError, match="'ms' is both free and fixed"):
+        qc.identify(m, free=["ms", "ks"], fixed={"ms": 300.0})
+    every = {"ms": 300.0, "mu": 40.0, "ks": 2e4, "ku": 2e5, "cs": 1500.0}
+    with pytest.raises(ValueError, match="nothing to fit"):
+        qc.identify(m, fixed=every)
     with pytest.raises(ValueError, match="free parameter 'ks' is given twice"):
         qc.identify(m, free=["ks", "ks"])
     dead = qc.Measurement(t, zr=zr, body_acc=np.sin(t), susp_travel=np.full(t.size, 0.01))

@@ -806,6 +806,13 @@ class Scenario:
             else:
                 extra.append((option.name, checked))
         object.__setattr__(self, "model_options", tuple(extra))
+        if given:
+            # an option valid alone may not fit the vehicle (a top mount needs a damper,
+            # cs > 0): the build says so, and the error is the option's
+            try:
+                self.entry.model(self.vehicle, road=False, **self.option_arguments("build"))
+            except ValueError as exc:
+                raise ScenarioError(str(exc), "scenario", next(iter(given))) from None
 
     def option(self, name: str) -> Any:
         """The value of the model option ``name`` (a `ModelOption` of its entry)."""

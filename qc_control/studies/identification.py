@@ -352,8 +352,13 @@ def _setup(measurement, free, fixed, start, gains, outputs) -> tuple[dict, tuple
     fixed_values = _positive_values(fixed, "fixed")
     start_values = _positive_values(start, "start")
     free_names = _as_names(DEFAULT_FREE if free is None else free, "free parameter", PHYSICAL)
+    both = [n for n in free_names if n in fixed_values] if free is not None else []
+    if both:
+        raise ValueError(f"{both[0]!r} is both free and fixed: give it in one of them")
     free_names = tuple(n for n in free_names if n not in fixed_values)
     gain_names = _as_names(gains, "gain", measurement.inputs)
+    if not free_names and not gain_names:
+        raise ValueError("nothing to fit: every parameter is fixed and no gain is free")
     outs = _as_names(
         [k for k in measurement.outputs if k in OUTPUT_LABELS] if outputs is None else outputs,
         "output",
