@@ -255,6 +255,11 @@ class Measurement:
             frame = pd.read_csv(path, comment="#")
         except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
             raise ValueError(f"cannot read {str(path)!r}: {exc}") from None
+        except UnicodeDecodeError as exc:  # a logger's export in a Windows code page
+            raise ValueError(
+                f"{str(path)!r} is not UTF-8 text (byte {exc.object[exc.start]:#04x} at "
+                f"position {exc.start}): save it as 'CSV UTF-8' and read it again"
+            ) from None
         # the header is line 1 (comment lines are counted only before it)
         skipped = _leading_comments(path)
         return cls.from_frame(
