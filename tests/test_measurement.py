@@ -108,6 +108,6 @@ def test_a_csv_not_in_utf8_names_the_file_and_the_fix(tmp_path):
     """Issue 39 item 14: "'utf-8' codec can't decode byte 0xff" named neither the
     file nor what to do."""
     path = tmp_path / "logger.csv"
-    path.write_bytes("time_s,zr\n0,1\n0.1,2\n".encode() + b"0.2,\xb5\n")  # cp1252's µ
+    path.write_bytes(b"time_s,zr\n0,1\n0.1,2\n0.2,\xb5\n")  # cp1252's µ
     with pytest.raises(ValueError, match=r"logger.csv' is not UTF-8 text .*save it as 'CSV UTF-8'"):
         qc.Measurement.from_csv(path, time="time_s")
