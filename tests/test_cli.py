@@ -136,6 +136,9 @@ BAD = [
     (["modes", "--bogus"], "unrecognized arguments: --bogus"),
     ([], "command"),
     (["report", "--out", ""], "the report folder (--out) is empty"),
+    # a negative value is the option's value, refused for what it is (issue 39 item 14)
+    (["report", "--model", "nonlinear", "--bump-stop", "-0.05,1e5"], "got [-0.05, 100000.0]"),
+    (["report", "--scenario", "stiff", "--model", "half"], "--scenario 'stiff' is a run of"),
     (["report", "--mount-stiffness", "1e6", "--zeta", "0"], "a damper top mount needs a damper"),
     (["report", "--road", "step", "--road-t0", "20"], "--road-t0 20 s is after the run's end"),
     (["report", "--h", "1e-320"], "more than 1.8e308 steps per method"),

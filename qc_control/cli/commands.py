@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import functools
+import re
 import sys
 from importlib.metadata import version
 from typing import Any
@@ -49,7 +50,19 @@ class UsageError(Exception):
 
 class CommandParser(argparse.ArgumentParser):
     """An argument parser whose complaint is a `UsageError` (one line), not
-    argparse's usage block and exit."""
+    argparse's usage block and exit.
+
+    A value such as ``-0.05,1e5`` (``--bump-stop``'s gap and stiffness) or
+    ``-1e-3`` is a value, not an option: argparse takes only ``-5`` and ``-.5``
+    for numbers, and read ``--bump-stop -0.05,1e5`` as a missing argument.
+    """
+
+    #: A negative number, or a comma-separated list starting with one.
+    _NEGATIVE = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(,[-+]?[\d.eE+-]+)*$")
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = self._NEGATIVE
 
     def error(self, message):
         raise UsageError(message)

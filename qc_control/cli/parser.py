@@ -484,9 +484,15 @@ def _in_options(exc, doc: dict, spelled: Mapping[str, str]) -> str:
     return str(exc)
 
 
+#: ``[scenario]`` keys whose option is spelt otherwise (``kind`` is ``--scenario``).
+_OPTION_OF = {"kind": "--scenario"}
+
+
 def _run_option(key: str) -> str:
     """The option of a ``[scenario]`` key: ``--t-end``, or a model option's flag
     (``--no-events``) when the option is a boolean one."""
+    if key in _OPTION_OF:
+        return _OPTION_OF[key]
     flags = [o for e in MODELS.values() for o in e.options if o.name == key]
     if flags and isinstance(flags[0].default, bool):
         return option_flag(key, flags[0].default)
