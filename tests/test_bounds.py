@@ -6,13 +6,13 @@ Each refusal is `ResourceLimitError` (a ValueError) from
 The expected counts are closed forms (the product of the axes' lengths, the
 intervals of T times the substeps), not the code's own output. The limit is
 fixed through ``QC_CONTROL_MAX_MEMORY`` so that the boundary does not depend
-on the machine; every refusal must come before any large allocation, so each
-test finishes in milliseconds (a time bound of 1 s is asserted: the grids
-used to run 39 s into a bare MemoryError).
+on the machine; every refusal must come before any large allocation (the
+grids used to run 39 s into a bare MemoryError): what the refused call
+allocates is measured with tracemalloc, never its time.
 """
 
 import itertools
-import time
+import tracemalloc
 
 import control
 import numpy as np
@@ -39,17 +39,30 @@ def limit_16g(monkeypatch):
     monkeypatch.setenv(limits.ENV_VAR, "16G")
 
 
+#: What a refusal may allocate [bytes]: the refused runs need TiB, and building
+#: their grids first (as before the checks) took GBs; the check's own arrays (a
+#: grid's axes, T) are kilobytes. 64 MB leaves room for a first call's caches.
+REFUSAL_BYTES = 64 * 2**20
+
+
 def refused_quickly(call, *words):
-    """``call()`` raises ResourceLimitError within 1 s, its message holding ``words``."""
-    start = time.perf_counter()
-    with pytest.raises(limits.ResourceLimitError) as err:
-        call()
-    elapsed = time.perf_counter() - start
+    """``call()`` raises ResourceLimitError, its message holding ``words``, having
+    allocated less than `REFUSAL_BYTES` (tracemalloc's peak, which NumPy's
+    arrays report to): the count was refused before the run was built."""
+    with pytest.raises(limits.ResourceLimitError):
+        call()  # once untraced: imports and caches a first call makes
+    tracemalloc.start()
+    try:
+        with pytest.raises(limits.ResourceLimitError) as err:
+            call()
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
     text = str(err.value)
     for word in words:
         assert word in text, text
     assert "QC_CONTROL_MAX_MEMORY=16G" in text and "TiB" in text
-    assert elapsed < 1.0, f"refused after {elapsed:.2f} s: the grid was built first"
+    assert peak < REFUSAL_BYTES, f"allocated {peak / 2**20:.0f} MB before refusing"
     return text
 
 
