@@ -236,18 +236,27 @@ def weighted(acc, T, name: str) -> np.ndarray:
     bad = np.argwhere(~np.isfinite(a))
     if bad.size:
         raise ValueError(f"acc is not finite at sample {int(bad[0, -1])}")
-    dt = uniform_step(T)
-    if dt is None:
-        raise ValueError(f"T must be uniform for the ISO 2631 weighting {key}")
+    dt = _uniform(T, key)
     top = _band_top(key)
     if 1 / (2 * dt) < top:
         raise ValueError(
             f"dt = {dt:g} s is too coarse for {key}: its band reaches {top:g} Hz, so the "
             f"samples must be at most {1 / (2 * top):g} s apart"
         )
+    return _convolved(key, a, T, dt).reshape(np.shape(acc))
+
+
+def _uniform(T: np.ndarray, key: str) -> float:
+    dt = uniform_step(T)
+    if dt is None:
+        raise ValueError(f"T must be uniform for the ISO 2631 weighting {key}")
+    return dt
+
+
+def _convolved(key: str, a: np.ndarray, T: np.ndarray, dt: float) -> np.ndarray:
+    """``(m, N)`` signals weighted by ``key``: `_impulse`'s convolution."""
     h, v = _impulse(key, round(dt, 15), T.size)
-    out = scipy.signal.oaconvolve(a, h[None, :], axes=-1)[:, : T.size] + a[:, :1] * v
-    return out.reshape(np.shape(acc))
+    return scipy.signal.oaconvolve(a, h[None, :], axes=-1)[:, : T.size] + a[:, :1] * v
 
 
 def wk_weighted(acc, T) -> np.ndarray:
@@ -260,9 +269,4 @@ def wk_weighted(acc, T) -> np.ndarray:
     """
     T = np.asarray(T, dtype=float)
     a = np.atleast_2d(np.asarray(acc, dtype=float))
-    dt = uniform_step(T)
-    if dt is None:
-        raise ValueError("T must be uniform for the ISO 2631 weighting")
-    h, v = _impulse("Wk", round(dt, 15), T.size)
-    out = scipy.signal.oaconvolve(a, h[None, :], axes=-1)[:, : T.size] + a[:, :1] * v
-    return out.reshape(np.shape(acc))
+    return _convolved("Wk", a, T, _uniform(T, "Wk")).reshape(np.shape(acc))

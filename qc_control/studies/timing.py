@@ -154,13 +154,10 @@ def same_work(table) -> list[SameWork]:
         for b in names[i + 1 :]:
             if rows.at[a, "RHS evals"] != rows.at[b, "RHS evals"]:
                 continue
-            ta, tb = (
-                Timing(rows.at[m, "wall time [ms]"] / 1e3, rows.at[m, "wall min [ms]"] / 1e3,
-                       rows.at[m, "wall max [ms]"] / 1e3, float("nan"), 0)
-                for m in (a, b)
-            )  # fmt: skip
-            found.append(
-                SameWork(a, b, int(rows.at[a, "RHS evals"]), (ta.wall, tb.wall),
-                         ta.indistinguishable_from(tb))
-            )  # fmt: skip
+            low, high, wall = (
+                rows[c] for c in ("wall min [ms]", "wall max [ms]", "wall time [ms]")
+            )
+            noise = bool(low[a] <= high[b] and low[b] <= high[a])  # as `indistinguishable_from`
+            times = (float(wall[a]) / 1e3, float(wall[b]) / 1e3)
+            found.append(SameWork(a, b, int(rows.at[a, "RHS evals"]), times, noise))
     return found
