@@ -145,9 +145,8 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     )
     from .ride.iso2631 import weighted, weighting
     from .ride.metrics import Metric, RideSignals
+    from .ride.road import ISO8608Road, iso8608_intensity
     from .ride.spectral import (
-        ISO8608Road,
-        iso8608_intensity,
         lyapunov_variances,
         white_velocity_variances,
     )
@@ -253,8 +252,8 @@ _LAZY: dict[str, str] = {
     "spectral": "ride.spectral",
     "lyapunov_variances": "ride.spectral",
     "white_velocity_variances": "ride.spectral",
-    "iso8608_intensity": "ride.spectral",
-    "ISO8608Road": "ride.spectral",
+    "iso8608_intensity": "ride.road",
+    "ISO8608Road": "ride.road",
     "HalfCarParams": "models.halfcar",
     "FullCarParams": "models.halfcar",
     "half_car": "models.halfcar",

@@ -147,14 +147,17 @@ BAD = [
     (["report", "--t-end", "1e4", "--h", "0.01", "--max-steps", "1000"], "max_steps = 1,000"),
     (
         ["report", "--road", "iso8608", "--seed", "-1"],
-        "--seed must be a non-negative integer, got -1",
+        "--seed must be a whole number >= 0, got -1",
     ),
     (["report", "--seed", "-1"], "--seed -1 does not apply without a road"),
     (["report", "--road", "bump", "--seed", "3"], "--seed 3 does not apply to a bump road"),
     (["report", "--road-height", "0.1"], "--road-height 0.1 does not apply without a road"),
     (["report", "--road", "wobble"], "--road must be one of step, bump, sine, iso8608 or none"),
     (["report", "--road", "iso8608", "--h", "0.01"], "--h 0.01 s is too coarse for an ISO 8608"),
-    (["report", "--road", "iso8608", "--road-class", "Z"], "unknown ISO 8608 road class 'Z'"),
+    (
+        ["report", "--road", "iso8608", "--road-class", "Z"],
+        "--road-class must be an ISO 8608 class, one of A, B, C, D, E, F, G, H, got 'Z'",
+    ),
     # found by tests/test_properties.py: 1/(20 × 1e308 Hz) underflows to a 0 s limit, whose
     # log10 was a math domain error (an internal error) when the default step was lowered
     (["report", "--road", "sine", "--road-frequency", "1e308"], "<= 0 s (give a lower freq"),
@@ -216,7 +219,7 @@ def test_bad_input_one_line_exit_2(files, monkeypatch, args, words, capsys):
 def test_bad_input_via_real_process(files):
     out = run("report", "--road", "iso8608", "--seed", "-1")
     assert out.returncode == 2 and out.stdout == ""
-    assert out.stderr == ("qc-control: error: --seed must be a non-negative integer, got -1\n")
+    assert out.stderr == ("qc-control: error: --seed must be a whole number >= 0, got -1\n")
 
 
 def test_unwritable_out_is_refused_before_computing(files, monkeypatch, capsys):

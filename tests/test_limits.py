@@ -54,7 +54,7 @@ def test_iso8608_work_follows_the_span_not_the_smallest_gap(monkeypatch):
 
 
 def test_negative_seed_is_named():
-    with pytest.raises(ValueError, match="seed must be a non-negative integer, got -1"):
+    with pytest.raises(ValueError, match="seed must be a whole number >= 0, got -1"):
         road.iso8608(np.linspace(0, 1, 201), "C", seed=-1)
 
 

@@ -145,8 +145,8 @@ def test_cli_report_of_a_step_at_the_end(options, pictures, tmp_path, capsys, mo
 
 def test_jumps_of_the_roads():
     """A step jumps at t0; a bump, a sine road and no road are continuous."""
-    assert StepRoad(t0=0.3).jumps() == (0.3,)
-    assert BumpRoad().jumps() == SineRoad().jumps() == ()
+    assert StepRoad(t0=0.3).jumps == (0.3,)
+    assert BumpRoad().jumps == SineRoad().jumps == ()
     sc = Scenario(model="nonlinear", road=StepRoad(t0=0.3), t_end=1.0)
     assert sc.vehicle_model(road=True).system.jumps == (0.3,)
     assert qc.nonlinear_quarter_car().jumps == qc.nonlinear_quarter_car(road=False).jumps == ()

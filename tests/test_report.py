@@ -296,7 +296,10 @@ def test_road_report_has_the_ride_section(tmp_path, capsys):
     "args, words",
     [
         (["--road", "gravel"], "--road must be one of step, bump, sine, iso8608"),
-        (["--road", "iso8608", "--road-class", "Z"], "unknown ISO 8608 road class 'Z'"),
+        (
+            ["--road", "iso8608", "--road-class", "Z"],
+            "--road-class must be an ISO 8608 class, one of A, B, C, D, E, F, G, H, got 'Z'",
+        ),
         (["--road", "iso8608", "--speed", "-3"], "--speed must be a finite number > 0 m/s"),
         (["--road", "iso8608", "--h", "0.01"], "too coarse for an ISO 8608 road at 20 m/s"),
         (["--road", "step", "--road-class", "B"], "--road-class 'B' does not apply to a step road"),

@@ -132,7 +132,10 @@ def test_bad_inputs():
     )
     with pytest.raises(ValueError, match="must be uniform"):
         ride_metrics(uneven)
-    with pytest.raises(ValueError, match="unknown ISO 8608 road class 'Q'"):
+    with pytest.raises(
+        ValueError,
+        match="road_class must be an ISO 8608 class, one of A, B, C, D, E, F, G, H, got 'Q'",
+    ):
         ride_metrics_spectral(None, "Q")
     with pytest.raises(ValueError, match="speed must be a finite number > 0 m/s, got 0.0"):
         ride_metrics_spectral(None, "C", speed=0.0)

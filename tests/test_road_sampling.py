@@ -11,14 +11,8 @@ import numpy as np
 import pytest
 
 from qc_control.cli import parser
-from qc_control.cli.scenario import (
-    BUMP_STEPS,
-    SINE_STEPS,
-    BumpRoad,
-    Scenario,
-    ScenarioError,
-    SineRoad,
-)
+from qc_control.cli.scenario import BumpRoad, Scenario, ScenarioError, SineRoad
+from qc_control.ride.road import BUMP_STEPS, SINE_STEPS
 
 SHORT_BUMP = {"kind": "bump", "length": 0.05, "speed": 30.0}  # 1.67 ms long
 FAST_SINE = {"kind": "sine", "frequency": 80.0}  # above the 50 Hz Nyquist limit of h = 10 ms

@@ -69,22 +69,25 @@ BAD = [
     (dict(x0=[1, 2]), "[scenario] x0 must be 4 comma-separated numbers, all finite: vs, vu"),
     (dict(x0=[0, 0, math.inf, 0]), "x0 must be 4 comma-separated numbers"),
     (dict(x0="0,0,a,0"), "vs, vu, xs, xu [m/s, m/s, m, m]; got '0,0,a,0'"),
-    (dict(road=5), "[scenario] road must be a Road"),
+    (dict(road=5), "[scenario] road must be a qc_control.road.Road"),
     (dict(road={"kind": "wobble"}), "kind must be one of step, bump, sine, iso8608 or none, got"),
     (
         dict(road={"kind": "iso8608", "seed": -1}),
-        "[scenario.road] seed must be a non-negative integer, got -1",
+        "[scenario.road] seed must be a whole number >= 0, got -1",
     ),
-    (dict(road={"kind": "iso8608", "seed": 1.5}), "seed must be a non-negative integer, got 1.5"),
+    (dict(road={"kind": "iso8608", "seed": 1.5}), "seed must be a whole number >= 0, got 1.5"),
     (
         dict(road={"kind": "iso8608", "road_class": "Z"}),
-        "unknown ISO 8608 road class 'Z'; expected one of A, B",
+        "road_class must be an ISO 8608 class, one of A, B",
     ),
-    (dict(road={"kind": "iso8608", "band": [3, 1]}), "band must be [n_min, n_max] in cycles/m"),
+    (
+        dict(road={"kind": "iso8608", "band": [3, 1]}),
+        "band must be (n_min, n_max) with 0 < n_min < n_max cycles/m",
+    ),
     (dict(road={"kind": "bump", "length": 0}), "length must be a finite number > 0 m, got 0"),
     (dict(road={"kind": "bump", "speed": -1}), "speed must be a finite number > 0 m/s, got -1"),
     (dict(road={"kind": "sine", "frequency": 0}), "frequency must be a finite number > 0 Hz"),
-    (dict(road={"kind": "step", "height": "x"}), "height must be a finite number [m], got 'x'"),
+    (dict(road={"kind": "step", "height": "x"}), "height must be a finite number m, got 'x'"),
     (
         dict(road={"kind": "iso8608", "height": 0.1}),
         "height = 0.1 does not apply to an iso8608 road: it is a parameter of step and bump",
@@ -419,7 +422,7 @@ def test_run_is_compare_methods_on_the_scenario():
 
 
 def test_every_kind_is_registered():
-    assert set(ROADS) == {"none", "step", "bump", "sine", "iso8608"}
+    assert set(ROADS) == {"none", "step", "bump", "sine", "iso8608", "profile"}
     assert all(cls.kind == kind for kind, cls in ROADS.items())
 
 

@@ -134,7 +134,10 @@ def test_iso8608_intensity():
     """q = 2π² n0² Gd(n0) v: class C (Gd(n0) = 256e-6 m³), n0 = 0.1, 20 m/s."""
     assert iso8608_intensity("C", 20.0) == pytest.approx(2 * math.pi**2 * 0.01 * 256e-6 * 20)
     assert iso8608_intensity(256e-6, 20.0) == iso8608_intensity("c", 20.0)
-    with pytest.raises(ValueError, match="unknown ISO 8608 road class 'Z'"):
+    with pytest.raises(
+        ValueError,
+        match="road_class must be an ISO 8608 class, one of A, B, C, D, E, F, G, H, got 'Z'",
+    ):
         iso8608_intensity("Z", 20.0)
     with pytest.raises(ValueError, match="speed must be a finite number > 0 m/s, got -1"):
         iso8608_intensity("C", -1)

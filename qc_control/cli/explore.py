@@ -41,7 +41,7 @@ from ..numerics.methods import TABLEAUS
 from ..numerics.stability import stability_boundary
 from ..studies.compare import DEFAULT_METHODS
 from ..studies.quick import QuickComparison, error_ladder, ladder_steps, quick_comparison
-from .scenario import MAX_STEPS, ROADS, Scenario, ScenarioError, road_from_mapping, whole_step
+from .scenario import CLI_ROADS, MAX_STEPS, Scenario, ScenarioError, road_from_mapping, whole_step
 
 __all__ = [
     "explorer",
@@ -103,7 +103,7 @@ def _panel():
 def _road_fields() -> dict[str, Any]:
     """Every road parameter of every kind, once, with the kinds that take it."""
     found: dict[str, Any] = {}
-    for kind, cls in ROADS.items():
+    for kind, cls in CLI_ROADS.items():
         for f in dataclasses.fields(cls):
             if f.name != "band":  # the ISO band: a setting for specialists, left at its default
                 found.setdefault(f.name, (f, []))[1].append(kind)
@@ -610,7 +610,7 @@ def _widgets(pn, values: dict[str, Any]) -> dict[str, Any]:
         "vu0": W.FloatInput(name="vu [m/s]", value=values["vu0"], width=120),
         "xs0": W.FloatInput(name="xs [m]", value=values["xs0"], width=120),
         "xu0": W.FloatInput(name="xu [m]", value=values["xu0"], width=120),
-        "road": W.Select(name="road", options=list(ROADS), value=values["road"]),
+        "road": W.Select(name="road", options=list(CLI_ROADS), value=values["road"]),
         "output": W.Select(
             name="output",
             options=["xs", "xu", "susp_travel", "tire_defl", "body_acc"],

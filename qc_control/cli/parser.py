@@ -35,8 +35,8 @@ from .commands import COMMANDS, PROG, UsageError, error_line, top_level
 from .measured import CommandTools as _CommandTools
 from .measured import add_measured_commands
 from .scenario import (
+    CLI_ROADS,
     DEFAULT_MODEL,
-    ROADS,
     Scenario,
     ScenarioError,
     command_line,
@@ -166,10 +166,10 @@ def _add_road(parser: argparse.ArgumentParser) -> None:
         "--road",
         dest="road_kind",
         metavar="KIND",
-        help=f"{', '.join(ROADS)}; under a road the car starts at rest unless --x0 is given",
+        help=f"{', '.join(CLI_ROADS)}; under a road the car starts at rest unless --x0 is given",
     )
     options: dict[str, list] = {}
-    for kind, cls in ROADS.items():
+    for kind, cls in CLI_ROADS.items():
         for f in fields(cls):
             options.setdefault(road_option(f), []).append((kind, f))
     types: dict[str, Callable[[str], Any]] = {
@@ -432,7 +432,7 @@ def _road_options(args: argparse.Namespace) -> tuple[dict[str, Any], dict[str, s
     """
     road = {"kind": args.road_kind} if getattr(args, "road_kind", None) is not None else {}
     spelled = {"kind": "--road"} if road else {}
-    for cls in ROADS.values():
+    for cls in CLI_ROADS.values():
         for f in fields(cls):
             value = getattr(args, f"road_{f.name}", None)
             if value is not None:

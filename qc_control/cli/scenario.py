@@ -47,7 +47,6 @@ and ``bump_length``) are read for one more release, each with a
 
 from __future__ import annotations
 
-import functools
 import inspect
 import json
 import math
@@ -59,7 +58,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
 from types import FrameType
-from typing import Any, ClassVar, cast
+from typing import Any, cast
 
 import control
 import numpy as np
@@ -68,10 +67,11 @@ from ..models.quarter import QuarterCarParams
 from ..models.registry import MODELS, ModelEntry, get_model, model_for_params, parameter_keys
 from ..models.vehicle import VehicleModel
 from ..numerics import methods as catalogue
+from ..numerics.checks import ParameterError
 from ..numerics.methods import METHODS, get_method
 from ..numerics.stability import max_stable_step
-from ..ride import road as roads
-from ..ride.spectral import ISO8608Road, road_parameter
+from ..numerics.steps import preferred_step, whole_step
+from ..ride.road import ROADS, Bump, ISO8608Road, NoRoad, Profile, Road, Sine, Step
 from ..studies.compare import DEFAULT_METHODS, MethodComparison, compare_methods
 from ..studies.peers import check_solvers
 from ..studies.scenarios import POTHOLE, STIFF_CAR, stiff_car_methods, stiff_car_ride_cost
@@ -93,6 +93,7 @@ __all__ = [
     "SineRoad",
     "ISO8608Road",
     "ROADS",
+    "CLI_ROADS",
     "RoadSpec",
     "MAX_STEPS",
     "MAX_CONFIG_BYTES",
@@ -171,208 +172,21 @@ def _number(section: str, key: str, value, unit: str, *, positive: bool) -> floa
     return float(value)
 
 
-def _length(metres: float) -> str:
-    """A road height for a sentence: '10 cm', '1.5 m'."""
-    return f"{metres * 100:.4g} cm" if abs(metres) < 1 else f"{metres:.4g} m"
-
-
 # ---------------------------------------------------------------- roads
 
 
 _ROAD_SECTION = "scenario.road"
 
+# The road kinds are the ride layer's (`qc_control.road`); the command line's
+# earlier names for them stay as aliases.
+StepRoad, BumpRoad, SineRoad = Step, Bump, Sine
 
-def _road_value(f, value):
-    """A road parameter's value, checked by its kind of check, or a ScenarioError."""
-    check, unit, key = f.metadata["check"], f.metadata["unit"], f.name
-    return _number(_ROAD_SECTION, key, value, unit, positive=check == "positive")
+#: The roads a scenario's TOML and the command line take by ``kind``: every
+#: kind whose parameters are numbers (a `Profile`'s arrays are given in Python).
+CLI_ROADS: dict[str, type[Road]] = {k: c for k, c in ROADS.items() if c is not Profile}
 
-
-#: Help of the parameters that step and bump share.
-_HEIGHT, _T0 = "step or bump height", "time the step or bump starts"
-
-
-@dataclass(frozen=True)
-class Road:
-    """Base of the road specs: the kind of road and all its parameters.
-
-    Each kind is a frozen dataclass whose fields are its parameters, named
-    as the keyword arguments of its function in `qc_control.ride.road`, with
-    that function's defaults. `ROADS` maps each ``kind`` to its class.
-    """
-
-    kind: ClassVar[str] = "none"
-    #: The road in a sentence's words: "a bump road".
-    noun: ClassVar[str] = "no road"
-
-    def __post_init__(self):
-        for f in fields(self):
-            object.__setattr__(self, f.name, _road_value(f, getattr(self, f.name)))
-
-    def params(self) -> dict[str, Any]:
-        """The parameters as a dict, in field order (without ``kind``)."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
-
-    def samples(self, T) -> np.ndarray | None:
-        """The road height zr [m] on the time grid ``T`` [s]; None for no road."""
-        return None
-
-    def height_at(self, t: float) -> float:
-        """The road height zr [m] at one time ``t`` [s]: the number `samples` gives at ``t``.
-
-        The nonlinear car reads its road as a function of time at each stage of
-        every step and of its reference's solve (about 200,000 times a report);
-        the kinds of road write theirs out as one number's arithmetic,
-        operation for operation as their `samples` (tests/test_reference_road_step.py
-        checks each to the last bit). This fallback samples a grid of two times
-        (`qc_control.ride.road`'s functions take at least two).
-        """
-        return float(np.asarray(self.samples(np.array([t, t + 1.0])))[0])
-
-    def describe(self) -> str:
-        """The road in words, from its actual parameters; '' for no road."""
-        return ""
-
-    def largest_step(self) -> float:
-        """The largest time step [s] that samples this road; inf if any step does."""
-        return math.inf
-
-    def jumps(self) -> tuple[float, ...]:
-        """The times [s] where the road height jumps; () for a continuous road."""
-        return ()
-
-    def sampled(self) -> str:
-        """What `largest_step` samples, in words."""
-        return self.noun
-
-
-@dataclass(frozen=True)
-class NoRoad(Road):
-    """No road input: the free response from ``x0``."""
-
-
-@dataclass(frozen=True)
-class StepRoad(Road):
-    """A road step (a kerb), `qc_control.ride.road.step`."""
-
-    kind: ClassVar[str] = "step"
-    noun: ClassVar[str] = "a step road"
-    height: float = road_parameter(_default(roads.step, "height"), "finite", "m", _HEIGHT)
-    t0: float = road_parameter(_default(roads.step, "t0"), "finite", "s", _T0)
-
-    def samples(self, T) -> np.ndarray:
-        return roads.step(T, height=self.height, t0=self.t0)
-
-    def height_at(self, t: float) -> float:
-        return self.height if t >= self.t0 else 0.0
-
-    def describe(self) -> str:
-        return f"a {_length(self.height)} road step at t = {self.t0:g} s"
-
-    def jumps(self) -> tuple[float, ...]:
-        return (self.t0,)
-
-
-#: One speed default for every road that has a speed: `qc_control.ride.road.iso8608`'s.
-_SPEED = _default(roads.iso8608, "speed")
-
-
-#: The fewest steps a bump may span: a 1 − cos pulse over fewer falls between
-#: the samples (0.05 m at 30 m/s lasts 1.7 ms: at h = 10 ms every method saw
-#: no bump at all). Four steps put three samples on it.
-BUMP_STEPS = 4
-#: The fewest steps per period of a sine road: ten, a fifth of the Nyquist
-#: frequency 1/(2h). At the Nyquist frequency itself the samples can all be
-#: zero; at a fifth of it linear interpolation between them is within 5 % of
-#: the amplitude (1 − cos(π/10)), where the methods' stages read the input.
-SINE_STEPS = 10
-
-
-@dataclass(frozen=True)
-class BumpRoad(Road):
-    """A 1 − cos bump, `qc_control.ride.road.bump`.
-
-    Its speed defaults to the ISO 8608 road's (`qc_control.ride.road.iso8608`),
-    so that every road with a speed has the same default; `road.bump`'s own
-    default is not used.
-    """
-
-    kind: ClassVar[str] = "bump"
-    noun: ClassVar[str] = "a bump road"
-    height: float = road_parameter(_default(roads.bump, "height"), "finite", "m", _HEIGHT)
-    length: float = road_parameter(_default(roads.bump, "length"), "positive", "m", "bump length")
-    speed: float = road_parameter(_SPEED, "positive", "m/s", "vehicle speed", "--speed")
-    t0: float = road_parameter(_default(roads.bump, "t0"), "finite", "s", _T0)
-
-    def samples(self, T) -> np.ndarray:
-        return roads.bump(T, height=self.height, length=self.length, speed=self.speed, t0=self.t0)
-
-    def height_at(self, t: float) -> float:
-        x = self.speed * (t - self.t0)
-        if not 0 <= x <= self.length:
-            return 0.0
-        return float(0.5 * self.height * (1 - np.cos(2 * np.pi * x / self.length)))
-
-    def describe(self) -> str:
-        return (
-            f"a {_length(self.height)} high, {self.length:g} m long 1 − cos bump "
-            f"met at t = {self.t0:g} s at {self.speed:g} m/s"
-        )
-
-    def largest_step(self) -> float:
-        """The bump's duration length/speed over `BUMP_STEPS`."""
-        return self.length / self.speed / BUMP_STEPS
-
-    def sampled(self) -> str:
-        return (
-            f"a {self.length:g} m bump at {self.speed:g} m/s, which lasts "
-            f"{1e3 * self.length / self.speed:.3g} ms and needs {BUMP_STEPS} steps across it"
-        )
-
-
-@dataclass(frozen=True)
-class SineRoad(Road):
-    """A sinusoidal road ``zr = amplitude · sin(2π f t)``, `qc_control.ride.road.sine`."""
-
-    kind: ClassVar[str] = "sine"
-    noun: ClassVar[str] = "a sine road"
-    amplitude: float = road_parameter(
-        _default(roads.sine, "amplitude"), "finite", "m", "sine amplitude"
-    )
-    frequency: float = road_parameter(
-        _default(roads.sine, "frequency"), "positive", "Hz", "sine frequency"
-    )
-
-    def samples(self, T) -> np.ndarray:
-        return roads.sine(T, amplitude=self.amplitude, frequency=self.frequency)
-
-    def height_at(self, t: float) -> float:
-        return float(self.amplitude * np.sin(2 * np.pi * self.frequency * t))
-
-    def describe(self) -> str:
-        return f"a sinusoidal road, {_length(self.amplitude)} amplitude at {self.frequency:g} Hz"
-
-    def largest_step(self) -> float:
-        """One period over `SINE_STEPS`: a fifth of the Nyquist frequency 1/(2h)."""
-        return 1.0 / (self.frequency * SINE_STEPS)
-
-    def sampled(self) -> str:
-        return (
-            f"a {self.frequency:g} Hz sine road, which needs {SINE_STEPS} steps per period "
-            f"(at most a fifth of the Nyquist frequency 1/(2h))"
-        )
-
-
-#: Every kind of road, by its ``kind``. The ISO 8608 road is the ride layer's
-#: (`qc_control.ride.spectral.ISO8608Road`): one class for the Scenario's
-#: sampled road and for the spectral sweep's white road velocity.
-ROADS: dict[str, type[Road] | type[ISO8608Road]] = {
-    cls.kind: cls for cls in (NoRoad, StepRoad, BumpRoad, SineRoad, ISO8608Road)
-}
-
-
-#: A road spec: one of `ROADS`' classes.
-RoadSpec = Road | ISO8608Road
+#: A road spec: a `qc_control.road.Road`.
+RoadSpec = Road
 
 
 def road_option(f) -> str:
@@ -389,14 +203,14 @@ def road_from_mapping(values: Mapping[str, Any]) -> RoadSpec:
     """
     values = dict(values)
     kind = values.pop("kind", "none")
-    if not isinstance(kind, str) or kind.lower() not in ROADS:
-        kinds = [k for k in ROADS if k != NoRoad.kind]
+    if not isinstance(kind, str) or kind.lower() not in CLI_ROADS:
+        kinds = [k for k in CLI_ROADS if k != NoRoad.kind]
         raise ScenarioError(
             f"kind must be one of {', '.join(kinds)} or {NoRoad.kind}, got {kind!r}",
             _ROAD_SECTION,
             "kind",
         )
-    cls = ROADS[kind.lower()]
+    cls = CLI_ROADS[kind.lower()]
     allowed = [f.name for f in fields(cls)]
     takes = (
         f"{cls.noun} takes {', '.join(allowed)}"
@@ -406,7 +220,7 @@ def road_from_mapping(values: Mapping[str, Any]) -> RoadSpec:
     for key, value in values.items():
         if key in allowed:
             continue
-        users = [k for k, c in ROADS.items() if key in {f.name for f in fields(c)}]
+        users = [k for k, c in CLI_ROADS.items() if key in {f.name for f in fields(c)}]
         if users:
             where = "without a road" if cls is NoRoad else f"to {cls.noun}"
             raise ScenarioError(
@@ -418,11 +232,8 @@ def road_from_mapping(values: Mapping[str, Any]) -> RoadSpec:
         raise ScenarioError(f"unknown [scenario.road] key {key!r}; {takes}", None, key)
     try:
         return cls(**values)
-    except ScenarioError:
-        raise
-    except ValueError as exc:  # the ride layer's road: its message starts with the name
-        culprit = next((k for k in allowed if str(exc).startswith(k + " ")), None)
-        raise ScenarioError(str(exc), _ROAD_SECTION, culprit) from None
+    except ParameterError as exc:
+        raise ScenarioError(str(exc), _ROAD_SECTION, exc.name) from None
 
 
 # ------------------------------------------------------------- scenario
@@ -528,27 +339,11 @@ def _culprit(values: Mapping, cls: type) -> str | None:
 _STABLE_DEFAULT_SPAN = 10.0
 
 
-def _coarse_remedy(road, limit: float) -> str:
+def _coarse_remedy(road: Road, limit: float) -> str:
     """What to change when the road is too fine for the grid: h, or the road
     alone when its ``limit`` underflowed to 0 s (a 1e308 Hz sine), which no h meets."""
-    if isinstance(road, BumpRoad):
-        road_change = "a longer bump or a lower speed"
-    elif isinstance(road, SineRoad):
-        road_change = "a lower frequency"
-    else:
-        return "give a smaller h, or narrow the band" if limit > 0 else "narrow the band"
+    road_change = road.finer or "a coarser road"
     return f"give a smaller h, or {road_change}" if limit > 0 else f"give {road_change}"
-
-
-def _iso_step(limit: float) -> float:
-    """The largest step of the 1-2-5 series (…, 1, 2, 5, 10 ms, …) not above ``limit`` [s]."""
-    e = math.floor(math.log10(limit))
-    for exponent in (e + 1, e, e - 1):
-        for mantissa in (5, 2, 1):
-            step = float(f"{mantissa}e{exponent}")
-            if step <= limit:
-                return step
-    raise AssertionError(f"no 1-2-5 step below {limit!r}")  # pragma: no cover
 
 
 def _sequence(value) -> list | None:
@@ -577,9 +372,10 @@ def _road(road: Any, default: Mapping[str, Any] | None) -> RoadSpec:
         if default and road.get("kind", default["kind"]) == default["kind"]:
             road = {**default, **road}
         road = road_from_mapping(road)
-    if not isinstance(road, (Road, ISO8608Road)):
+    if not isinstance(road, Road):
         raise ScenarioError(
-            f"road must be a Road (e.g. BumpRoad(height=0.1)) or a table with 'kind', got {road!r}",
+            f"road must be a qc_control.road.Road (e.g. qc.road.Bump(height=0.1)) or a table "
+            f"with 'kind', got {road!r}",
             "scenario",
             "road",
         )
@@ -840,11 +636,11 @@ class Scenario:
         warning (`beyond_limits`) instead.
         """
         if h > road_limit > 0:  # 0 s: no step samples the road, which the grid check refuses
-            h = _iso_step(road_limit)
+            h = preferred_step(road_limit)
         stable = [limit for limit in self.step_limits().values() if 0 < limit < h]
         if not stable:
             return h
-        step = _iso_step(min(stable))
+        step = preferred_step(min(stable))
         return step if step * _STABLE_DEFAULT_SPAN >= h else h
 
     def step_note(self) -> str:
@@ -1009,24 +805,11 @@ class Scenario:
         parameters. ``T`` defaults to `time_grid`.
         """
         T = self.time_grid() if T is None else T
-        zr, description = self.road.samples(T), self.road.describe()
-        layout = self.entry.road_layout
-        if zr is None or layout == "single":
-            return zr, description
-        v, speed = self.vehicle, float(cast(Any, self.road).speed)
-        wheelbase = v.a + v.b
-        late = f"; the rear wheels {wheelbase / speed:.4g} s later ((a + b)/speed)"
-        if layout == "axles":
-            return roads.axle_inputs(T, zr, wheelbase, speed), description + late
-        if isinstance(self.road, ISO8608Road):
-            r = self.road
-            left, right = roads.iso8608_tracks(
-                T, str(r.road_class), speed, v.track_front, r.seed, r.band
-            )
-            description += f", left and right tracks {v.track_front:g} m apart (isotropic road)"
-        else:
-            left = right = zr
-        return roads.corner_inputs(T, left, right, wheelbase, speed), description + late
+        v, layout = self.vehicle, self.entry.road_layout
+        if layout == "single":
+            return self.road.wheel_inputs(T)
+        track = v.track_front if layout == "corners" else None
+        return self.road.wheel_inputs(T, layout, wheelbase=v.a + v.b, track=track)
 
     def vehicle_model(self, *, road: bool = False) -> VehicleModel:
         """The `VehicleModel` this scenario runs, with this scenario's model options
@@ -1039,9 +822,7 @@ class Scenario:
         """
         profile: Any = bool(road)
         if road and self.entry.road_function and not isinstance(self.road, (NoRoad, ISO8608Road)):
-            # a partial takes the jumps as an attribute, which a bound method does not
-            profile = functools.partial(_road_at, self.road)
-            profile.jumps = self.road.jumps()
+            profile = self.road  # a Road is the function zr(t), with its jumps
         return self.entry.model(self.vehicle, road=profile, **self.option_arguments("build"))
 
     def problem(self) -> tuple[VehicleModel, np.ndarray, np.ndarray | None, str]:
@@ -1268,18 +1049,6 @@ def _named_tableaus() -> dict:
     return getattr(catalogue, "TABLEAUS", METHODS)
 
 
-def whole_step(t_end: float, h: float) -> float:
-    """The step nearest ``h`` that divides ``t_end`` into a whole number (>= 2) of
-    steps, as a `Scenario` requires: ``t_end / max(2, round(t_end / h))``.
-
-    Examples
-    --------
-    >>> whole_step(10.0, 0.0198), whole_step(10.0, 0.001)
-    (0.019801980198019802, 0.001)
-    """
-    return t_end / max(2, round(t_end / h))
-
-
 def option_name(key: str) -> str:
     """A key's option: ``--ks-front`` for ``ks_front`` (one spelling, as ``--t-end``)."""
     return "--" + key.replace("_", "-")
@@ -1338,11 +1107,6 @@ def _cmd_quote(arg: str) -> str:
     escaped = re.sub(r'(\\*)"', r'\1\1\\"', arg)  # backslashes before a quote doubled
     escaped = re.sub(r"(\\+)$", r"\1\1", escaped)  # and before the closing quote
     return f'"{escaped}"'
-
-
-def _road_at(road: Road, t: float) -> float:
-    """A road's height [m] at one time ``t`` [s] (`Road.height_at`)."""
-    return road.height_at(t)
 
 
 def _option(name: str, value: str) -> list[str]:

@@ -17,16 +17,35 @@ stays the exact reference.
 
 from __future__ import annotations
 
+import functools
+import inspect
 import math
+from dataclasses import dataclass, field, fields
+from typing import Any, ClassVar
 
 import numpy as np
 import scipy.special
 
+from ..numerics import checks
+from ..numerics.checks import ParameterError
 from ..numerics.integrate import check_time_grid, uniform_step
 from ..numerics.limits import check_memory
 from .roughness import IRI_SPEED, SMOOTHING_BASE, IRISegments, golden_car_matrices, iri
 
 __all__ = [
+    "Road",
+    "NoRoad",
+    "Step",
+    "Bump",
+    "Sine",
+    "ISO8608Road",
+    "Profile",
+    "ROADS",
+    "as_road",
+    "road_parameter",
+    "iso8608_intensity",
+    "BUMP_STEPS",
+    "SINE_STEPS",
     "step",
     "bump",
     "sine",
@@ -37,8 +56,6 @@ __all__ = [
     "ISO8608_N0",
     "ISO8608_BAND",
     "largest_step",
-    "positive",
-    "finite",
     "road_class_psd",
     "band_limits",
     "delay",
@@ -66,25 +83,27 @@ def _grid(T) -> np.ndarray:
     return check_time_grid(T, "T")
 
 
-def positive(name: str, value, unit: str) -> float:
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, (int, float, np.number))
-        or not math.isfinite(value)
-        or value <= 0
-    ):
-        raise ValueError(f"{name} must be a finite number > 0 {unit}, got {value!r}")
-    return float(value)
+#: The checks of a road's numbers (`qc_control.numerics.checks`): one wording
+#: everywhere a road is given, a `ParameterError` naming the value.
+positive = checks.positive
+finite = checks.finite
 
 
-def finite(name: str, value, unit: str) -> float:
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, (int, float, np.number))
-        or not math.isfinite(value)
-    ):
-        raise ValueError(f"{name} must be a finite number [{unit}], got {value!r}")
-    return float(value)
+def _step_height(t, height, t0):
+    """``height`` where ``t >= t0``, else 0: the one formula of a step road."""
+    return np.where(t >= t0, height, 0.0)
+
+
+def _bump_height(t, height, length, speed, t0):
+    """The one formula of a 1 − cos bump, for an array of times or one time."""
+    x = speed * (t - t0)
+    inside = (x >= 0) & (x <= length)
+    return np.where(inside, 0.5 * height * (1 - np.cos(2 * np.pi * x / length)), 0.0)
+
+
+def _sine_height(t, amplitude, frequency):
+    """The one formula of a sine road, for an array of times or one time."""
+    return amplitude * np.sin(2 * np.pi * frequency * t)
 
 
 def step(T, height: float = 0.05, t0: float = 0.5) -> np.ndarray:
@@ -94,7 +113,7 @@ def step(T, height: float = 0.05, t0: float = 0.5) -> np.ndarray:
     ``t0`` the input is a ramp, as python-control interpolates it.
     """
     T = _grid(T)
-    return np.where(T >= finite("t0", t0, "s"), finite("height", height, "m"), 0.0)
+    return _step_height(T, finite("height", height, "m"), finite("t0", t0, "s"))
 
 
 def bump(
@@ -108,35 +127,35 @@ def bump(
     T = _grid(T)
     height, t0 = finite("height", height, "m"), finite("t0", t0, "s")
     length, speed = positive("length", length, "m"), positive("speed", speed, "m/s")
-    x = speed * (T - t0)
-    inside = (x >= 0) & (x <= length)
-    return np.where(inside, 0.5 * height * (1 - np.cos(2 * np.pi * x / length)), 0.0)
+    return _bump_height(T, height, length, speed, t0)
 
 
 def sine(T, amplitude: float = 0.01, frequency: float = 1.0) -> np.ndarray:
     """A sinusoidal road ``zr = amplitude · sin(2π f t)`` [m], f in Hz."""
     T = _grid(T)
-    return finite("amplitude", amplitude, "m") * np.sin(
-        2 * np.pi * positive("frequency", frequency, "Hz") * T
-    )
+    amplitude = finite("amplitude", amplitude, "m")
+    return _sine_height(T, amplitude, positive("frequency", frequency, "Hz"))
 
 
 def road_class_psd(road_class: str) -> float:
-    key = str(road_class).strip().upper()
+    """Gd(n0) [m³] of an ISO 8608 class ``'A'`` ... ``'H'`` (any case), `ISO8608_CLASSES`."""
+    key = road_class.strip().upper() if isinstance(road_class, str) else None
     if key not in ISO8608_CLASSES:
-        raise ValueError(
-            f"unknown ISO 8608 road class {road_class!r}; expected one of "
-            f"{', '.join(ISO8608_CLASSES)}"
+        raise ParameterError(
+            "road_class", road_class, f"an ISO 8608 class, one of {', '.join(ISO8608_CLASSES)}"
         )
     return ISO8608_CLASSES[key]
 
 
 def band_limits(band) -> tuple[float, float]:
-    lo, hi = (float(b) for b in band)
-    if not (0 < lo < hi and math.isfinite(hi)):
-        raise ValueError(
-            f"band must be (n_min, n_max) with 0 < n_min < n_max cycles/m, got {band!r}"
-        )
+    """``(n_min, n_max)`` [cycles/m] of a band, refused unless ``0 < n_min < n_max < inf``."""
+    try:
+        lo, hi = (float(b) for b in band if not isinstance(b, (bool, str)))
+        ok = 0 < lo < hi and math.isfinite(hi)
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ParameterError("band", band, "(n_min, n_max) with 0 < n_min < n_max cycles/m")
     return lo, hi
 
 
@@ -196,9 +215,7 @@ def iso8608_profile(
 
 
 def _seed(seed) -> int:
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
-    return int(seed)
+    return checks.integer("seed", seed, minimum=0)
 
 
 def _harmonics(length, dx, road_class, band) -> tuple[int, np.ndarray]:
@@ -458,3 +475,519 @@ def iso8608_iri(road_class: str = "C", band=None) -> float:
     integrand = np.abs(H) ** 2 * np.sinc(n * SMOOTHING_BASE) ** 2 * iso8608_psd(n, road_class)
     variance = float(np.sum(np.diff(n) * (integrand[1:] + integrand[:-1]) / 2))
     return 1000.0 * math.sqrt(variance) * math.sqrt(2 / math.pi) / IRI_SPEED
+
+
+def iso8608_intensity(road_class, speed: float) -> float:
+    """White road-velocity intensity [m²/s] of an ISO 8608 road at ``speed`` [m/s].
+
+    .. math:: q = 2 π^2 n_0^2 G_d(n_0)\\, v
+
+    The displacement PSD ``Gd(n) = Gd(n0)(n/n0)^-2`` (one-sided, spatial)
+    gives the road velocity ``v dz/dx`` a one-sided temporal PSD
+    ``(2πf)² Gd(f/v)/v = 4π² n0² Gd(n0) v``, flat in ``f``: white noise of
+    two-sided intensity ``q`` (ISO 8608:2016; Gobbi & Mastinu, 2001).
+
+    Parameters
+    ----------
+    road_class : str or float
+        A class ``'A'`` ... ``'H'`` (its geometric mean ``Gd(n0)``), or
+        ``Gd(n0)`` [m³] itself.
+    speed : float
+        Vehicle speed [m/s], > 0.
+
+    Examples
+    --------
+    >>> round(iso8608_intensity("C", 20.0), 6)
+    0.001011
+    """
+    if isinstance(road_class, str):
+        g0 = road_class_psd(road_class)
+    else:
+        g0 = positive("road_class", road_class, "m³", description="Gd(n0)")
+    v = positive("speed", speed, "m/s")
+    return 2.0 * math.pi**2 * ISO8608_N0**2 * g0 * v
+
+
+# ----------------------------------------------------------------- the road
+#
+# One road concept: a `Road` is a frozen value that every API taking a road
+# takes (the studies, the sweeps, the nonlinear car, the controller study,
+# `Scenario` and the command line). Its numbers are written once, in the
+# functions above; a kind only holds its parameters and reads them there.
+
+
+def road_parameter(default, check: str, unit: str, help: str, option: str | None = None):
+    """A field of a `Road` kind with what the command line and a Scenario read of it.
+
+    Its default, its kind of check (``'finite'``, ``'positive'``, ``'class'``,
+    ``'seed'``, ``'band'``; the first two are checked by `Road`, the others by
+    their kind), its SI unit, its help and its command-line option (None:
+    ``--road-<name>``).
+    """
+    return field(
+        default=default, metadata={"check": check, "unit": unit, "help": help, "option": option}
+    )
+
+
+def _default(func, name: str):
+    """The default of ``func``'s argument ``name``: a kind's defaults are its function's."""
+    return inspect.signature(func).parameters[name].default
+
+
+#: How `Road` checks a field by its declared kind of check.
+_CHECKS = {"finite": checks.finite, "positive": checks.positive}
+#: One speed default for every road that has a speed: `iso8608`'s.
+_SPEED = _default(iso8608, "speed")
+#: The fewest steps a bump may span: a 1 − cos pulse over fewer falls between
+#: the samples (0.05 m at 30 m/s lasts 1.7 ms: at h = 10 ms every method saw
+#: no bump at all). Four steps put three samples on it.
+BUMP_STEPS = 4
+#: The fewest steps per period of a sine road: ten, a fifth of the Nyquist
+#: frequency 1/(2h). At the Nyquist frequency itself the samples can all be
+#: zero; at a fifth of it linear interpolation between them is within 5 % of
+#: the amplitude (1 − cos(π/10)), where the methods' stages read the input.
+SINE_STEPS = 10
+#: Help of the parameters that step and bump share.
+_HEIGHT, _T0 = "step or bump height", "time the step or bump starts"
+
+
+def _length_text(metres: float) -> str:
+    """A road height for a sentence: '10 cm', '1.5 m'."""
+    return f"{metres * 100:.4g} cm" if abs(metres) < 1 else f"{metres:.4g} m"
+
+
+@dataclass(frozen=True)
+class Road:
+    """A road under the wheels: the base of every kind.
+
+    Each kind (`Step`, `Bump`, `Sine`, `ISO8608Road`, `Profile`) is a frozen
+    dataclass whose fields are its parameters, named and defaulted as the
+    keyword arguments of its function in this module (`step`, `bump`, ...),
+    so that ``Step(height=h, t0=t).samples(T)`` is ``step(T, h, t)`` to the
+    bit. A road is also the function ``zr(t)`` of one time (``road(t)``,
+    `height_at`), which the nonlinear car reads at every stage. A bad value
+    is refused by `qc_control.ParameterError` naming the field.
+    """
+
+    kind: ClassVar[str] = "none"
+    #: The road in a sentence's words: "a bump road".
+    noun: ClassVar[str] = "no road"
+    #: What to change in the road when a grid cannot resolve it.
+    finer: ClassVar[str] = ""
+
+    def __post_init__(self):
+        for f in fields(self):
+            check = _CHECKS.get(f.metadata.get("check"))
+            if check is not None:
+                value = check(f.name, getattr(self, f.name), f.metadata["unit"])
+                object.__setattr__(self, f.name, value)
+
+    def params(self) -> dict[str, Any]:
+        """The parameters as a dict, in field order (without ``kind``)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def samples(self, T) -> np.ndarray | None:
+        """The road height zr [m] on the time grid ``T`` [s]; None for no road."""
+        return None
+
+    def height_at(self, t: float) -> float:
+        """The road height zr [m] at one time ``t`` [s]: the number `samples` gives at ``t``.
+
+        The kinds evaluate their one formula at the single time (the same
+        NumPy operations, so the same bits as the array's element); this
+        fallback samples a grid of two times.
+        """
+        zr = self.samples(np.array([t, t + 1.0]))
+        return 0.0 if zr is None else float(np.asarray(zr)[0])
+
+    def __call__(self, t: float) -> float:
+        """``zr(t)`` [m]: the road as a function of time (`height_at`)."""
+        return self.height_at(t)
+
+    @property
+    def jumps(self) -> tuple[float, ...]:
+        """The times [s] where the road height jumps; () for a continuous road."""
+        return ()
+
+    def describe(self) -> str:
+        """The road in words, from its actual parameters; '' for no road."""
+        return ""
+
+    def largest_step(self) -> float:
+        """The largest time step [s] that samples this road; inf if any step does."""
+        return math.inf
+
+    def sampled(self) -> str:
+        """What `largest_step` samples, in words."""
+        return self.noun
+
+    def wheel_inputs(
+        self, T, layout: str = "single", *, wheelbase=None, track=None
+    ) -> tuple[np.ndarray | None, str]:
+        """``(inputs on T, description)`` for a car whose wheels meet this road.
+
+        ``layout`` is a model's `ModelEntry.road_layout`: ``'single'`` (one
+        wheel: ``zr``), ``'axles'`` (``[zr_front, zr_rear]``, the rear a
+        wheelbase later: `axle_inputs`) or ``'corners'`` (``[zr_fl, zr_fr,
+        zr_rl, zr_rr]``: `corner_inputs`, both tracks the same road).
+
+        Parameters
+        ----------
+        T : array_like
+            Time grid [s].
+        layout : {'single', 'axles', 'corners'}
+        wheelbase, track : float, optional
+            The car's ``a + b`` and front track [m], for the later layouts.
+        """
+        checks.choice("layout", layout, ("single", "axles", "corners"))
+        zr, description = self.samples(T), self.describe()
+        if zr is None or layout == "single":
+            return zr, description
+        speed = getattr(self, "speed", None)
+        if speed is None:
+            raise ParameterError(
+                "road",
+                self,
+                f"a road with a speed (a Bump, an ISO8608Road or a Profile): the rear wheels "
+                f"meet the road (a + b)/speed after the front ones, and {self.noun} has none",
+            )
+        wheelbase = positive("wheelbase", wheelbase, "m")
+        late = f"; the rear wheels {wheelbase / speed:.4g} s later ((a + b)/speed)"
+        if layout == "axles":
+            return axle_inputs(T, zr, wheelbase, speed), description + late
+        left, right, tracks = self._tracks(T, zr, positive("track", track, "m"))
+        return corner_inputs(T, left, right, wheelbase, speed), description + tracks + late
+
+    def _tracks(self, T, zr: np.ndarray, track: float) -> tuple[np.ndarray, np.ndarray, str]:
+        """The left and right tracks ``track`` [m] apart: both this road, unless a kind
+        knows how its two tracks differ (`ISO8608Road`)."""
+        return zr, zr, ""
+
+
+@dataclass(frozen=True)
+class NoRoad(Road):
+    """No road input: the free response from ``x0``."""
+
+
+@dataclass(frozen=True)
+class Step(Road):
+    """A road step (a kerb) of ``height`` [m] at ``t0`` [s]: `step`."""
+
+    kind: ClassVar[str] = "step"
+    noun: ClassVar[str] = "a step road"
+    height: float = road_parameter(_default(step, "height"), "finite", "m", _HEIGHT)
+    t0: float = road_parameter(_default(step, "t0"), "finite", "s", _T0)
+
+    def samples(self, T) -> np.ndarray:
+        return step(T, height=self.height, t0=self.t0)
+
+    def height_at(self, t: float) -> float:
+        return float(_step_height(t, self.height, self.t0))
+
+    @property
+    def jumps(self) -> tuple[float, ...]:
+        return (self.t0,)
+
+    def describe(self) -> str:
+        return f"a {_length_text(self.height)} road step at t = {self.t0:g} s"
+
+
+@dataclass(frozen=True)
+class Bump(Road):
+    """A 1 − cos bump ``height`` [m] high and ``length`` [m] long, met at ``t0`` [s]: `bump`.
+
+    Its speed defaults to the ISO 8608 road's (`iso8608`), so that every
+    road with a speed has the same default; `bump`'s own default is not used.
+    """
+
+    kind: ClassVar[str] = "bump"
+    noun: ClassVar[str] = "a bump road"
+    finer: ClassVar[str] = "a longer bump or a lower speed"
+    height: float = road_parameter(_default(bump, "height"), "finite", "m", _HEIGHT)
+    length: float = road_parameter(_default(bump, "length"), "positive", "m", "bump length")
+    speed: float = road_parameter(_SPEED, "positive", "m/s", "vehicle speed", "--speed")
+    t0: float = road_parameter(_default(bump, "t0"), "finite", "s", _T0)
+
+    def samples(self, T) -> np.ndarray:
+        return bump(T, height=self.height, length=self.length, speed=self.speed, t0=self.t0)
+
+    def height_at(self, t: float) -> float:
+        return float(_bump_height(t, self.height, self.length, self.speed, self.t0))
+
+    def describe(self) -> str:
+        return (
+            f"a {_length_text(self.height)} high, {self.length:g} m long 1 − cos bump "
+            f"met at t = {self.t0:g} s at {self.speed:g} m/s"
+        )
+
+    def largest_step(self) -> float:
+        """The bump's duration length/speed over `BUMP_STEPS`."""
+        return self.length / self.speed / BUMP_STEPS
+
+    def sampled(self) -> str:
+        return (
+            f"a {self.length:g} m bump at {self.speed:g} m/s, which lasts "
+            f"{1e3 * self.length / self.speed:.3g} ms and needs {BUMP_STEPS} steps across it"
+        )
+
+
+@dataclass(frozen=True)
+class Sine(Road):
+    """A sinusoidal road ``zr = amplitude · sin(2π f t)`` [m], f in Hz: `sine`."""
+
+    kind: ClassVar[str] = "sine"
+    noun: ClassVar[str] = "a sine road"
+    finer: ClassVar[str] = "a lower frequency"
+    amplitude: float = road_parameter(_default(sine, "amplitude"), "finite", "m", "sine amplitude")
+    frequency: float = road_parameter(
+        _default(sine, "frequency"), "positive", "Hz", "sine frequency"
+    )
+
+    def samples(self, T) -> np.ndarray:
+        return sine(T, amplitude=self.amplitude, frequency=self.frequency)
+
+    def height_at(self, t: float) -> float:
+        return float(_sine_height(t, self.amplitude, self.frequency))
+
+    def describe(self) -> str:
+        return (
+            f"a sinusoidal road, {_length_text(self.amplitude)} amplitude at {self.frequency:g} Hz"
+        )
+
+    def largest_step(self) -> float:
+        """One period over `SINE_STEPS`: a fifth of the Nyquist frequency 1/(2h)."""
+        return 1.0 / (self.frequency * SINE_STEPS)
+
+    def sampled(self) -> str:
+        return (
+            f"a {self.frequency:g} Hz sine road, which needs {SINE_STEPS} steps per period "
+            f"(at most a fifth of the Nyquist frequency 1/(2h))"
+        )
+
+
+_ISO_DEFAULTS = inspect.signature(iso8608).parameters
+
+
+@dataclass(frozen=True)
+class ISO8608Road(Road):
+    """A random ISO 8608 road driven at a constant speed: sampled for a simulation,
+    or, for exact spectral metrics, white road velocity of its intensity.
+
+    Over the unbounded band (waviness 2) it is white road velocity of
+    intensity `iso8608_intensity` ``= 2π² n0² Gd(n0) v``: give it to
+    `qc_control.sweep` as ``road=`` for a spectral sweep (no simulation), or
+    to `qc_control.optimal_damping`. Its `samples` on a time grid are
+    `iso8608`'s, and it is the ``iso8608`` road of a `qc_control.Scenario`.
+
+    Parameters
+    ----------
+    road_class : str or float, default 'C'
+        ``'A'`` ... ``'H'`` (any case), or ``Gd(n0)`` [m³] (spectral only:
+        a sampled road needs a class).
+    speed : float, default 20
+        [m/s], > 0.
+    seed : int, default 0
+        The random phases' seed (>= 0) of the sampled road.
+    band : (float, float), default `ISO8608_BAND`
+        The sampled road's band ``(n_min, n_max)`` [cycles/m].
+
+    Raises
+    ------
+    qc_control.ParameterError
+        A bad value, naming the field.
+
+    Examples
+    --------
+    >>> round(ISO8608Road("C", speed=20.0).intensity, 6)
+    0.001011
+    """
+
+    kind: ClassVar[str] = "iso8608"
+    noun: ClassVar[str] = "an iso8608 road"
+    finer: ClassVar[str] = "a narrower band"
+
+    road_class: str | float = road_parameter(
+        _ISO_DEFAULTS["road_class"].default, "class", "", "ISO 8608 class A-H", "--road-class"
+    )
+    speed: float = road_parameter(
+        _ISO_DEFAULTS["speed"].default, "positive", "m/s", "vehicle speed", "--speed"
+    )
+    seed: int = road_parameter(_ISO_DEFAULTS["seed"].default, "seed", "", "road seed", "--seed")
+    band: tuple[float, float] = road_parameter(
+        _ISO_DEFAULTS["band"].default, "band", "cycles/m", "ISO 8608 band n_min,n_max"
+    )
+
+    def __post_init__(self):
+        super().__post_init__()
+        put = functools.partial(object.__setattr__, self)
+        cls = self.road_class
+        if isinstance(cls, str):
+            road_class_psd(cls)
+            put("road_class", cls.strip().upper())
+        else:
+            put("road_class", positive("road_class", cls, "m³", description="Gd(n0)"))
+        put("seed", _seed(self.seed))
+        put("band", band_limits(self.band))
+
+    @property
+    def intensity(self) -> float:
+        """White road-velocity intensity ``q`` [m²/s] (`iso8608_intensity`)."""
+        return iso8608_intensity(self.road_class, self.speed)
+
+    def samples(self, T) -> np.ndarray:
+        """The road height zr [m] on the time grid ``T`` [s] (`iso8608`)."""
+        if not isinstance(self.road_class, str):
+            raise ParameterError(
+                "road_class",
+                self.road_class,
+                "a class A-H to sample a road (Gd(n0) in m³ is a spectral road only)",
+            )
+        return iso8608(T, self.road_class, speed=self.speed, seed=self.seed, band=self.band)
+
+    def describe(self) -> str:
+        """The road in words, from its actual parameters.
+
+        A class's road also states its expected International Roughness
+        Index (`iso8608_iri` over the road's band): the road engineer's
+        measure of the same roughness, independent of the speed driven.
+        """
+        lo, hi = self.band
+        roughness = ""
+        if isinstance(self.road_class, str):
+            roughness = f", expected IRI {iso8608_iri(self.road_class, self.band):.3g} m/km"
+        return (
+            f"an ISO 8608 class {self.road_class} road at {self.speed:g} m/s "
+            f"(seed {self.seed}, band {lo:g}–{hi:g} cycles/m{roughness})"
+        )
+
+    def largest_step(self) -> float:
+        """The largest time step [s] that samples the band (`largest_step`)."""
+        return largest_step(self.speed, self.band)
+
+    def sampled(self) -> str:
+        return (
+            f"an ISO 8608 road at {self.speed:g} m/s, whose band reaches {self.band[1]:g} cycles/m"
+        )
+
+    def _tracks(self, T, zr: np.ndarray, track: float) -> tuple[np.ndarray, np.ndarray, str]:
+        left, right = iso8608_tracks(
+            T, str(self.road_class), self.speed, track, self.seed, self.band
+        )
+        return left, right, f", left and right tracks {track:g} m apart (isotropic road)"
+
+
+@dataclass(frozen=True, eq=False)
+class Profile(Road):
+    """A measured road profile ``z(x)`` driven at a constant ``speed``.
+
+    The wheel is at ``x = x[0] + speed · (t - t0)`` at time ``t``; the height
+    between the profile's points is linear (as a profilometer's record is
+    read), and before the first point or after the last the road keeps that
+    point's height (level road).
+
+    .. math:: z_r(t) = z\\big(x_0 + v (t - t_0)\\big)
+
+    Parameters
+    ----------
+    x : array_like
+        Distance along the road [m], strictly increasing, at least two points.
+    z : array_like
+        Road height [m] at ``x``.
+    speed : float, default 20
+        [m/s], > 0.
+    t0 : float, default 0
+        Time [s] at which the wheel is at ``x[0]``.
+    name : str, default ''
+        What the profile is ("the rig's measured track"), for `describe`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> p = Profile([0.0, 1.0, 2.0], [0.0, 0.01, 0.0], speed=1.0)
+    >>> p.samples(np.array([0.0, 0.5, 1.0, 3.0])).tolist()
+    [0.0, 0.005, 0.01, 0.0]
+    """
+
+    kind: ClassVar[str] = "profile"
+    noun: ClassVar[str] = "a measured profile"
+    finer: ClassVar[str] = "a lower speed"
+
+    x: Any = road_parameter((), "profile", "m", "distance along the profile")
+    z: Any = road_parameter((), "profile", "m", "profile height")
+    speed: float = road_parameter(_SPEED, "positive", "m/s", "vehicle speed", "--speed")
+    t0: float = road_parameter(0.0, "finite", "s", "time the wheel is at the first point")
+    name: str = road_parameter("", "text", "", "what the profile is")
+
+    def __post_init__(self):
+        super().__post_init__()
+        x, z = _profile_arrays(self.x, self.z)
+        object.__setattr__(self, "x", x)
+        object.__setattr__(self, "z", z)
+        if not isinstance(self.name, str):
+            raise ParameterError("name", self.name, "a str")
+
+    def samples(self, T) -> np.ndarray:
+        T = _grid(T)
+        return np.interp(self.x[0] + self.speed * (T - self.t0), self.x, self.z)
+
+    def height_at(self, t: float) -> float:
+        return float(np.interp(self.x[0] + self.speed * (t - self.t0), self.x, self.z))
+
+    def describe(self) -> str:
+        what = self.name or f"a measured {self.x[-1] - self.x[0]:g} m profile"
+        return (
+            f"{what} ({self.x.size} points, every {self._spacing() * 100:.3g} cm at the closest) "
+            f"driven at {self.speed:g} m/s from t = {self.t0:g} s"
+        )
+
+    def _spacing(self) -> float:
+        return float(np.min(np.diff(self.x)))
+
+    def largest_step(self) -> float:
+        """The time the wheel takes between the profile's two closest points:
+        a coarser step would skip measured points."""
+        return self._spacing() / self.speed
+
+    def sampled(self) -> str:
+        return (
+            f"a profile measured every {self._spacing() * 100:.3g} cm at the closest, driven at "
+            f"{self.speed:g} m/s"
+        )
+
+
+def _profile_arrays(x, z) -> tuple[np.ndarray, np.ndarray]:
+    """``x, z`` of a `Profile` as read-only float arrays, refused by name unless
+    finite, of one length of at least two, and ``x`` strictly increasing."""
+    try:
+        xa = np.array(x, dtype=float)
+        za = np.array(z, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError("x", x, "distances [m] and heights [m] as numbers") from None
+    if xa.ndim != 1 or xa.size < 2:
+        raise ParameterError("x", x, "at least two distances [m] in a 1-D array")
+    if za.shape != xa.shape:
+        raise ParameterError("z", z, f"{xa.size} heights [m], one per distance x")
+    for name, a in (("x", xa), ("z", za)):
+        if not np.all(np.isfinite(a)):
+            i = int(np.flatnonzero(~np.isfinite(a))[0])
+            raise ParameterError(f"{name}[{i}]", a[i], "a finite number m")
+    if np.any(np.diff(xa) <= 0):
+        i = int(np.flatnonzero(np.diff(xa) <= 0)[0]) + 1
+        raise ParameterError(f"x[{i}]", xa[i], f"a distance > x[{i - 1}] = {xa[i - 1]!r} m")
+    xa.setflags(write=False)
+    za.setflags(write=False)
+    return xa, za
+
+
+#: Every kind of road, by its ``kind``.
+ROADS: dict[str, type[Road]] = {
+    cls.kind: cls for cls in (NoRoad, Step, Bump, Sine, ISO8608Road, Profile)
+}
+
+
+def as_road(road, *, where: str = "road") -> Road:
+    """``road`` if it is a `Road`; a `ParameterError` naming ``where`` otherwise."""
+    if isinstance(road, Road):
+        return road
+    kinds = ", ".join(c.__name__ for c in ROADS.values() if c is not NoRoad)
+    raise ParameterError(where, road, f"a qc_control.road.Road ({kinds})")

@@ -24,10 +24,6 @@ quarter car); Dahlberg, J. Sound Vib. 58(2), 1978; Kwakernaak & Sivan,
 from __future__ import annotations
 
 import functools
-import inspect
-import math
-from dataclasses import dataclass, field, fields
-from typing import ClassVar
 
 import control
 import numpy as np
@@ -35,10 +31,9 @@ import scipy.linalg
 
 from ..models.vehicle import VehicleModel
 from ..numerics.threads import one_blas_thread
-from . import road
 from .iso2631 import wk_filter
 from .metrics import metric_columns
-from .road import ISO8608_N0, positive, road_class_psd
+from .road import ISO8608Road, iso8608_intensity, positive
 
 __all__ = [
     "lyapunov_variances",
@@ -308,37 +303,6 @@ def white_velocity_variances(
     return {o: (float(var[..., i]) if var.ndim == 1 else var[..., i]) for i, o in enumerate(wanted)}
 
 
-def iso8608_intensity(road_class, speed: float) -> float:
-    """White road-velocity intensity [m²/s] of an ISO 8608 road at ``speed`` [m/s].
-
-    .. math:: q = 2 π^2 n_0^2 G_d(n_0)\\, v
-
-    The displacement PSD ``Gd(n) = Gd(n0)(n/n0)^-2`` (one-sided, spatial)
-    gives the road velocity ``v dz/dx`` a one-sided temporal PSD
-    ``(2πf)² Gd(f/v)/v = 4π² n0² Gd(n0) v``, flat in ``f``: white noise of
-    two-sided intensity ``q`` (ISO 8608:2016; Gobbi & Mastinu, 2001).
-
-    Parameters
-    ----------
-    road_class : str or float
-        A class ``'A'`` ... ``'H'`` (its geometric mean ``Gd(n0)``), or
-        ``Gd(n0)`` [m³] itself.
-    speed : float
-        Vehicle speed [m/s], > 0.
-
-    Examples
-    --------
-    >>> round(iso8608_intensity("C", 20.0), 6)
-    0.001011
-    """
-    if isinstance(road_class, str):
-        g0 = road_class_psd(road_class)
-    else:
-        g0 = positive("road_class (Gd(n0))", road_class, "m³")
-    v = positive("speed", speed, "m/s")
-    return 2.0 * math.pi**2 * ISO8608_N0**2 * g0 * v
-
-
 def white_velocity_wk_variance(model: VehicleModel, *, intensity: float = 1.0, batch=None):
     """Stationary variance of the ISO 2631-1 Wk-weighted body acceleration on white road velocity.
 
@@ -385,142 +349,6 @@ def white_velocity_wk_variance(model: VehicleModel, *, intensity: float = 1.0, b
 def _wk_matrices() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     sys = control.ss(wk_filter())
     return tuple(np.asarray(getattr(sys, k), dtype=float) for k in "ABCD")  # type: ignore[return-value]
-
-
-def road_parameter(default, check: str, unit: str, help: str, option: str | None = None):
-    """A field of a road spec with what the command line and the Scenario read of it:
-    its default, its kind of check (``'finite'``, ``'positive'``, ``'class'``,
-    ``'seed'``, ``'band'``), its unit, its help and its option
-    (`qc_control.cli.scenario.road_option`; None: ``--road-<name>``)."""
-    return field(
-        default=default, metadata={"check": check, "unit": unit, "help": help, "option": option}
-    )
-
-
-_ISO_DEFAULTS = inspect.signature(road.iso8608).parameters
-
-
-@dataclass(frozen=True)
-class ISO8608Road:
-    """A random ISO 8608 road driven at a constant speed: sampled for a simulation,
-    or, for exact spectral metrics, white road velocity of its intensity.
-
-    Over the unbounded band (waviness 2) it is white road velocity of
-    intensity `iso8608_intensity` ``= 2π² n0² Gd(n0) v``: give it to
-    `qc_control.sweep` as ``road=`` for a spectral sweep (no simulation). Its
-    `samples` on a time grid are `qc_control.ride.road.iso8608`'s, and it is
-    the ``iso8608`` road of a `qc_control.Scenario` (``[scenario.road]``).
-
-    Parameters
-    ----------
-    road_class : str or float, default 'C'
-        ``'A'`` ... ``'H'`` (any case), or ``Gd(n0)`` [m³] (spectral only:
-        a sampled road needs a class).
-    speed : float, default 20
-        [m/s], > 0.
-    seed : int, default 0
-        The random phases' seed (>= 0) of the sampled road.
-    band : (float, float), default `qc_control.ride.road.ISO8608_BAND`
-        The sampled road's band ``(n_min, n_max)`` [cycles/m].
-
-    Raises
-    ------
-    ValueError
-        A bad value; the message starts with the parameter's name.
-
-    Examples
-    --------
-    >>> round(ISO8608Road("C", speed=20.0).intensity, 6)
-    0.001011
-    """
-
-    kind: ClassVar[str] = "iso8608"
-    #: The road in a sentence's words.
-    noun: ClassVar[str] = "an iso8608 road"
-
-    road_class: str | float = road_parameter(
-        _ISO_DEFAULTS["road_class"].default, "class", "", "ISO 8608 class A-H", "--road-class"
-    )
-    speed: float = road_parameter(
-        _ISO_DEFAULTS["speed"].default, "positive", "m/s", "vehicle speed", "--speed"
-    )
-    seed: int = road_parameter(_ISO_DEFAULTS["seed"].default, "seed", "", "road seed", "--seed")
-    band: tuple[float, float] = road_parameter(
-        _ISO_DEFAULTS["band"].default, "band", "cycles/m", "ISO 8608 band n_min,n_max"
-    )
-
-    def __post_init__(self):
-        put = functools.partial(object.__setattr__, self)
-        cls = self.road_class
-        if isinstance(cls, str):
-            try:
-                road.road_class_psd(cls)
-            except ValueError as exc:
-                raise ValueError(f"road_class = {cls!r}: {exc}") from None
-            put("road_class", cls.strip().upper())
-        else:
-            put("road_class", road.positive("road_class", cls, "m³ (Gd(n0))"))
-        put("speed", road.positive("speed", self.speed, "m/s"))
-        seed = self.seed
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-            raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
-        put("seed", int(seed))
-        band = self.band
-        try:
-            lo, hi = (float(b) for b in band if not isinstance(b, (bool, str)))
-            ok = 0 < lo < hi and math.isfinite(hi)
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise ValueError(
-                f"band must be [n_min, n_max] in cycles/m with 0 < n_min < n_max, got {band!r}"
-            )
-        put("band", (lo, hi))
-
-    @property
-    def intensity(self) -> float:
-        """White road-velocity intensity ``q`` [m²/s]."""
-        return iso8608_intensity(self.road_class, self.speed)
-
-    def params(self) -> dict:
-        """The parameters as a dict, in field order."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
-
-    def samples(self, T) -> np.ndarray:
-        """The road height zr [m] on the time grid ``T`` [s] (`qc_control.ride.road.iso8608`)."""
-        if not isinstance(self.road_class, str):
-            raise ValueError(
-                f"road_class must be a class A-H to sample a road, got Gd(n0) = "
-                f"{self.road_class!r} m³ (a spectral road only)"
-            )
-        return road.iso8608(T, self.road_class, speed=self.speed, seed=self.seed, band=self.band)
-
-    def describe(self) -> str:
-        """The road in words, from its actual parameters.
-
-        A class's road also states its expected International Roughness
-        Index (`qc_control.ride.road.iso8608_iri` over the road's band): the
-        road engineer's measure of the same roughness, independent of the
-        speed driven.
-        """
-        lo, hi = self.band
-        roughness = ""
-        if isinstance(self.road_class, str):
-            roughness = f", expected IRI {road.iso8608_iri(self.road_class, self.band):.3g} m/km"
-        return (
-            f"an ISO 8608 class {self.road_class} road at {self.speed:g} m/s "
-            f"(seed {self.seed}, band {lo:g}–{hi:g} cycles/m{roughness})"
-        )
-
-    def largest_step(self) -> float:
-        """The largest time step [s] that samples the band (`qc_control.ride.road.largest_step`)."""
-        return road.largest_step(self.speed, self.band)
-
-    def sampled(self) -> str:
-        """What `largest_step` samples, in words."""
-        return (
-            f"an ISO 8608 road at {self.speed:g} m/s, whose band reaches {self.band[1]:g} cycles/m"
-        )
 
 
 #: The metrics a spectral sweep computes unless told otherwise (the
