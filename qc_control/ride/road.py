@@ -577,7 +577,8 @@ class Road:
 
     def __post_init__(self):
         for f in fields(self):
-            check = _CHECKS.get(f.metadata.get("check"))
+            name = f.metadata.get("check")
+            check = _CHECKS.get(name) if name is not None else None
             if check is not None:
                 value = check(f.name, getattr(self, f.name), f.metadata["unit"])
                 object.__setattr__(self, f.name, value)
