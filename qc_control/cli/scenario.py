@@ -73,6 +73,7 @@ from ..numerics.stability import max_stable_step
 from ..numerics.steps import preferred_step, whole_step
 from ..ride.road import ROADS, Bump, ISO8608Road, NoRoad, Profile, Road, Sine, Step
 from ..studies.compare import DEFAULT_METHODS, MethodComparison, compare_methods
+from ..studies.on_road import road_inputs, road_problem
 from ..studies.peers import check_solvers
 from ..studies.scenarios import POTHOLE, STIFF_CAR, stiff_car_methods, stiff_car_ride_cost
 
@@ -805,11 +806,7 @@ class Scenario:
         parameters. ``T`` defaults to `time_grid`.
         """
         T = self.time_grid() if T is None else T
-        v, layout = self.vehicle, self.entry.road_layout
-        if layout == "single":
-            return self.road.wheel_inputs(T)
-        track = v.track_front if layout == "corners" else None
-        return self.road.wheel_inputs(T, layout, wheelbase=v.a + v.b, track=track)
+        return road_inputs(self.road, T, self.entry, self.vehicle)
 
     def vehicle_model(self, *, road: bool = False) -> VehicleModel:
         """The `VehicleModel` this scenario runs, with this scenario's model options
@@ -820,10 +817,12 @@ class Scenario:
         at every stage, with its ``jumps`` (`Road.jumps`: a step's t0); an
         ISO 8608 road, which has no closed form, stays the input ``zr``.
         """
-        profile: Any = bool(road)
-        if road and self.entry.road_function and not isinstance(self.road, (NoRoad, ISO8608Road)):
-            profile = self.road  # a Road is the function zr(t), with its jumps
-        return self.entry.model(self.vehicle, road=profile, **self.option_arguments("build"))
+        if not road:
+            return self.entry.model(self.vehicle, **self.option_arguments("build"))
+        T = self.time_grid()[:2]
+        return road_problem(
+            self.vehicle, self.road, T, entry=self.entry, options=self.option_arguments("build")
+        )[0]
 
     def problem(self) -> tuple[VehicleModel, np.ndarray, np.ndarray | None, str]:
         """What `run` compares the methods on: ``(vehicle, T, U, description)``.
@@ -833,10 +832,9 @@ class Scenario:
         model takes the road as a function of time) and the road in words.
         """
         T = self.time_grid()
-        U, description = self.road_input(T)
-        vehicle = self.vehicle_model(road=U is not None)
-        if U is not None and not vehicle.road_inputs():
-            U, description = None, description + " (the road as a function of time)"
+        vehicle, U, description = road_problem(
+            self.vehicle, self.road, T, entry=self.entry, options=self.option_arguments("build")
+        )
         return vehicle, T, U, description
 
     def run(self, progress: Callable[[str], None] | None = None) -> MethodComparison:

@@ -31,6 +31,7 @@ from ..models.quarter import (
 )
 from ..models.registry import MODELS, model_for_params, model_for_system
 from ..models.vehicle import VehicleModel
+from ..numerics.checks import ParameterError
 from ..numerics.clocked import ClockedLoop, exact_clocked
 from ..numerics.integrate import (
     DivergenceWarning,
@@ -52,7 +53,9 @@ from ..responses.timeresp import (
     input_output_response,
 )
 from ..ride.comfort import Transmissibility, ride_metrics, transmissibility
+from ..ride.road import Road
 from .confirm import CostCheck, confirmed_costs
+from .on_road import road_problem
 from .peers import RTOLS, WorkPrecision, check_solvers, work_precision
 from .ride_cost import RideCost
 from .timing import TIME_COLUMNS, interleaved_times
@@ -815,6 +818,11 @@ def _tableaus(methods: Sequence) -> tuple[ButcherTableau, ...]:
     return tabs
 
 
+def _default_grid() -> np.ndarray:
+    """The comparison's time grid unless one is given: 0-10 s at 0.01 s."""
+    return np.linspace(0, DEFAULT_T_END, 1001)
+
+
 def _checked_problem(
     sys, model, params, T, X0, U, methods: Sequence, h, repeats
 ) -> ComparisonProblem:
@@ -825,7 +833,7 @@ def _checked_problem(
             "(e.g. qc.quarter_car_model(params, road=True)) so that the "
             "comparison knows which output is which"
         )
-    T = check_time_grid(np.linspace(0, DEFAULT_T_END, 1001) if T is None else T, "T")
+    T = check_time_grid(_default_grid() if T is None else T, "T")
     h, substeps = _grid(T, h)
     tabs = _tableaus(methods)
     if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
@@ -1052,6 +1060,7 @@ def compare_methods(
     T=None,
     X0=DEFAULT_X0,
     *,
+    road: Road | None = None,
     U=None,
     methods: Sequence = DEFAULT_METHODS,
     h: float | None = None,
@@ -1090,6 +1099,11 @@ def compare_methods(
         Uniform output grid [s]; default 0-10 s at 0.01 s.
     X0 : array_like, default ``(0, 0, 0.05, 0)``
         Initial state [m/s, m/s, m, m].
+    road : qc_control.road.Road, optional
+        The road the car drives, sampled on ``T`` under every wheel in the
+        car's layout (`qc_control.studies.on_road.road_problem`: the rear
+        wheels a wheelbase later). It gives ``U`` and
+        ``input_description``; give it instead of them.
     U : array_like, optional
         Input samples on ``T`` (python-control's shapes); ``None`` for the
         free response.
@@ -1173,6 +1187,13 @@ def compare_methods(
     acts only at the ticks. Wall times are one run each (no LTI engine);
     ``solvers``, ``events`` and ``levels`` do not apply.
     """
+    if road is not None:
+        if U is not None or input_description:
+            raise ParameterError(
+                "road", road, "given alone: the road gives U and input_description"
+            )
+        T = _default_grid() if T is None else T
+        sys, U, input_description = road_problem(sys, road, T, params)
     sys, model, params = _as_model(sys, U, params)
     problem = _checked_problem(sys, model, params, T, X0, U, methods, h, repeats)
     peers = check_solvers(solvers)
