@@ -28,15 +28,10 @@ from qc_control.report.outputs import output_folder, show_inline
 out = output_folder("lift_off")  # OUT_DIR from the command line, if any
 
 HEIGHT, LENGTH, SPEED, T0, T_END = 0.20, 8.0, 20.0, 0.1, 0.8
-DURATION = LENGTH / SPEED
 
 
-def bump(t):
-    """The road under the tire [m]; its ends (0.1 s, 0.5 s) are points of every grid below."""
-    s = t - T0
-    return 0.5 * HEIGHT * (1 - math.cos(2 * math.pi * s / DURATION)) if 0 <= s <= DURATION else 0.0
-
-
+# The road under the tire; its ends (0.1 s, 0.5 s) are points of every grid below.
+bump = qc.road.Bump(height=HEIGHT, length=LENGTH, speed=SPEED, t0=T0)
 car = qc.nonlinear_quarter_car(road=bump)  # the seed's Table 1, gravity, unilateral tire
 
 

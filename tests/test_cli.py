@@ -487,9 +487,12 @@ def test_nonlinear_options_make_the_scenario(files):
         True,
     )
     sc = parse(
-        "--model", "nonlinear", "--bump-height", "0.3", "--bump-length", "6", "--speed", "25"
+        "--model", "nonlinear", "--road-height", "0.3", "--road-length", "6", "--speed", "25"
     )
     assert sc.road == BumpRoad(height=0.3, length=6.0, speed=25.0, t0=0.1)
+    with pytest.warns(DeprecationWarning, match="--bump-length is deprecated.*--road-length"):
+        old = parse("--model", "nonlinear", "--bump-length", "6", "--speed", "25")
+    assert old.road == BumpRoad(height=0.2, length=6.0, speed=25.0, t0=0.1)
     sc = parse("--model", "nonlinear", "--tire", "linear", "--bump-stop", "0.05,1e5", "--no-events")
     assert (sc.tire, sc.bump_stop, sc.events) == ("linear", (0.05, 1e5), False)
     # the command and the TOML give the same scenario back, a free response included

@@ -32,6 +32,8 @@ P = qc.QuarterCarParams()
 G = 9.80665
 BUMP_H, BUMP_L, SPEED, T0 = 0.2, 8.0, 20.0, 0.1
 TB = BUMP_L / SPEED
+# The same bump as the car's road (`qc.road.Bump`); `bump` stays the hand-written reference.
+BUMP_ROAD = qc.road.Bump(height=BUMP_H, length=BUMP_L, speed=SPEED, t0=T0)
 DELTA0 = (P.ms + P.mu) * G / P.ku
 T_LIFT = np.linspace(0.0, 0.8, 401)  # h = 2 ms, as the README's table
 
@@ -74,7 +76,7 @@ def hand_reference(T):
 
 @pytest.fixture(scope="module")
 def lift_off():
-    model = qc.nonlinear_quarter_car_model(road=bump)
+    model = qc.nonlinear_quarter_car_model(road=BUMP_ROAD)
     return qc.compare_methods(model, T_LIFT, np.zeros(4), timing=False)
 
 
@@ -204,7 +206,7 @@ def test_semi_active_closed_loop_runs_through_compare_methods(skyhook_loop):
 
 
 def test_bare_nonlinear_car_takes_its_params_from_the_system():
-    car = qc.nonlinear_quarter_car({"cs": 2000.0}, road=bump)
+    car = qc.nonlinear_quarter_car({"cs": 2000.0}, road=BUMP_ROAD)
     cmp = qc.compare_methods(car, T_LIFT[:101], np.zeros(4), timing=False, methods=["rk4"])
     assert cmp.params.cs == 2000.0 and cmp.model.body_disp == "xs"
     assert cmp.model.unit("tire_force") == "N"
@@ -224,7 +226,7 @@ def test_bad_nonlinear_arguments_are_named(skyhook_loop):
 
 
 def test_nonlinear_reference_names_its_events():
-    car = qc.nonlinear_quarter_car(road=bump)
+    car = qc.nonlinear_quarter_car(road=BUMP_ROAD)
     ref = nonlinear_reference(car, T_LIFT, events=True, rtol=1e-10)
     assert ref.event_labels == ("contact", "contact")
     assert ref.state_accuracy.shape == (4,)

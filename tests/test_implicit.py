@@ -441,7 +441,7 @@ def lift_off_bump(t):
 def lift_off_reference():
     from qc_control.studies.compare import nonlinear_reference
 
-    car = qc.nonlinear_quarter_car(road=lift_off_bump)
+    car = qc.nonlinear_quarter_car(road=qc.road.Bump(height=0.2, length=8.0, speed=20.0, t0=0.1))
     T = np.linspace(0.0, 0.8, 401)
     # DOP853 at rtol 1e-10, restarted at each contact event (tested against a
     # hand-written solve_ivp in test_compare_nonlinear)

@@ -192,7 +192,7 @@ def test_user_callables_have_no_compiled_steps():
     for options in (
         {"spring": lambda d: 2e4 * d + 1e6 * d**3},
         {"damper": lambda v: 1500.0 * np.tanh(v)},
-        {"road": lambda t: 0.0},
+        {"road": qc.road.Sine(amplitude=0.01, frequency=1.0)},
     ):
         model = qc.nonlinear_quarter_car_model(**options)
         assert model.batch_dynamics(DESIGNS[:1]).compiled_stepper() is None
@@ -201,10 +201,7 @@ def test_user_callables_have_no_compiled_steps():
 def test_custom_tableau_and_road_function():
     ralston = qc.ButcherTableau("ralston", a=[[0, 0], [2 / 3, 0]], b=[1 / 4, 3 / 4])
 
-    def bump(t):  # vectorises: np.where, no if on the value
-        s = np.clip((t - 0.1) / 0.4, 0.0, 1.0)
-        return 0.5 * 0.2 * (1 - np.cos(2 * np.pi * s))
-
+    bump = qc.road.Bump(height=0.2, length=8.0, speed=20.0, t0=0.1)
     model = qc.nonlinear_quarter_car_model(road=bump, damper=lambda v: 1500.0 * np.tanh(v))
     T = np.linspace(0.0, 0.8, 801)
     batch = simulate_batch(model.batch_dynamics(DESIGNS[:2]), T, np.zeros(4), None, ralston)
@@ -332,7 +329,9 @@ def test_lift_off_against_solve_ivp_with_events():
     designs = [
         dict(ms=301.2, mu=100.0, ks=30000.0, ku=29530.0, cs=cs) for cs in (1503.0, 2000.0, 2500.0)
     ]
-    model = qc.nonlinear_quarter_car_model(road=bump)
+    model = qc.nonlinear_quarter_car_model(
+        road=qc.road.Bump(height=0.2, length=8.0, speed=20.0, t0=0.1)
+    )
     dyn = model.batch_dynamics(designs)
     with_events = simulate_batch(dyn, T, np.zeros(4), events=True)
     without = simulate_batch(dyn, T, np.zeros(4))

@@ -41,6 +41,8 @@ P = qc.QuarterCarParams()
 G = 9.80665
 BUMP_H, BUMP_L, SPEED, T0 = 0.2, 8.0, 20.0, 0.1
 TB = BUMP_L / SPEED
+# The same bump as the car's road (`qc.road.Bump`); `bump` stays the hand-written reference.
+BUMP_ROAD = qc.road.Bump(height=BUMP_H, length=BUMP_L, speed=SPEED, t0=T0)
 T_END = 0.8
 DELTA0 = (P.ms + P.mu) * G / P.ku
 
@@ -119,7 +121,7 @@ STEPS = (2e-3, 1e-3, 5e-4)
 
 
 def lift_off(h, events):
-    car = qc.nonlinear_quarter_car(road=bump)
+    car = qc.nonlinear_quarter_car(road=BUMP_ROAD)
     return qc.input_output_response(car, grid(h), events=events)
 
 
@@ -288,7 +290,7 @@ def test_force_elements():
         (dict(spring=-1.0), ValueError, r"spring \(the cubic coefficient k3.*got -1.0"),
         (dict(spring=lambda d: 100.0 + d), ValueError, r"spring\(0.0\) = 100.0"),
         (dict(gravity=1), TypeError, "gravity must be True or False, got 1"),
-        (dict(road="bump"), TypeError, "road must be True, False or a callable"),
+        (dict(road="bump"), TypeError, "road must be True, False or a qc.road.Road"),
         (dict(params={"ms": -1.0}), ValueError, "ms .* must be > 0"),
     ],
 )
@@ -332,7 +334,7 @@ def test_nonlinear_reference_restarts_at_events(lift_off_reference):
     from qc_control.studies.compare import nonlinear_reference
 
     reference, ref_events = lift_off_reference
-    car = qc.nonlinear_quarter_car(road=bump)
+    car = qc.nonlinear_quarter_car(road=BUMP_ROAD)
     T = grid(1e-3)
     ref = nonlinear_reference(car, T, events=True, rtol=1e-10)
     np.testing.assert_allclose(ref.t_events, ref_events, rtol=0, atol=1e-9)

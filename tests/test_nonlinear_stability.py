@@ -44,6 +44,11 @@ def _bump(height=0.15):
     return road
 
 
+def _bump_road(height=0.15):
+    """`_bump`'s road as the car takes it: a `qc.road.Bump` 0.2 m long at 1 m/s from 0.1 s."""
+    return qc.road.Bump(height=height, length=0.2, speed=1.0, t0=0.1)
+
+
 def _reference(car, T, x0=(0.0, 0.0, 0.0, 0.0), road=None):
     """The car's equations by LSODA at rtol 1e-9, sampled at T: states (4, len(T)).
 
@@ -92,7 +97,7 @@ def _run(*args, **kwargs):
 
 def test_stiff_stop_beyond_the_step_limit_is_not_a_success():
     """1e12 N/m stop, 7.5 cm bump, RK4 at 2 ms: max|v| 9.2e15 m/s (truth 0.92)."""
-    car = qc.nonlinear_quarter_car(bump_stop=qc.BumpStop(0.01, 1e12), road=_bump())
+    car = qc.nonlinear_quarter_car(bump_stop=qc.BumpStop(0.01, 1e12), road=_bump_road())
     T = np.linspace(0, 1, 501)
     r, warned = _run(car, T)
     assert not r.success
@@ -105,7 +110,7 @@ def test_stiff_stop_beyond_the_step_limit_is_not_a_success():
 
 def test_stiff_stop_with_events_is_not_a_success():
     """The same with events located: 2.8e8 m/s, success was True."""
-    car = qc.nonlinear_quarter_car(bump_stop=qc.BumpStop(0.01, 1e12), road=_bump())
+    car = qc.nonlinear_quarter_car(bump_stop=qc.BumpStop(0.01, 1e12), road=_bump_road())
     r, warned = _run(car, np.linspace(0, 1, 501), events=True)
     assert not r.success and warned
     assert r.t_events.size > 0
@@ -114,7 +119,7 @@ def test_stiff_stop_with_events_is_not_a_success():
 def test_stop_engaged_between_samples_is_seen():
     """1e9 N/m: the stop is engaged for less than a sample; the velocities came out
     3.5x too large with success True."""
-    car = qc.nonlinear_quarter_car(bump_stop=qc.BumpStop(0.01, 1e9), road=_bump())
+    car = qc.nonlinear_quarter_car(bump_stop=qc.BumpStop(0.01, 1e9), road=_bump_road())
     T = np.linspace(0, 0.6, 301)
     r, warned = _run(car, T)
     assert not _within_judgement(r.states, _reference(car, T))
@@ -189,7 +194,7 @@ def test_a_stable_methods_are_not_flagged(method):
     tyre (1e8 N/m, linear): a stop's kink would stall the simplified Newton
     iteration at this step, which is reported as such, not as instability."""
     p = qc.QuarterCarParams(ms=300.0, mu=40.0, ks=25000.0, ku=1e8, cs=1500.0)
-    car = qc.nonlinear_quarter_car(p, tire="linear", road=_bump(0.1))
+    car = qc.nonlinear_quarter_car(p, tire="linear", road=_bump_road(0.1))
     T = np.linspace(0, 0.6, 61)  # h = 10 ms: over 5 times RK4's limit (1.8 ms)
     assert qc.max_stable_step("rk4", qc.quarter_car(p)) < 2e-3
     assert not _run(car, T, method="rk4")[0].success  # the explicit method is flagged
@@ -234,7 +239,7 @@ def test_success_agrees_with_a_tight_reference(
     (module docstring). 0.6 s runs; about 0.1 s an example."""
     p = qc.QuarterCarParams(ms=300.0, mu=40.0, ks=25000.0, ku=10**log_ku, cs=cs)
     stop = qc.BumpStop(clearance, 10**log_stiffness)
-    car = qc.nonlinear_quarter_car(p, bump_stop=stop, tire=tire, road=_bump(height))
+    car = qc.nonlinear_quarter_car(p, bump_stop=stop, tire=tire, road=_bump_road(height))
     T = np.arange(0.0, 0.6 + h / 2, h)
     r, warned = _run(car, T, method=method)
     assert r.success or r.message

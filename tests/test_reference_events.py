@@ -37,6 +37,11 @@ def bump_of(height):
     return bump
 
 
+def road_of(height):
+    """The car's road: `bump_of`'s bump as a `qc.road.Bump` (the reference keeps the function)."""
+    return qc.road.Bump(height=height, length=BUMP_L, speed=SPEED, t0=T0)
+
+
 def by_hand(p, clearance, stiffness, road):
     """The car's right-hand side and its two switching functions, from the equations."""
     delta0 = (p.ms + p.mu) * G / p.ku
@@ -106,7 +111,7 @@ def assert_matches_hand(x, T, **car):
 def test_reference_through_bump_stop_events(clearance, stiffness, height):
     """The CLI's `--bump-stop 0,1e5`, `0,1e6 --bump-height 0.3` and `0.05,1e10` runs."""
     car = qc.nonlinear_quarter_car(
-        bump_stop=qc.BumpStop(clearance, stiffness), road=bump_of(height)
+        bump_stop=qc.BumpStop(clearance, stiffness), road=road_of(height)
     )
     ref = nonlinear_reference(car, T_LIFT, events=True)
     events = assert_matches_hand(
@@ -129,7 +134,7 @@ def test_reference_through_bump_stop_events(clearance, stiffness, height):
 def test_reference_of_a_tire_of_1e9():
     """The CLI's `--ku 1e9`: the wheel bounces off the road, ~20 contacts in 0.8 s."""
     p = qc.QuarterCarParams(ku=1e9)
-    car = qc.nonlinear_quarter_car(p, road=bump_of(0.2))
+    car = qc.nonlinear_quarter_car(p, road=road_of(0.2))
     T = T_LIFT[:201]  # 0-0.4 s: the first flights, under 2 s
     ref = nonlinear_reference(car, T, events=True)
     events = assert_matches_hand(ref.x, T, p=p)
@@ -144,7 +149,7 @@ def test_reference_of_a_tire_of_1e9():
 
 def test_two_samples_hold_all_events():
     """`compare_methods(nonlinear model, [0, 0.8], zeros)`: events between two samples."""
-    model = qc.nonlinear_quarter_car_model(road=bump_of(0.2))
+    model = qc.nonlinear_quarter_car_model(road=road_of(0.2))
     cmp = qc.compare_methods(model, np.array([0, 0.8]), np.zeros(4), timing=False)
     T = cmp.T
     # refined to 5 samples 0.2 s apart: lift-off and landing fall between two of them
@@ -214,7 +219,7 @@ def test_cli_report_of_the_nonlinear_car(options, pdf, tmp_path, capsys, request
 
 # ------------------------------------------------------------------ the budget
 
-FRICTION = dict(damper=lambda v: 1500 * v + 300 * np.sign(v), road=bump_of(0.2))
+FRICTION = dict(damper=lambda v: 1500 * v + 300 * np.sign(v), road=road_of(0.2))
 
 
 def test_friction_without_a_switching_function_stops_with_its_cause():
@@ -228,7 +233,7 @@ def test_friction_without_a_switching_function_stops_with_its_cause():
     assert "tanh" in message and "max_nfev" in message
     # the same car with the law smoothed (the message's advice) runs within that budget
     smooth = qc.nonlinear_quarter_car(
-        damper=lambda v: 1500 * v + 300 * np.tanh(v / 0.01), road=bump_of(0.2)
+        damper=lambda v: 1500 * v + 300 * np.tanh(v / 0.01), road=road_of(0.2)
     )
     ref = nonlinear_reference(smooth, T_LIFT, events=True, max_nfev=20_000)
     assert np.all(np.isfinite(ref.x))
@@ -236,7 +241,7 @@ def test_friction_without_a_switching_function_stops_with_its_cause():
 
 @pytest.mark.parametrize("bad", [0, -5, 1.5, True, "many"])
 def test_bad_budget_is_named(bad):
-    car = qc.nonlinear_quarter_car(road=bump_of(0.2))
+    car = qc.nonlinear_quarter_car(road=road_of(0.2))
     with pytest.raises(ValueError, match="max_nfev must be a positive integer or None"):
         nonlinear_reference(car, T_LIFT, max_nfev=bad)
 
@@ -263,7 +268,7 @@ def test_friction_comparison_ends_with_a_value_error():
 
 def test_a_road_far_faster_than_the_samples_stops_with_the_other_cause():
     """A 1e4 Hz road under samples 2 ms apart: the wheel leaves and meets it every period."""
-    car = qc.nonlinear_quarter_car(road=lambda t: 0.01 * math.sin(2 * math.pi * 1e4 * t))
+    car = qc.nonlinear_quarter_car(road=qc.road.Sine(amplitude=0.01, frequency=1e4))
     with pytest.raises(ValueError, match="far faster than the samples") as info:
         nonlinear_reference(car, T_LIFT, events=True, max_nfev=20_000)
     assert "smaller h" in str(info.value) and " events." in str(info.value)

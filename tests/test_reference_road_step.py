@@ -103,7 +103,8 @@ def test_a_left_continuous_road_function_with_its_jump():
 
     t0 = 0.4999
     road.jumps = (t0,)
-    car = qc.nonlinear_quarter_car(road=road)
+    with pytest.warns(DeprecationWarning, match=r"plain function zr\(t\).*qc\.road\.Road"):
+        car = qc.nonlinear_quarter_car(road=road)  # 0.1's form: still runs, warning
     assert car.jumps == (t0,)
     T = np.linspace(0.0, 0.5, 51)
     ref = nonlinear_reference(car, T, events=True)
@@ -191,4 +192,5 @@ def test_bad_jumps_are_named(bad):
 
     road.jumps = bad
     with pytest.raises(ValueError, match=r"road\.jumps must be finite times \[s\], got"):
-        qc.nonlinear_quarter_car(road=road)
+        with pytest.warns(DeprecationWarning, match="qc.road.Road"):
+            qc.nonlinear_quarter_car(road=road)

@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -306,13 +307,37 @@ def _damper_law(damper) -> Callable:
     return lambda v, q: float(damper(v))
 
 
+def _profile_of(road) -> Callable[[float], float] | None:
+    """The road height ``zr(t)`` [m] of a road given as a function of time: a
+    `qc_control.road.Road`'s ``height_at`` (read without its ``__call__``'s
+    dispatch), or a plain function itself; None for the input ``zr`` or none."""
+    if isinstance(road, bool) or not callable(road):
+        return None
+    return getattr(road, "height_at", road)
+
+
+def _warn_plain_road(road, stacklevel: int) -> None:
+    """A plain function ``zr(t)`` (with a patched ``.jumps``) was 0.1's road form:
+    it still runs, warning; a `qc_control.road.Road` carries its jumps itself."""
+    if callable(road) and not isinstance(road, bool) and not hasattr(road, "height_at"):
+        warnings.warn(
+            f"road={road!r}: a plain function zr(t) is deprecated and will be removed in "
+            "the next release: give a qc.road.Road (Step, Bump, Sine, a Profile of "
+            "measured points, or a Road subclass with height_at and jumps)",
+            DeprecationWarning,
+            stacklevel=stacklevel + 1,
+        )
+
+
 def _road_height(road, actuator: bool):
     """``(zr_at(t, u), inputs, ia)``: the road height [m] from the input ``zr`` or a
-    profile ``zr(t)`` (0 without either), the input labels, and the index of the
-    actuator force ``fa`` (None without one)."""
-    profile = road if callable(road) else None
+    road function ``zr(t)`` (0 without either), the input labels, and the index of
+    the actuator force ``fa`` (None without one)."""
+    profile = _profile_of(road)
     if profile is None and not isinstance(road, bool):
-        raise TypeError(f"road must be True, False or a callable zr(t) [m], got {road!r}")
+        raise TypeError(
+            f"road must be True, False or a qc.road.Road (a function zr(t) [m]), got {road!r}"
+        )
     road_input = road is True
     iz = 0 if road_input else None
     ia = (1 if road_input else 0) if actuator else None
@@ -428,13 +453,16 @@ def nonlinear_quarter_car(
     spring : None, float ``k3`` [N/m³] or callable ``F(d)`` [N] (0 at ``d = 0``)
     gravity : bool, default True
         Whether the tire carries the static load ``(ms + mu)·g``.
-    road : bool or callable ``zr(t)`` [m], default True
+    road : bool or qc_control.road.Road, default True
         True: the input ``zr`` [m], as in `quarter_car` (but on by default:
-        the nonlinear car is mostly driven by one). A callable: the road
-        height as a function of time, evaluated at every stage (no ``zr``
-        input), so that no interpolation of samples limits the order of a
-        convergence study. Its optional attribute ``jumps`` lists the times
-        [s] where it jumps (a step), which the system carries.
+        the nonlinear car is mostly driven by one). A `qc_control.road.Road`
+        (``qc.road.Step(0.05, 0.5)``, a measured ``qc.road.Profile``): the
+        road height as a function of time, its ``height_at(t)`` evaluated
+        at every stage (no ``zr`` input), so that no interpolation of
+        samples limits the order of a convergence study; its ``jumps`` (a
+        step's ``t0``) the system carries. A plain function ``zr(t)``, with
+        an optional attribute ``jumps``, still runs, with a
+        DeprecationWarning.
     actuator : bool
         The input ``fa`` [N], as in `quarter_car`.
     name : str
@@ -462,6 +490,7 @@ def nonlinear_quarter_car(
     >>> round(float(car.output(0, np.zeros(4), [0.0])[-1]), 1)  # the static wheel load [N]
     3934.4
     """
+    _warn_plain_road(road, stacklevel=2)
     p = as_params(params)
     if p.cu:  # its tire is a spring that may lift off; a tire damper is the linear car's
         raise ValueError(f"the nonlinear car has no tire damping: cu must be 0, got {p.cu!r}")
@@ -525,7 +554,10 @@ def nonlinear_quarter_car_model(params=None, **options) -> VehicleModel:
     ('body_acc', 'zr', 'tire_force')
     """
     p = as_params(params)
-    sys = nonlinear_quarter_car(p, **options)
+    _warn_plain_road(options.get("road"), stacklevel=2)
+    with warnings.catch_warnings():  # warned above, at the caller's line
+        warnings.simplefilter("ignore", DeprecationWarning)
+        sys = nonlinear_quarter_car(p, **options)
     corner = Corner(
         "",
         "susp_travel",
@@ -631,7 +663,9 @@ class NonlinearQuarterCarBatch:
     def __init__(self, ms, mu, ks, ku, cs, **options):
         a = _design_arrays({"ms": ms, "mu": mu, "ks": ks, "ku": ku, "cs": cs})
         first = {name: float(v[0]) for name, v in a.items()}
-        single = nonlinear_quarter_car(first, **options)  # checks the options once
+        with warnings.catch_warnings():  # a plain road function warned where the model was built
+            warnings.simplefilter("ignore", DeprecationWarning)
+            single = nonlinear_quarter_car(first, **options)  # checks the options once
         for which in ("spring", "damper"):
             fn = options.get(which)
             if callable(fn) and not isinstance(fn, PiecewiseDamper) and not _vectorises(fn):
@@ -653,7 +687,7 @@ class NonlinearQuarterCarBatch:
         self._damper = options.get("damper")
         self._stop = options.get("bump_stop")
         road = options.get("road", True)
-        self._profile = road if callable(road) else None
+        self._profile = _profile_of(road)
         self._iz = 0 if road is True else None
         self._ia = (1 if road is True else 0) if options.get("actuator", False) else None
         self._set(a)
