@@ -8,9 +8,12 @@ import pytest
 
 import qc_control as qc
 from qc_control.cli.parser import build_parser, run, scenario_from_args
-from qc_control.cli.scenario import BumpRoad, ISO8608Road, Scenario, ScenarioError
 from qc_control.models.halfcar import FullCarParams, HalfCarParams
 from qc_control.ride import road
+from qc_control.ride.road import Bump as BumpRoad
+from qc_control.ride.road import ISO8608Road
+from qc_control.studies.scenario import Scenario
+from qc_control.studies.scenario_toml import ScenarioError
 
 
 def test_model_defaults_and_the_free_release():
