@@ -56,9 +56,10 @@ from .scenario_toml import (
     ROAD_SECTION,
     RUN_KEYS,
     ScenarioError,
-    canonical_layout,
     config_text,
+    error_in_layout,
     load_config,
+    merged_layout,
     outside_level,
     parse_toml,
     read_config,
@@ -761,45 +762,22 @@ class Scenario:
             For an unknown key, a key that does not apply (a road parameter
             of another kind of road), or a bad value.
         """
-        over = canonical_layout(overrides or {})
-        try:
-            base = canonical_layout(values, source)
-        except ScenarioError as exc:
-            raise ScenarioError(exc.detail, exc.section, exc.key, source) from None
-        vehicle = dict(base["vehicle"])
-        if {"zeta", "cs"} & set(over["vehicle"]):
-            vehicle.pop("zeta", None)
-            vehicle.pop("cs", None)
-        vehicle.update(over["vehicle"])
-        run = {**base["run"], **over["run"]}
-        road = base["road"]
-        if "kind" in over["road"] and over["road"]["kind"] != road.get("kind", "none"):
-            road = dict(over["road"])
-        else:
-            road = {**road, **over["road"]}
-        given = {None: over["vehicle"], "scenario": over["run"], ROAD_SECTION: over["road"]}
+        layout = merged_layout(values, overrides, source)
+        run, road = layout["run"], layout["road"]
         try:
             fixed = {k: v for k, v in run.items() if k in RUN_KEYS}
             extra = {k: v for k, v in run.items() if k not in RUN_KEYS}
             if road:  # the file's table, as the Road it describes over the model's default
-                model = get_model(_model_name(fixed.get("model"), vehicle))
+                model = get_model(_model_name(fixed.get("model"), layout["vehicle"]))
                 road = _road(road, model.defaults.road)
             return cls(
-                vehicle=cast(Any, vehicle),
+                vehicle=cast(Any, layout["vehicle"]),
                 road=cast(Any, road or None),
                 model_options=extra or None,
                 **fixed,
             )
         except ScenarioError as exc:
-            from_overrides = exc.key is not None and exc.key in given.get(exc.section, {})
-            section, key, detail = exc.section, exc.key, exc.detail
-            if section == ROAD_SECTION and not from_overrides:
-                section = base["road_section"]
-                written = base["road_keys"].get(key, key)  # as the file spells it
-                if key is not None and written != key and detail.startswith(f"{key} "):
-                    detail = written + detail[len(key) :]
-                key = written
-            raise ScenarioError(detail, section, key, None if from_overrides else source) from None
+            raise error_in_layout(exc, layout, source) from None
 
     @classmethod
     def from_toml(cls, path, *, overrides: Mapping[str, Any] | None = None) -> Scenario:

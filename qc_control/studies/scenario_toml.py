@@ -75,6 +75,8 @@ __all__ = [
     "toml_value",
     "scenario_text",
     "canonical_layout",
+    "merged_layout",
+    "error_in_layout",
     "outside_level",
     "vehicle_config",
     "config_text",
@@ -271,6 +273,61 @@ def canonical_layout(doc: Mapping[str, Any], source: str | None = None) -> dict[
         "road_section": section,
         "road_keys": road_keys,
     }
+
+
+def merged_layout(
+    values: Mapping[str, Any], overrides: Mapping[str, Any] | None, source: str | None
+) -> dict[str, Any]:
+    """``overrides`` over ``values`` (each a TOML document's mapping), as
+    `canonical_layout` gives them, with ``given``: the keys the overrides gave.
+
+    Damping given in the overrides (``zeta`` or ``cs``) replaces both of
+    ``values``'; a road of another ``kind`` replaces ``values``' road, a road
+    of the same kind (or none given) updates it. An error in ``values`` names
+    ``source``.
+    """
+    over = canonical_layout(overrides or {})
+    try:
+        base = canonical_layout(values, source)
+    except ScenarioError as exc:
+        raise ScenarioError(exc.detail, exc.section, exc.key, source) from None
+    vehicle = dict(base["vehicle"])
+    if {"zeta", "cs"} & set(over["vehicle"]):
+        vehicle.pop("zeta", None)
+        vehicle.pop("cs", None)
+    vehicle.update(over["vehicle"])
+    road = base["road"]
+    if "kind" in over["road"] and over["road"]["kind"] != road.get("kind", "none"):
+        road = dict(over["road"])
+    else:
+        road = {**road, **over["road"]}
+    return {
+        **base,
+        "vehicle": vehicle,
+        "run": {**base["run"], **over["run"]},
+        "road": road,
+        "given": {None: over["vehicle"], "scenario": over["run"], ROAD_SECTION: over["road"]},
+    }
+
+
+def error_in_layout(
+    exc: ScenarioError, layout: Mapping[str, Any], source: str | None
+) -> ScenarioError:
+    """``exc`` located in the document (`merged_layout`'s) the bad value came from.
+
+    A value the overrides gave is theirs (no file named); a road key of the file
+    is named in its table and spelling (the flat ``[scenario] bump_height`` of an
+    earlier layout for ``height``).
+    """
+    from_overrides = exc.key is not None and exc.key in layout["given"].get(exc.section, {})
+    section, key, detail = exc.section, exc.key, exc.detail
+    if section == ROAD_SECTION and not from_overrides:
+        section = layout["road_section"]
+        written = layout["road_keys"].get(key, key)  # as the file spells it
+        if key is not None and written != key and detail.startswith(f"{key} "):
+            detail = written + detail[len(key) :]
+        key = written
+    return ScenarioError(detail, section, key, None if from_overrides else source)
 
 
 def _warn_legacy(road, legacy: Mapping[str, Any], source: str | None) -> None:
