@@ -273,10 +273,13 @@ class Scenario:
     vehicle : parameters or mapping, default the model's default vehicle
         The vehicle's parameters: `QuarterCarParams` (the seed's Table 1 by
         default), `HalfCarParams` or `FullCarParams`, as ``model`` says.
-    road : Road or mapping, default `NoRoad`
-        The road input, with all its parameters: `StepRoad`, `BumpRoad`,
-        `SineRoad` or `ISO8608Road`; a mapping ``{'kind': 'bump', ...}``
-        is read by `road_from_mapping`.
+    road : qc_control.road.Road, default `NoRoad` (the model's own road, if it has one)
+        The road input, with all its parameters: a `qc_control.road.Step`,
+        `~qc_control.road.Bump`, `~qc_control.road.Sine`,
+        `~qc_control.road.ISO8608Road` or `~qc_control.road.Profile`. A kind's
+        name (``'bump'``) or a table ``{'kind': 'bump', ...}`` (read by
+        `road_from_mapping`, the model's own road filling what it omits) is
+        deprecated: it warns, naming the `Road` to give.
     x0 : sequence of float, optional
         Initial state in the model's state order (the quarter car's
         ``[vs, vu, xs, xu]`` [m/s, m/s, m, m]). Default: the car at rest
@@ -336,7 +339,8 @@ class Scenario:
 
     Examples
     --------
-    >>> sc = Scenario(road=BumpRoad(height=0.1, speed=15.0))
+    >>> from qc_control.road import Bump
+    >>> sc = Scenario(road=Bump(height=0.1, speed=15.0))
     >>> sc.h, sc.x0, sc.steps
     (0.01, (0.0, 0.0, 0.0, 0.0), 1000)
     >>> sc.road_input()[1]
