@@ -396,6 +396,10 @@ def _add_control_report(sub, shown: str) -> None:
 def scenario_from_args(args: argparse.Namespace):
     """The `qc_control.Scenario` of parsed arguments: ``--config``, then the options over it.
 
+    The road options (``--road``, ``--road-height`` ...) over the config's road
+    table become one `qc_control.road.Road` (`Scenario.from_mapping`), the road
+    the Scenario is given.
+
     ``report`` reads the whole config; the other commands run no scenario and
     read only its vehicle (`vehicle_config`), so that a report's
     ``scenario.toml`` serves them too and its run's keys cannot be refused there.

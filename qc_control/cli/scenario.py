@@ -104,4 +104,6 @@ __all__ = [
 
 def __getattr__(name: str) -> Any:
     """The road kinds' earlier names (``BumpRoad``), each warning with its new one."""
-    return getattr(_new, name)
+    if name in ("StepRoad", "BumpRoad", "SineRoad"):
+        return getattr(_new, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
