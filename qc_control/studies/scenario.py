@@ -23,6 +23,7 @@ every stage), except an ISO 8608 road, which is sampled.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from collections.abc import Callable, Mapping
@@ -85,7 +86,8 @@ __all__ = [
 ]
 
 
-#: The largest |x0| entry: its square (RMS errors, energies) stays far inside float range.
+#: The largest magnitude of an x0 entry: its square (RMS errors, energies) stays far
+#: inside the range of a float.
 MAX_STATE = 1e150
 
 
@@ -713,8 +715,8 @@ class Scenario:
     def run(self, progress: Callable[[str], None] | None = None) -> MethodComparison:
         """Run the comparison: `qc_control.compare_methods` on this scenario.
 
-        Returns its `MethodComparison`, with ``cmp.scenario`` set to this
-        scenario (the report records it and its `command`).
+        Returns its `MethodComparison` with ``scenario`` this scenario (the
+        report records it and its `command`).
         """
         vehicle, T, U, description = self.problem()
         cmp = compare_methods(
@@ -729,9 +731,8 @@ class Scenario:
             **self.option_arguments("compare"),
         )
         if self.kind == "stiff" and cmp.ride is not None:  # on the road: a ride answer
-            cmp.ride_cost = stiff_car_ride_cost(cmp, progress=progress)
-        cmp.scenario = self
-        return cmp
+            cmp = dataclasses.replace(cmp, ride_cost=stiff_car_ride_cost(cmp, progress=progress))
+        return dataclasses.replace(cmp, scenario=self)  # a new comparison: it may be frozen
 
     # ------------------------------------------------------ reading, writing
 
