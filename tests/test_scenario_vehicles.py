@@ -12,6 +12,7 @@ from qc_control.models.halfcar import FullCarParams, HalfCarParams
 from qc_control.ride import road
 from qc_control.ride.road import Bump as BumpRoad
 from qc_control.ride.road import ISO8608Road
+from qc_control.ride.road import Step as StepRoad
 from qc_control.studies.scenario import Scenario
 from qc_control.studies.scenario_toml import ScenarioError
 
@@ -57,7 +58,7 @@ def test_full_car_iso_road_has_two_tracks():
 
 def test_roads_without_speed_and_parameters_of_another_model_are_refused():
     with pytest.raises(ScenarioError, match="a step road has no speed"):
-        Scenario(model="half", road={"kind": "step"})
+        Scenario(model="half", road=StepRoad())
     with pytest.raises(ScenarioError, match="Iy is a parameter of the half and full car"):
         Scenario.from_mapping({"Iy": 1000.0})
     with pytest.raises(ScenarioError, match="track_front is a parameter of the full car"):
