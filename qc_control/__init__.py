@@ -73,7 +73,6 @@ except PackageNotFoundError:  # pragma: no cover - a source tree that was never 
     __version__ = "0+unknown"
 
 if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
-    from .cli.scenario import Scenario, ScenarioError, load_config, read_config
     from .models.controllers import (
         HinfDesign,
         add_damper,
@@ -156,6 +155,8 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from .studies.identification import Identification, identify
     from .studies.measurement import Measurement
     from .studies.nlsweep import BatchResponse, simulate_batch
+    from .studies.scenario import Scenario
+    from .studies.scenario_toml import ScenarioError, load_config, read_config
     from .studies.sweeps import (
         DEFAULT_METRICS,
         METRICS,
@@ -206,16 +207,16 @@ _LAZY: dict[str, str] = {
     "OUTPUTS": "models.quarter",
     "STATES": "models.quarter",
     "QuarterCarParams": "models.quarter",
-    "load_config": "cli.scenario",
+    "load_config": "studies.scenario_toml",
     "quarter_car": "models.quarter",
-    "read_config": "cli.scenario",
+    "read_config": "studies.scenario_toml",
     "quarter_car_model": "models.quarter",
     "Metric": "ride.metrics",
     "RideSignals": "ride.metrics",
     "write_report": "report",
     "plot_outputs": "report.plotting",
-    "Scenario": "cli.scenario",
-    "ScenarioError": "cli.scenario",
+    "Scenario": "studies.scenario",
+    "ScenarioError": "studies.scenario_toml",
     "Corner": "models.vehicle",
     "ModelEntry": "models.registry",
     "ModelOption": "models.registry",

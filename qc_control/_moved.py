@@ -55,7 +55,7 @@ MOVED: dict[str, str | None] = {
     "plotting": "report.plotting",
     "recurrence": "numerics.recurrence",
     "response": "responses.timeresp",
-    "scenario": "cli.scenario",
+    "scenario": "studies.scenario",
     "spectral": "ride.spectral",
     "stability": "numerics.stability",
     "sweeps": "studies.sweeps",

@@ -34,8 +34,8 @@ from matplotlib.figure import Figure
 
 from qc_control import report as report_package
 from qc_control.cli import parser as parser_module
-from qc_control.cli import scenario as scenario_module
 from qc_control.report import comparison, writer
+from qc_control.studies import scenario as scenario_module
 
 
 @pytest.fixture
@@ -109,8 +109,8 @@ def half_car_report(tmp_path_factory) -> tuple:
     has: 25 error measures, 4 wheels' modes, 14 ride metrics, an 8-state A).
     """
     if "half" not in _SHARED:
-        from qc_control.cli.scenario import Scenario
         from qc_control.report import write_report
+        from qc_control.studies.scenario import Scenario
 
         cmp = Scenario(model="half", road={"kind": "bump", "speed": 10.0}, t_end=2.0).run()
         out = tmp_path_factory.mktemp("half-car") / "report"

@@ -25,8 +25,10 @@ from qc_control.cli import console
 from qc_control.cli import parser as cli
 from qc_control.cli.console import main
 from qc_control.cli.parser import build_parser, scenario_from_args
-from qc_control.cli.scenario import MAX_CONFIG_BYTES, BumpRoad, Scenario
+from qc_control.ride.road import Bump as BumpRoad
 from qc_control.studies import control_study
+from qc_control.studies.scenario import Scenario
+from qc_control.studies.scenario_toml import MAX_CONFIG_BYTES
 
 #: Streams without end where the system has them (a large file stands in elsewhere).
 DEVICES = [d for d in ("/dev/zero", "/dev/urandom") if Path(d).exists()]
@@ -256,7 +258,7 @@ def test_internal_error_is_not_a_usage_error(files, monkeypatch, error, capsys):
     def broken(*args, **kwargs):
         raise error
 
-    monkeypatch.setattr("qc_control.cli.scenario.compare_methods", broken)
+    monkeypatch.setattr("qc_control.studies.scenario.compare_methods", broken)
     status = main(["report", "--t-end", "1", "--methods", "rk4", "--out", "R"])
     err = capsys.readouterr().err
     assert status == 1  # never 2: a bug is not passed off as bad input
@@ -273,7 +275,7 @@ def test_a_spent_reference_budget_is_one_line(files, monkeypatch, capsys):
     def stalled(*args, **kwargs):
         raise ReferenceBudgetError("the nonlinear reference spent its budget")
 
-    monkeypatch.setattr("qc_control.cli.scenario.compare_methods", stalled)
+    monkeypatch.setattr("qc_control.studies.scenario.compare_methods", stalled)
     status = main(["report", "--quiet", "--t-end", "1", "--methods", "rk4", "--out", "R"])
     err = capsys.readouterr().err
     assert status == 2

@@ -79,3 +79,24 @@ def test_public_names_stay_what_they_are_after_an_old_import(monkeypatch):
 def test_a_name_that_never_was_is_still_an_import_error():
     with pytest.raises(ModuleNotFoundError):
         importlib.import_module("qc_control.no_such_module")
+
+
+def test_the_command_lines_scenario_module_hands_on_the_moved_scenario(monkeypatch):
+    """``qc_control.cli.scenario`` (where `Scenario` and its TOML lived) imports with
+    a warning naming the new homes, and hands on what it had: the same objects."""
+    from qc_control.ride import road
+    from qc_control.studies import scenario, scenario_command, scenario_toml
+
+    monkeypatch.delitem(sys.modules, "qc_control.cli.scenario", raising=False)
+    with pytest.warns(DeprecationWarning, match=r"import qc_control\.studies\.scenario") as seen:
+        import qc_control.cli.scenario as old
+    assert seen[0].filename == __file__  # the importing line, not the import system
+    assert old.Scenario is scenario.Scenario is qc.Scenario
+    assert old.ScenarioError is scenario_toml.ScenarioError is qc.ScenarioError
+    assert old.read_config is qc.read_config and old.load_config is qc.load_config
+    assert old.command_line is scenario_command.command_line
+    assert old.road_from_mapping is scenario_toml.road_from_mapping
+    for name in old.__all__:
+        assert getattr(old, name) is not None, name
+    with pytest.warns(DeprecationWarning, match=r"use qc_control\.road\.Bump"):
+        assert old.BumpRoad is road.Bump

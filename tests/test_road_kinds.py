@@ -8,8 +8,6 @@ points, as python-control reads an input between samples).
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 
@@ -112,9 +110,11 @@ def test_rear_wheels_meet_the_road_a_wheelbase_later():
 
 
 def test_the_command_lines_names_are_the_kinds():
-    from qc_control.cli import scenario
+    """The command line's earlier names answer with the kinds, and a warning naming them."""
+    from qc_control.studies import scenario
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        assert scenario.StepRoad is road.Step and scenario.BumpRoad is road.Bump
+    with pytest.warns(DeprecationWarning, match=r"StepRoad is deprecated.*qc_control\.road\.Step"):
+        assert scenario.StepRoad is road.Step
+    with pytest.warns(DeprecationWarning, match=r"BumpRoad is deprecated.*qc_control\.road\.Bump"):
+        assert scenario.BumpRoad is road.Bump
     assert qc.ISO8608Road is road.ISO8608Road

@@ -18,7 +18,9 @@ import pytest
 from qc_control.cli import parser as cli
 from qc_control.cli.console import main
 from qc_control.cli.parser import build_parser, scenario_from_args
-from qc_control.cli.scenario import BumpRoad, NoRoad, Scenario
+from qc_control.ride.road import Bump as BumpRoad
+from qc_control.ride.road import NoRoad
+from qc_control.studies.scenario import Scenario
 
 MODELS = ("quarter", "half", "full", "nonlinear")
 #: The bump every model is driven over below: 8 cm high, 2 m long, at 10 m/s.

@@ -1,4 +1,4 @@
-"""qc_control.cli.scenario: validation, defaults from where they are defined, TOML, command, run.
+"""qc_control.studies.scenario: validation, defaults from where they are defined, TOML, run.
 
 References: the road functions of `qc_control.ride.road` called directly (road
 samples), the functions' own signatures (defaults), `compare_methods` called
@@ -9,6 +9,8 @@ import inspect
 import math
 import re
 import shlex
+import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -16,24 +18,19 @@ import pandas as pd
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from reports_shared import run_untimed
 
 from qc_control import QuarterCarParams, compare_methods
 from qc_control.cli.parser import build_parser, scenario_from_args
-from qc_control.cli.scenario import (
-    MAX_CONFIG_BYTES,
-    MAX_STEPS,
-    ROADS,
-    BumpRoad,
-    ISO8608Road,
-    NoRoad,
-    Scenario,
-    ScenarioError,
-    SineRoad,
-    StepRoad,
-    read_config,
-)
 from qc_control.ride import road
+from qc_control.ride.road import ROADS, Bump, ISO8608Road, NoRoad, Sine, Step
+from qc_control.ride.road import Bump as BumpRoad
+from qc_control.ride.road import Sine as SineRoad
+from qc_control.ride.road import Step as StepRoad
+from qc_control.studies import scenario as scenario_module
 from qc_control.studies.compare import DEFAULT_H, DEFAULT_METHODS, DEFAULT_T_END, DEFAULT_X0
+from qc_control.studies.scenario import NONLINEAR_ROAD, Scenario
+from qc_control.studies.scenario_toml import MAX_CONFIG_BYTES, MAX_STEPS, ScenarioError, read_config
 
 try:
     import tomllib
@@ -64,8 +61,8 @@ BAD = [
     (dict(t_end=1e308, h=1.0), "is 1e+308 steps per method"),
     (dict(t_end=1e6, h=0.01), "is 1e+08 steps per method (and more for the refinements"),
     (dict(t_end=1e6, h=0.01), f"above max_steps = {MAX_STEPS:,}"),
-    (dict(max_steps=0), "[scenario] max_steps must be an integer >= 2, got 0"),
-    (dict(max_steps=1.5e6), "max_steps must be an integer >= 2, got 1500000.0"),
+    (dict(max_steps=0), "[scenario] max_steps must be a whole number >= 2, got 0"),
+    (dict(max_steps=1.5e6), "max_steps must be a whole number >= 2, got 1500000.0"),
     (dict(x0=[1, 2]), "[scenario] x0 must be 4 comma-separated numbers, all finite: vs, vu"),
     (dict(x0=[0, 0, math.inf, 0]), "x0 must be 4 comma-separated numbers"),
     (dict(x0="0,0,a,0"), "vs, vu, xs, xu [m/s, m/s, m, m]; got '0,0,a,0'"),
@@ -419,6 +416,52 @@ def test_run_is_compare_methods_on_the_scenario():
     pd.testing.assert_frame_equal(
         cmp.table.drop(columns=timing), direct.table.drop(columns=timing), check_exact=True
     )
+
+
+#: Each older form of a scenario's road beside the `Road` it stands for: a kind's
+#: name, a table (the nonlinear car's takes what it omits from its default bump).
+OLDER_ROAD_FORMS = [
+    ("quarter", {"kind": "bump", "height": 0.1, "speed": 15.0}, Bump(height=0.1, speed=15.0)),
+    ("quarter", "step", Step()),
+    ("half", {"kind": "bump", "speed": 10.0}, Bump(speed=10.0)),
+    ("nonlinear", {"kind": "bump", "height": 0.05}, replace(NONLINEAR_ROAD, height=0.05)),
+]
+
+
+@pytest.mark.parametrize("model, older, new", OLDER_ROAD_FORMS)
+def test_a_road_gives_the_report_numbers_of_the_older_form_to_the_bit(model, older, new):
+    """``Scenario(road=Road)`` and the older form it replaces run the same comparison:
+    the reference is the older API's own result, every number of the table bit for bit
+    (but the wall times, which are not run: `run_untimed`)."""
+    grid = dict(model=model, t_end=1.0, h=0.01, methods=("heun", "rk4"))
+    if model == "nonlinear":
+        grid.update(t_end=0.2, h=0.002)
+    with pytest.warns(DeprecationWarning, match=r"give a qc_control\.road\.Road, road=qc_"):
+        old = Scenario(road=older, **grid)
+    sc = Scenario(road=new, **grid)
+    assert sc == old
+    cmp, before = run_untimed(sc), run_untimed(old)
+    np.testing.assert_array_equal(cmp.T, before.T)
+    if before.U is not None:
+        np.testing.assert_array_equal(cmp.U, before.U)
+    assert cmp.input_description == before.input_description
+    pd.testing.assert_frame_equal(cmp.table, before.table, check_exact=True)
+
+
+def test_the_older_forms_warn_naming_the_road_to_give():
+    with pytest.warns(DeprecationWarning) as seen:
+        Scenario(road={"kind": "sine", "frequency": 2.0})
+    assert str(seen[0].message).endswith("road=qc_control.road.Sine(amplitude=0.01, frequency=2.0)")
+    assert seen[0].filename == __file__  # the user's line, not the package's
+    for name, kind in [("StepRoad", Step), ("BumpRoad", Bump), ("SineRoad", Sine)]:
+        with pytest.warns(DeprecationWarning, match=rf"{name} is deprecated.*qc_control\.road\."):
+            assert getattr(scenario_module, name) is kind
+    # a TOML file's road table is its format: read without a warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)
+        sc = Scenario.from_toml_string('[scenario.road]\nkind = "bump"\nspeed = 15.0\n')
+        assert sc.road == Bump(speed=15.0)
+        assert Scenario(road=Bump(speed=15.0)) == sc
 
 
 def test_every_kind_is_registered():

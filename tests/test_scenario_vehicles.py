@@ -8,9 +8,13 @@ import pytest
 
 import qc_control as qc
 from qc_control.cli.parser import build_parser, run, scenario_from_args
-from qc_control.cli.scenario import BumpRoad, ISO8608Road, Scenario, ScenarioError
 from qc_control.models.halfcar import FullCarParams, HalfCarParams
 from qc_control.ride import road
+from qc_control.ride.road import Bump as BumpRoad
+from qc_control.ride.road import ISO8608Road
+from qc_control.ride.road import Step as StepRoad
+from qc_control.studies.scenario import Scenario
+from qc_control.studies.scenario_toml import ScenarioError
 
 
 def test_model_defaults_and_the_free_release():
@@ -54,7 +58,7 @@ def test_full_car_iso_road_has_two_tracks():
 
 def test_roads_without_speed_and_parameters_of_another_model_are_refused():
     with pytest.raises(ScenarioError, match="a step road has no speed"):
-        Scenario(model="half", road={"kind": "step"})
+        Scenario(model="half", road=StepRoad())
     with pytest.raises(ScenarioError, match="Iy is a parameter of the half and full car"):
         Scenario.from_mapping({"Iy": 1000.0})
     with pytest.raises(ScenarioError, match="track_front is a parameter of the full car"):

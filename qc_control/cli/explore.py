@@ -39,9 +39,11 @@ from ..models.quarter import QuarterCarParams
 from ..numerics.messages import install_hint
 from ..numerics.methods import TABLEAUS
 from ..numerics.stability import stability_boundary
+from ..numerics.steps import whole_step
 from ..studies.compare import DEFAULT_METHODS
 from ..studies.quick import QuickComparison, error_ladder, ladder_steps, quick_comparison
-from .scenario import CLI_ROADS, MAX_STEPS, Scenario, ScenarioError, road_from_mapping, whole_step
+from ..studies.scenario import Scenario
+from ..studies.scenario_toml import CLI_ROADS, MAX_STEPS, ScenarioError, road_from_mapping
 
 __all__ = [
     "explorer",
@@ -114,7 +116,7 @@ def scenario_of(values: dict[str, Any]) -> Scenario:
     """The `Scenario` of the page's values: the vehicle, start, road, grid and methods.
 
     ``h`` [ms] is moved to the nearest step that divides ``t_end``
-    (`qc_control.cli.scenario.whole_step`); a run of more than `MAX_STEPS`
+    (`qc_control.numerics.steps.whole_step`); a run of more than `MAX_STEPS`
     steps is given ``max_steps = EXPLORE_MAX_STEPS``, so that longer ones are
     refused with the command line's message. Raises `ScenarioError` for a
     bad value.

@@ -31,24 +31,21 @@ from ..report import ReportError, check_target, report_lock, report_path, write_
 from ..report.control import unavailable_designs, write_control_report
 from ..studies.compare import ReferenceBudgetError
 from ..studies.control_study import DESIGNS, compare_controllers
-from .commands import COMMANDS, PROG, UsageError, error_line, top_level
-from .measured import CommandTools as _CommandTools
-from .measured import add_measured_commands
-from .scenario import (
+from ..studies.scenario import Scenario
+from ..studies.scenario_command import command_line, option_flag, option_name, road_option
+from ..studies.scenario_toml import (
     CLI_ROADS,
     DEFAULT_MODEL,
-    Scenario,
     ScenarioError,
-    command_line,
-    option_flag,
-    option_name,
     outside_level,
     road_from_mapping,
-    road_option,
     run_keys,
     vehicle_config,
     vehicle_keys,
 )
+from .commands import COMMANDS, PROG, UsageError, error_line, top_level
+from .measured import CommandTools as _CommandTools
+from .measured import add_measured_commands
 
 __all__ = ["run", "build_parser", "scenario_from_args", "summarise_warnings", "UsageError"]
 
@@ -398,6 +395,10 @@ def _add_control_report(sub, shown: str) -> None:
 
 def scenario_from_args(args: argparse.Namespace):
     """The `qc_control.Scenario` of parsed arguments: ``--config``, then the options over it.
+
+    The road options (``--road``, ``--road-height`` ...) over the config's road
+    table become one `qc_control.road.Road` (`Scenario.from_mapping`), the road
+    the Scenario is given.
 
     ``report`` reads the whole config; the other commands run no scenario and
     read only its vehicle (`vehicle_config`), so that a report's
