@@ -10,6 +10,7 @@ from conftest import valid_params
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import qc_control as qc
 from qc_control import QuarterCarParams, load_config, quarter_car
 
 SEED = dict(ms=301.2, mu=100.0, ks=30000.0, ku=29530.0)
@@ -64,7 +65,9 @@ def test_bad_damping_names_field_and_value(field, value):
 
 
 def test_non_number_is_rejected():
-    with pytest.raises(ValueError, match=r"ms \(sprung mass\) must be a number in kg, got '300'"):
+    # a string is not a number: the one checker's words, naming the field and the value
+    match = r"ms \(sprung mass\) must be a finite number > 0 kg, got '300'"
+    with pytest.raises(qc.ParameterError, match=match):
         QuarterCarParams(ms="300")
 
 
@@ -100,7 +103,9 @@ def test_toml_unknown_key_is_named(tmp_path):
 def test_toml_bad_value_names_file_and_field(tmp_path):
     path = tmp_path / "car.toml"
     path.write_text("mu = -5.0\n")
-    with pytest.raises(ValueError, match=r"car.toml.*mu .* must be > 0 kg, got -5.0"):
+    with pytest.raises(
+        ValueError, match=r"car.toml.*mu .* must be a finite number > 0 kg, got -5.0"
+    ):
         load_config(path)
 
 

@@ -13,7 +13,8 @@ with `check_fields`.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+import re
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,6 +24,7 @@ __all__ = [
     "Field",
     "ParameterError",
     "check_fields",
+    "field_in",
     "choice",
     "finite",
     "integer",
@@ -165,11 +167,11 @@ def choice(name: str, value, options: Iterable[Any]) -> Any:
     raise ParameterError(name, value, f"one of {listed}")
 
 
-#: How a `Field` bounds its value: the checker that enforces it.
-_KINDS = {
-    "positive": positive,
-    "nonneg": nonnegative,
-    "finite": finite,
+#: How a `Field`'s kind bounds its value from below: ``(low, low_open)``.
+_KINDS: dict[str, tuple[float | None, bool]] = {
+    "positive": (0.0, True),
+    "nonneg": (0.0, False),
+    "finite": (None, False),
 }
 
 
@@ -177,22 +179,54 @@ _KINDS = {
 class Field:
     """One parameter's declaration: what it is, its SI unit, its range.
 
-    ``kind`` is ``"positive"`` (> 0), ``"nonneg"`` (>= 0) or ``"finite"``;
-    ``optional`` lets the value be None (derived later, as ``zeta`` from ``cs``).
+    ``kind`` is ``"positive"`` (> 0), ``"nonneg"`` (>= 0) or ``"finite"``
+    (any finite number, or from ``low``: a lower bound other than 0, as a
+    growth factor's > 1); ``high`` adds an upper bound (a ratio in (0, 1]),
+    ``low_open``/``high_open`` exclude the bounds, ``allow_inf`` lets the
+    value be infinite (a clearance or a knee that is "none"). ``optional``
+    lets the value be None (derived later, as ``zeta`` from ``cs``).
+
+    Examples
+    --------
+    >>> Field("growth factor", "", "finite", low=1.0, low_open=True).check("max_factor", 10)
+    10.0
     """
 
     description: str
     unit: str
     kind: str = "positive"
     optional: bool = False
+    high: float | None = None
+    high_open: bool = False
+    allow_inf: bool = False
+    low: float | None = None
+    low_open: bool = False
 
     def __post_init__(self):
         choice("kind", self.kind, _KINDS)
+        if self.low is not None and self.kind != "finite":
+            raise ParameterError(
+                "low", self.low, f"None with kind {self.kind!r}, whose lower bound is 0"
+            )
+
+    @property
+    def bounds(self) -> dict[str, Any]:
+        """The keyword arguments of `number` that enforce this declaration."""
+        low, low_open = (self.low, self.low_open) if self.low is not None else _KINDS[self.kind]
+        return {
+            "low": low,
+            "low_open": low_open,
+            "high": self.high,
+            "high_open": self.high_open,
+            "allow_inf": self.allow_inf,
+        }
 
     def check(self, name: str, value) -> float | None:
+        """``value`` as a float in the declared range (None if optional and
+        None), or a `ParameterError` naming ``name``, the description and the unit."""
         if value is None and self.optional:
             return None
-        return _KINDS[self.kind](name, value, self.unit, description=self.description)
+        return number(name, value, self.unit, description=self.description, **self.bounds)
 
 
 def check_fields(obj, spec: Mapping[str, Field]) -> None:
@@ -200,3 +234,16 @@ def check_fields(obj, spec: Mapping[str, Field]) -> None:
     declared in ``spec``, refusing the first bad one by name."""
     for name, field in spec.items():
         object.__setattr__(obj, name, field.check(name, getattr(obj, name)))
+
+
+def field_in(expression: str, names: Sequence[str]) -> str:
+    """The first of ``names`` that a formula reads: ``'ks'`` of
+    ``'sqrt(ks/ms)'``, ``'cs_front'`` of ``'cs_front*a²/Iy'``, ``'ms'`` of
+    ``'sqrt(Σks/ms)'`` (a sum is no one field); ``names[0]`` if none.
+
+    A check across fields (a vehicle's time scales) refuses with a
+    `ParameterError` naming this field, the formula and every value staying
+    in its text, so that a caller who reads ``.name`` is pointed at a
+    parameter the user gave.
+    """
+    return next((w for w in re.findall(r"(?<![Σ\w])\w+", expression) if w in names), names[0])
