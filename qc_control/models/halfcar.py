@@ -58,7 +58,7 @@ from typing import Any, ClassVar
 import control
 import numpy as np
 
-from ..numerics.checks import Field, ParameterError, check_fields, field_in
+from ..numerics.checks import Field, ParameterError, blamed_field, check_fields
 from .quarter import MAX_RATE_SPAN
 from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel, params_as
 
@@ -176,7 +176,7 @@ class _VehicleParams:
         bad = next((k for k, r in rates.items() if not math.isfinite(r)), None)
         if bad is not None:
             self._refuse(
-                field_in(bad, list(self.spec())),
+                blamed_field(self, bad),
                 f"a value for which the {self.kind} car's matrix is finite, but it would not "
                 f"be finite: {bad} overflows to {rates[bad]!r} ({self._values()})",
             )
@@ -184,7 +184,7 @@ class _VehicleParams:
         fast = max(rates, key=rates.__getitem__)
         if rates[fast] > MAX_RATE_SPAN * stiff[slow]:
             self._refuse(
-                field_in(fast, list(self.spec())),
+                blamed_field(self, fast),
                 f"a value whose modes can be resolved in double precision, but the "
                 f"{self.kind} car's time scales span more than {MAX_RATE_SPAN:.0e}: {fast} = "
                 f"{rates[fast]:.3g} 1/s against {slow} = {stiff[slow]:.3g} 1/s "

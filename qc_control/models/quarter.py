@@ -34,7 +34,7 @@ from typing import Any
 import control
 import numpy as np
 
-from ..numerics.checks import Field, ParameterError, check_fields, field_in
+from ..numerics.checks import Field, ParameterError, blamed_field, check_fields
 from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel, params_as
 
 __all__ = [
@@ -230,8 +230,8 @@ class QuarterCarParams:
             )
 
     def _refuse(self, rate: str, expected: str) -> None:
-        """A `ParameterError` naming the field the refused ``rate`` is read from."""
-        name = field_in(rate, list(_SPEC))
+        """A `ParameterError` naming the field the refused ``rate`` most likely blames."""
+        name = blamed_field(self, rate)
         raise ParameterError(
             name, getattr(self, name), expected, description=_SPEC[name].description
         )

@@ -12,10 +12,10 @@ with `check_fields`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
-from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
@@ -24,7 +24,7 @@ __all__ = [
     "Field",
     "ParameterError",
     "check_fields",
-    "field_in",
+    "blamed_field",
     "choice",
     "finite",
     "integer",
@@ -175,7 +175,7 @@ _KINDS: dict[str, tuple[float | None, bool]] = {
 }
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class Field:
     """One parameter's declaration: what it is, its SI unit, its range.
 
@@ -236,14 +236,37 @@ def check_fields(obj, spec: Mapping[str, Field]) -> None:
         object.__setattr__(obj, name, field.check(name, getattr(obj, name)))
 
 
-def field_in(expression: str, names: Sequence[str]) -> str:
-    """The first of ``names`` that a formula reads: ``'ks'`` of
-    ``'sqrt(ks/ms)'``, ``'cs_front'`` of ``'cs_front*a²/Iy'``, ``'ms'`` of
-    ``'sqrt(Σks/ms)'`` (a sum is no one field); ``names[0]`` if none.
+def blamed_field(obj, expression: str) -> str:
+    """The field of the dataclass ``obj`` a refused formula most likely blames.
 
-    A check across fields (a vehicle's time scales) refuses with a
-    `ParameterError` naming this field, the formula and every value staying
-    in its text, so that a caller who reads ``.name`` is pointed at a
-    parameter the user gave.
+    Of the fields ``expression`` reads (``ks`` and ``mu`` in
+    ``'sqrt(ks/mu)'``; ``'Σks'``, a sum, is no one field), the one whose
+    value lies the most orders of magnitude from its default,
+    ``|log10(value/default)|``; the first field of ``obj`` if the formula
+    reads none. A check across fields (a vehicle's time scales) refuses with
+    a `ParameterError` naming it, the formula and every value staying in the
+    text, so that a caller who reads ``.name`` is pointed at the parameter
+    the user most likely mistyped.
+
+    Examples
+    --------
+    >>> from dataclasses import dataclass
+    >>> @dataclass
+    ... class Car:
+    ...     ks: float = 3e4
+    ...     mu: float = 100.0
+    >>> blamed_field(Car(mu=1e-305), "ks/mu")
+    'mu'
     """
-    return next((w for w in re.findall(r"(?<![Σ\w])\w+", expression) if w in names), names[0])
+    declared = {f.name: f.default for f in dataclasses.fields(obj)}
+    read = [w for w in re.findall(r"(?<![Σ\w])\w+", expression) if w in declared]
+
+    def distance(name: str) -> float:
+        value, default = getattr(obj, name), declared[name]
+        if not (_real(value) and _real(default)) or value == default:
+            return 0.0
+        if value == 0 or default == 0 or not math.isfinite(value / default):
+            return math.inf
+        return abs(math.log10(abs(value / default)))
+
+    return max(read, key=distance) if read else next(iter(declared))
