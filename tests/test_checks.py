@@ -272,3 +272,13 @@ def test_checks_across_fields_name_the_field(build, name, words):
         build()
     assert info.value.name == name and str(info.value).startswith(name)
     assert words in str(info.value)
+
+
+def test_a_field_holds_an_array_of_designs_by_the_declared_range():
+    # the batch path (thousands of designs at once) against this test's own reading
+    # of each declaration, for numbers in and out of range
+    values = [-1.0, 0.0, 0.5, 1.0, 1.5, 3e4, math.nan, math.inf, -math.inf]
+    for cls in PARAMETER_CLASSES:
+        for field in cls.spec().values():
+            want = [not _declared_out_of_range(field, v) for v in values]
+            assert field.holds(values).tolist() == want, (cls, field)

@@ -646,8 +646,7 @@ def _design_arrays(values: dict) -> dict[str, np.ndarray]:
         )
     spec = QuarterCarParams.spec()  # each design's range, as its constructor's
     for name, a in out.items():
-        low, low_open = spec[name].bounds["low"], spec[name].bounds["low_open"]
-        bad = np.flatnonzero(~np.isfinite(a) | ((a <= low) if low_open else (a < low)))
+        bad = np.flatnonzero(~spec[name].holds(a))
         if bad.size:
             i = int(bad[0])
             spec[name].check(f"{name}[{i}]", float(a[i]))  # refuses, naming the design

@@ -295,11 +295,11 @@ class QuarterCarParams:
         zeta, cs = columns.get("zeta", np.nan), columns.get("cs", np.nan)
         has_zeta, has_cs = "zeta" in keys, "cs" in keys
         with np.errstate(all="ignore"):
-            ok = np.isfinite(ms) & np.isfinite(mu) & np.isfinite(ks) & np.isfinite(ku)
-            ok &= (ms > 0) & (mu > 0) & (ks > 0) & (ku > 0)
-            for given, value in ((has_zeta, zeta), (has_cs, cs)):
-                if given:
-                    ok &= np.isfinite(value) & (value >= 0)
+            # each given value in its declared range, as check_fields finds it
+            # (the defaults of the others are in theirs)
+            ok = np.ones(m, dtype=bool)
+            for name, column in columns.items():
+                ok &= _SPEC[name].holds(column)
             critical = 2.0 * np.sqrt(ks) * np.sqrt(ms)
             if not has_cs:
                 zeta = zeta if has_zeta else np.full(m, 0.25)

@@ -221,6 +221,19 @@ class Field:
             "allow_inf": self.allow_inf,
         }
 
+    def holds(self, values) -> np.ndarray:
+        """Elementwise, whether each number of the array ``values`` is in the
+        declared range (`check`'s rule, for many designs at once; NaN never is)."""
+        b = self.bounds
+        a = np.asarray(values, dtype=float)
+        with np.errstate(invalid="ignore"):
+            ok = ~np.isnan(a) if b["allow_inf"] else np.isfinite(a)
+            if b["low"] is not None:
+                ok &= (a > b["low"]) if b["low_open"] else (a >= b["low"])
+            if b["high"] is not None:
+                ok &= (a < b["high"]) if b["high_open"] else (a <= b["high"])
+        return ok
+
     def check(self, name: str, value) -> float | None:
         """``value`` as a float in the declared range (None if optional and
         None), or a `ParameterError` naming ``name``, the description and the unit."""
