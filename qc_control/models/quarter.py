@@ -298,8 +298,8 @@ class QuarterCarParams:
             # each given value in its declared range, as check_fields finds it
             # (the defaults of the others are in theirs)
             ok = np.ones(m, dtype=bool)
-            for name, column in columns.items():
-                ok &= _SPEC[name].holds(column)
+            for name, given in columns.items():
+                ok &= _SPEC[name].holds(given)
             critical = 2.0 * np.sqrt(ks) * np.sqrt(ms)
             if not has_cs:
                 zeta = zeta if has_zeta else np.full(m, 0.25)
