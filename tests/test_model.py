@@ -81,8 +81,10 @@ def test_inconsistent_zeta_and_cs():
 
 
 def test_unknown_key_in_dict_is_named():
-    with pytest.raises(ValueError, match="unknown parameter 'kt'"):
+    words = r"kt \(unknown parameter\) must be a parameter of QuarterCarParams: one of \['cs'"
+    with pytest.raises(qc.ParameterError, match=words) as info:
         QuarterCarParams.from_mapping({"ms": 300.0, "kt": 1.0})
+    assert info.value.name == "kt"  # what a command line points at
 
 
 def test_toml_config(tmp_path):
@@ -96,7 +98,7 @@ def test_toml_config(tmp_path):
 def test_toml_unknown_key_is_named(tmp_path):
     path = tmp_path / "car.toml"
     path.write_text("ms = 350.0\nspring = 3\n")
-    with pytest.raises(ValueError, match="unknown parameter 'spring'"):
+    with pytest.raises(ValueError, match=r"spring \(unknown parameter\) .* got 'spring'"):
         load_config(path)
 
 

@@ -58,7 +58,7 @@ from typing import Any, ClassVar
 import control
 import numpy as np
 
-from ..numerics.checks import Field, ParameterError, blamed_field, check_fields
+from ..numerics.checks import Field, ParameterError, blamed_field, check_fields, instance_from
 from .quarter import MAX_RATE_SPAN
 from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel, params_as
 
@@ -231,12 +231,8 @@ class _VehicleParams:
 
     @classmethod
     def from_mapping(cls, values: Mapping[str, Any]):
-        """Build from a dict; an unknown key raises ``ValueError`` naming it."""
-        names = sorted(f.name for f in fields(cls))  # type: ignore[arg-type]
-        unknown = sorted(set(values) - set(names))
-        if unknown:
-            raise ValueError(f"unknown parameter {unknown[0]!r}; expected one of {names}")
-        return cls(**dict(values))
+        """Build from a dict; an unknown key is a `qc_control.ParameterError` naming it."""
+        return instance_from(cls, values)
 
     def to_dict(self, *, changing: Iterable[str] | None = None) -> dict[str, float]:
         """Every field as a plain dict. ``changing`` is accepted for the sweep

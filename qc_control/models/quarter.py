@@ -34,7 +34,7 @@ from typing import Any
 import control
 import numpy as np
 
-from ..numerics.checks import Field, ParameterError, blamed_field, check_fields
+from ..numerics.checks import Field, ParameterError, blamed_field, check_fields, instance_from
 from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel, params_as
 
 __all__ = [
@@ -247,11 +247,8 @@ class QuarterCarParams:
 
     @classmethod
     def from_mapping(cls, values: Mapping[str, Any]) -> QuarterCarParams:
-        """Build from a dict; an unknown key raises ``ValueError`` naming it."""
-        unknown = sorted(set(values) - _FIELDS)
-        if unknown:
-            raise ValueError(f"unknown parameter {unknown[0]!r}; expected one of {sorted(_FIELDS)}")
-        return cls(**dict(values))
+        """Build from a dict; an unknown key is a `qc_control.ParameterError` naming it."""
+        return instance_from(cls, values)
 
     @classmethod
     def from_mappings(cls, designs: Sequence[Any]) -> list[QuarterCarParams | None]:

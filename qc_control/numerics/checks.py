@@ -24,6 +24,7 @@ __all__ = [
     "Field",
     "ParameterError",
     "check_fields",
+    "instance_from",
     "blamed_field",
     "choice",
     "finite",
@@ -283,3 +284,21 @@ def blamed_field(obj, expression: str) -> str:
         return abs(math.log10(abs(value / default)))
 
     return max(read, key=distance) if read else next(iter(declared))
+
+
+def instance_from(cls, values: Mapping[str, Any]):
+    """``cls(**values)`` for a parameter dataclass ``cls``, an unknown key
+    refused first: a `ParameterError` whose ``.name`` is the key (so that a
+    command line or a TOML loader points at it), listing the parameters
+    ``cls`` has. The ``from_mapping`` of every car's parameter class.
+    """
+    names = sorted(f.name for f in dataclasses.fields(cls))
+    unknown = sorted(set(values) - set(names))
+    if unknown:
+        raise ParameterError(
+            unknown[0],
+            unknown[0],
+            f"a parameter of {cls.__name__}: one of {names}",
+            description="unknown parameter",
+        )
+    return cls(**dict(values))
