@@ -129,8 +129,8 @@ def files(tmp_path, monkeypatch):
 
 
 BAD = [
-    (["modes", "--ms", "-1"], "ms (sprung mass) must be > 0 kg, got -1.0"),
-    (["modes", "--ku", "nan"], "ku must be finite, got nan"),
+    (["modes", "--ms", "-1"], "ms (sprung mass) must be a finite number > 0 kg, got -1.0"),
+    (["modes", "--ku", "nan"], "ku (tire stiffness) must be a finite number > 0 N/m, got nan"),
     (["modes", "--ms", "abc"], "--ms: invalid float value: 'abc'"),
     (["modes", "--config", "missing.toml"], "config file 'missing.toml' cannot be read"),
     (["modes", "--config", "binary.toml"], "config file 'binary.toml' is not a TOML text file"),

@@ -10,6 +10,7 @@ from conftest import valid_params
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import qc_control as qc
 from qc_control import QuarterCarParams, load_config, quarter_car
 
 SEED = dict(ms=301.2, mu=100.0, ks=30000.0, ku=29530.0)
@@ -64,7 +65,9 @@ def test_bad_damping_names_field_and_value(field, value):
 
 
 def test_non_number_is_rejected():
-    with pytest.raises(ValueError, match=r"ms \(sprung mass\) must be a number in kg, got '300'"):
+    # a string is not a number: the one checker's words, naming the field and the value
+    match = r"ms \(sprung mass\) must be a finite number > 0 kg, got '300'"
+    with pytest.raises(qc.ParameterError, match=match):
         QuarterCarParams(ms="300")
 
 
@@ -78,8 +81,10 @@ def test_inconsistent_zeta_and_cs():
 
 
 def test_unknown_key_in_dict_is_named():
-    with pytest.raises(ValueError, match="unknown parameter 'kt'"):
+    words = r"kt \(unknown parameter\) must be a parameter of QuarterCarParams: one of \['cs'"
+    with pytest.raises(qc.ParameterError, match=words) as info:
         QuarterCarParams.from_mapping({"ms": 300.0, "kt": 1.0})
+    assert info.value.name == "kt"  # what a command line points at
 
 
 def test_toml_config(tmp_path):
@@ -93,14 +98,16 @@ def test_toml_config(tmp_path):
 def test_toml_unknown_key_is_named(tmp_path):
     path = tmp_path / "car.toml"
     path.write_text("ms = 350.0\nspring = 3\n")
-    with pytest.raises(ValueError, match="unknown parameter 'spring'"):
+    with pytest.raises(ValueError, match=r"spring \(unknown parameter\) .* got 'spring'"):
         load_config(path)
 
 
 def test_toml_bad_value_names_file_and_field(tmp_path):
     path = tmp_path / "car.toml"
     path.write_text("mu = -5.0\n")
-    with pytest.raises(ValueError, match=r"car.toml.*mu .* must be > 0 kg, got -5.0"):
+    with pytest.raises(
+        ValueError, match=r"car.toml.*mu .* must be a finite number > 0 kg, got -5.0"
+    ):
         load_config(path)
 
 

@@ -367,9 +367,14 @@ def test_free_flight_is_the_parabola():
 def test_bad_input_names_the_value():
     with pytest.raises(ValueError, match=r"one length.*'mu': 1"):
         NonlinearQuarterCarBatch([300.0, 310.0], [40.0], [2e4, 2e4], [2e5, 2e5], [1e3, 1e3])
-    with pytest.raises(ValueError, match=r"ms\[1\] must be finite and > 0, got -5.0"):
+    with pytest.raises(
+        ValueError, match=r"ms\[1\] \(sprung mass\) must be a finite number > 0 kg, got -5.0"
+    ):
         NonlinearQuarterCarBatch([300.0, -5.0], [40.0] * 2, [2e4] * 2, [2e5] * 2, [1e3] * 2)
-    with pytest.raises(ValueError, match=r"cs\[0\] must be finite and >= 0, got nan"):
+    with pytest.raises(
+        ValueError,
+        match=r"cs\[0\] \(suspension damping\) must be a finite number >= 0 N·s/m, got nan",
+    ):
         NonlinearQuarterCarBatch([300.0], [40.0], [2e4], [2e5], [math.nan])
     model = qc.nonlinear_quarter_car_model()
     with pytest.raises(ValueError, match=r"X0 must have shape \(4,\) .* got \(2,\)"):

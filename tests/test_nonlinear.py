@@ -284,14 +284,14 @@ def test_force_elements():
 @pytest.mark.parametrize(
     "kwargs, error, match",
     [
-        (dict(tire="soft"), ValueError, "tire must be 'unilateral' or 'linear', got 'soft'"),
+        (dict(tire="soft"), ValueError, "tire must be one of 'unilateral', 'linear', got 'soft'"),
         (dict(bump_stop=0.05), TypeError, "bump_stop must be a BumpStop"),
         (dict(damper="stiff"), TypeError, "damper must be None"),
         (dict(spring=-1.0), ValueError, r"spring \(the cubic coefficient k3.*got -1.0"),
         (dict(spring=lambda d: 100.0 + d), ValueError, r"spring\(0.0\) = 100.0"),
         (dict(gravity=1), TypeError, "gravity must be True or False, got 1"),
         (dict(road="bump"), TypeError, "road must be True, False or a qc.road.Road"),
-        (dict(params={"ms": -1.0}), ValueError, "ms .* must be > 0"),
+        (dict(params={"ms": -1.0}), ValueError, "ms .* must be a finite number > 0 kg"),
     ],
 )
 def test_bad_arguments_are_named(kwargs, error, match):
@@ -302,13 +302,22 @@ def test_bad_arguments_are_named(kwargs, error, match):
 @pytest.mark.parametrize(
     "build, match",
     [
-        (lambda: qc.BumpStop(clearance_bound=-0.01, stiffness=1e5), "clearance_bound must be >= 0"),
-        (lambda: qc.BumpStop(clearance_bound=0.01, stiffness=math.nan), "stiffness must be finite"),
+        (
+            lambda: qc.BumpStop(clearance_bound=-0.01, stiffness=1e5),
+            r"clearance_bound \(.*\) must be a number >= 0 m, got -0.01",
+        ),
+        (
+            lambda: qc.BumpStop(clearance_bound=0.01, stiffness=math.nan),
+            r"stiffness \(bump-stop stiffness k\) must be a finite number >= 0 N/m, got nan",
+        ),
         (
             lambda: qc.PiecewiseDamper(rebound=1.0, bound=1.0, knee_bound=0.0),
-            "knee_bound must be >",
+            r"knee_bound \(.*\) must be a number > 0 m/s, got 0.0",
         ),
-        (lambda: qc.PiecewiseDamper(rebound="a", bound=1.0), "rebound must be a number, got 'a'"),
+        (
+            lambda: qc.PiecewiseDamper(rebound="a", bound=1.0),
+            r"rebound \(.*\) must be a finite number >= 0 N·s/m, got 'a'",
+        ),
     ],
 )
 def test_bad_elements_are_named(build, match):

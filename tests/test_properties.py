@@ -70,7 +70,7 @@ def test_the_field_check_needs_the_field_as_a_word():
     fields = ("ms", "mu", "ks", "ku", "zeta")
     assert not names_a_field("the value must be a number", fields)  # "mu" of "must"
     assert not names_a_field("itemsize too large: kusp", fields)
-    assert names_a_field("mu (unsprung mass) must be > 0 kg, got 0.0", fields)
+    assert names_a_field("mu (unsprung mass) must be a finite number > 0 kg, got 0.0", fields)
     assert names_a_field("ks = 1e300 overflows", fields)
 
 

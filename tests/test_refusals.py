@@ -129,8 +129,8 @@ def test_a_semi_active_dampers_range_follows_the_responses_params():
 @pytest.mark.parametrize(
     ("estimator", "words"),
     [
-        ({"RN": [-1.0, 1e-3]}, "RN .* must be positive"),
-        ({"QN": -1.0}, "QN .* must be positive semi-definite"),
+        ({"RN": [-1.0, 1e-3]}, r"RN'\] \(sensor noise intensities\) must be finite and > 0"),
+        ({"QN": -1.0}, r"QN'\] \(process noise intensity\) must be positive semi-definite"),
         ({"outputs": []}, "at least one measured output"),
     ],
 )

@@ -234,7 +234,7 @@ def test_cli_report_writes_and_prints(tmp_path, capsys):
         (["--h", "0.03"], "must be a whole number"),
         (["--x0", "0,0,x,0"], "--x0 must be 4 comma-separated numbers"),
         (["--methods", "euler,rk5"], "unknown method 'rk5'"),
-        (["--ms", "0"], "ms (sprung mass) must be > 0 kg"),
+        (["--ms", "0"], "ms (sprung mass) must be a finite number > 0 kg"),
     ],
 )
 def test_cli_report_bad_input(args, words, tmp_path, capsys):

@@ -96,7 +96,7 @@ BAD = [
         "unknown [scenario.road] key 'foo'; a bump road takes height",
     ),
     (dict(road=ISO8608Road(), h=0.01), "h = 0.01 s is too coarse for an ISO 8608 road at 20 m/s"),
-    (dict(vehicle={"ms": -1}), "ms (sprung mass) must be > 0 kg, got -1"),
+    (dict(vehicle={"ms": -1}), "ms (sprung mass) must be a finite number > 0 kg, got -1"),
     (dict(vehicle={"ms": 1e200, "ks": 1e200}), "time scales span more than 1e+07: cs/mu"),
     (dict(vehicle={"mu": 1e-305}), "ks/mu overflows to inf"),
     (dict(vehicle=5), "vehicle must be a QuarterCarParams or a mapping"),
@@ -326,7 +326,7 @@ def test_overrides_over_a_file(tmp_path):
     assert str(info.value).startswith(f"config file {str(path)!r}: ms (sprung mass)")
     with pytest.raises(ScenarioError) as info:
         Scenario.from_toml(path, overrides={"ms": -2.0})
-    assert str(info.value) == "ms (sprung mass) must be > 0 kg, got -2.0"
+    assert str(info.value) == "ms (sprung mass) must be a finite number > 0 kg, got -2.0"
 
 
 # ------------------------------------------------ round trip and command

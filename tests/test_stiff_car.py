@@ -66,9 +66,12 @@ def test_without_a_mount_the_seed_car_is_unchanged():
 
 
 def test_bad_mount_is_refused_by_name():
-    with pytest.raises(ValueError, match="mount_stiffness must be a finite stiffness > 0"):
+    with pytest.raises(
+        ValueError,
+        match=r"mount_stiffness \(the damper.s top mount\) must be a finite number > 0 N/m",
+    ):
         quarter_car(mount_stiffness=-1.0)
-    with pytest.raises(ValueError, match="mount_stiffness .* must be a number"):
+    with pytest.raises(ValueError, match="mount_stiffness .* must be a finite number"):
         quarter_car(mount_stiffness="stiff")
     with pytest.raises(ValueError, match="needs a damper"):
         quarter_car({"cs": 0.0}, mount_stiffness=1e6)

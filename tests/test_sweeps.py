@@ -131,8 +131,10 @@ def test_bad_designs_are_reported_and_nothing_else_is_lost(grid_result):
     with pytest.warns(RuntimeWarning, match="4 of 6 designs were rejected"):
         r = sweep(grid, T, X0, progress=False)
     assert list(r.errors["index"]) == [1, 2, 3, 5]
-    assert "ku must be finite, got nan" in r.errors.loc[0, "error"]
-    assert "ms (sprung mass) must be > 0 kg, got -5.0" in r.errors.loc[1, "error"]
+    assert (
+        "ku (tire stiffness) must be a finite number > 0 N/m, got nan" in r.errors.loc[0, "error"]
+    )
+    assert "ms (sprung mass) must be a finite number > 0 kg, got -5.0" in r.errors.loc[1, "error"]
     assert r.errors.loc[1, "value"]["ms"] == -5.0
     good = r.metrics[r.metrics["error"] == ""]
     assert list(good.index) == [0, 4] and good[list(DEFAULT_METRICS)].notna().all().all()

@@ -40,7 +40,7 @@ def test_cu_zero_is_the_seed_model():
 
 
 def test_bad_cu_and_the_nonlinear_car():
-    with pytest.raises(ValueError, match="cu must be >= 0"):
+    with pytest.raises(ValueError, match=r"cu \(tire damping\) must be a finite number >= 0"):
         qc.QuarterCarParams(cu=-1.0)
     with pytest.raises(ValueError, match="nonlinear car has no tire damping"):
         qc.nonlinear_quarter_car(qc.QuarterCarParams(cu=100.0))

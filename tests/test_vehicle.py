@@ -81,8 +81,8 @@ def test_a_model_with_a_missing_role_is_refused():
 @pytest.mark.parametrize(
     ("kwargs", "words"),
     [
-        (dict(ms=None), r"ms \(sprung mass\) must be a number in kg, got None"),
-        (dict(ku=None), r"ku \(tire stiffness\) must be a number in N/m, got None"),
+        (dict(ms=None), r"ms \(sprung mass\) must be a finite number > 0 kg, got None"),
+        (dict(ku=None), r"ku \(tire stiffness\) must be a finite number > 0 N/m, got None"),
         (dict(ms=1e-300, ks=1e300), r"ks/ms overflows"),
         (dict(ms=1e200, ks=1e200), r"time scales span more than 1e\+07: cs/mu = 5e\+197"),
         (dict(mu=1e-300, ku=1e300), r"overflows"),

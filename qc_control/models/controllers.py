@@ -55,6 +55,15 @@ from typing import Any
 import control
 import numpy as np
 
+from ..numerics.checks import (
+    Field,
+    ParameterError,
+    check_fields,
+    choice,
+    nonnegative,
+    number,
+    positive,
+)
 from ..numerics.messages import install_hint
 from .sampled_loop import sampled_loop
 from .vehicle import VehicleModel
@@ -91,22 +100,14 @@ SEMI_ACTIVE_MODES = (None, "on-off", "continuous")
 _VELOCITIES = ("vs", "vu")
 
 
-def _positive(name: str, value, unit: str, *, allow_zero: bool = False) -> float:
-    ok = isinstance(value, (int, float, np.number)) and not isinstance(value, bool)
-    v = float(value) if ok else math.nan
-    if not ok or not math.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
-        want = ">= 0" if allow_zero else "> 0"
-        raise ValueError(f"{name} must be a finite number {want} {unit}, got {value!r}")
-    return v
-
-
 def _limits(cmin, cmax) -> tuple[float, float]:
-    lo = _positive("cmin", cmin, "N·s/m", allow_zero=True)
-    if cmax is None:
-        raise ValueError("cmax (largest damping of the semi-active damper) is needed, got None")
-    hi = _positive("cmax", cmax, "N·s/m")
+    """The semi-active damper's range [N·s/m]: ``0 <= cmin < cmax``."""
+    lo = nonnegative("cmin", cmin, "N·s/m", description="smallest damping of the damper")
+    hi = positive("cmax", cmax, "N·s/m", description="largest damping of the damper")
     if hi <= lo:
-        raise ValueError(f"cmax must exceed cmin, got cmin={lo!r}, cmax={hi!r} N·s/m")
+        raise ParameterError(
+            "cmax", cmax, f"> cmin = {lo!r} N·s/m", description="largest damping of the damper"
+        )
     return lo, hi
 
 
@@ -147,8 +148,7 @@ def _damping(params, f_ideal, vrel, mode, cmin, cmax):
 
 def _velocity_law(name: str, gain_vs: float, gain_vu: float, semi_active, cmin, cmax):
     """``fa = gain_vs·vs + gain_vu·vu``, ideal or clipped to a semi-active damper."""
-    if semi_active not in SEMI_ACTIVE_MODES:
-        raise ValueError(f"semi_active must be one of {SEMI_ACTIVE_MODES}, got {semi_active!r}")
+    choice("semi_active", semi_active, SEMI_ACTIVE_MODES)
     if semi_active is None:
         return control.ss(
             np.zeros((0, 0)),
@@ -218,7 +218,7 @@ def skyhook(c_sky: float, *, semi_active=None, cmin=0.0, cmax=None, name: str = 
     >>> sky.input_labels, sky.output_labels, sky.D.tolist()
     (['vs', 'vu'], ['fa'], [[-2000.0, 0.0]])
     """
-    c = _positive("c_sky", c_sky, "N·s/m")
+    c = positive("c_sky", c_sky, "N·s/m")
     return _velocity_law(name, -c, 0.0, semi_active, cmin, cmax)
 
 
@@ -233,7 +233,7 @@ def groundhook(c_ground: float, *, semi_active=None, cmin=0.0, cmax=None, name="
     the wheel hop and so the dynamic tire load, at the body's expense.
     Parameters and return value as in `skyhook`.
     """
-    c = _positive("c_ground", c_ground, "N·s/m")
+    c = positive("c_ground", c_ground, "N·s/m")
     return _velocity_law(name, 0.0, c, semi_active, cmin, cmax)
 
 
@@ -257,11 +257,8 @@ def hybrid(c: float, alpha: float = 0.5, *, semi_active=None, cmin=0.0, cmax=Non
     semi_active, cmin, cmax, name
         As in `skyhook`.
     """
-    c = _positive("c", c, "N·s/m")
-    ok = isinstance(alpha, (int, float, np.number)) and not isinstance(alpha, bool)
-    if not ok or not 0.0 <= float(alpha) <= 1.0:
-        raise ValueError(f"alpha (weight of skyhook) must be a number in [0, 1], got {alpha!r}")
-    a = float(alpha)
+    c = positive("c", c, "N·s/m")
+    a = number("alpha", alpha, low=0.0, high=1.0, description="weight of skyhook")
     return _velocity_law(name, -a * c, (1 - a) * c, semi_active, cmin, cmax)
 
 
@@ -302,7 +299,7 @@ def add_damper(cmin: float, cmax: float, *, sensor_hz: float = 50.0, name: str =
         above), output ``['fa']``.
     """
     lo, hi = _limits(cmin, cmax)
-    wc = 2 * math.pi * _positive("sensor_hz", sensor_hz, "Hz")
+    wc = 2 * math.pi * positive("sensor_hz", sensor_hz, "Hz")
 
     def update(t, x, u, params):
         return np.array([wc * (u[0] - x[0])])
@@ -351,12 +348,12 @@ def lqr_weights(car: VehicleModel, weights: Mapping[str, float] | None = None):
     w = dict(DEFAULT_LQR_WEIGHTS if weights is None else weights)
     A, B, j = _actuated(car)
     sys = car.system
-    wf = _positive("weights['fa']", w.pop("fa", 0.0), "1/N²", allow_zero=True)
+    wf = nonnegative("weights['fa']", w.pop("fa", 0.0), "1/N²")
     rows, ws = [], []
     for label, value in w.items():
         k = car.output(label)
         rows.append(k)
-        ws.append(_positive(f"weights[{label!r}]", value, "", allow_zero=True))
+        ws.append(nonnegative(f"weights[{label!r}]", value))
     C = np.asarray(sys.C, dtype=float)[rows]
     D = np.asarray(sys.D, dtype=float)[rows][:, [j]]
     W = np.diag(ws)
@@ -423,13 +420,18 @@ def _check_covariances(QN: np.ndarray, RN: np.ndarray) -> None:
     (a Kalman filter's assumptions; ``control.lqe`` accepts others and
     returns a filter with unstable poles)."""
     if not np.all(np.isfinite(QN)) or np.min(np.linalg.eigvalsh((QN + QN.T) / 2)) < 0:
-        raise ValueError(
-            f"estimator QN (process noise intensity) must be positive semi-definite, "
-            f"got {QN.tolist()}"
+        raise ParameterError(
+            "estimator['QN']",
+            QN.tolist(),
+            "positive semi-definite",
+            description="process noise intensity",
         )
     if not np.all(np.isfinite(RN)) or np.min(np.diag(RN)) <= 0:
-        raise ValueError(
-            f"estimator RN (sensor noise intensities) must be positive, got {np.diag(RN).tolist()}"
+        raise ParameterError(
+            "estimator['RN']",
+            np.diag(RN).tolist(),
+            "finite and > 0",
+            description="sensor noise intensities",
         )
 
 
@@ -532,12 +534,35 @@ def lqr_controller(
 # ---------------------------------------------------------------- H-infinity
 
 
+#: `HinfWeights`' number fields, declared once (MATLAB's example's meaning and unit).
+_HINF_SPEC = {
+    "road": Field("road disturbance weight W_road: zr = W_road d1", "m"),
+    "travel_noise": Field("travel sensor noise weight", "m"),
+    "acc_noise": Field("accelerometer noise weight", "m/s²"),
+    "actuator_bandwidth": Field("nominal actuator bandwidth: 1/(s/ω + 1)", "rad/s"),
+    "force_unit": Field("newtons per unit of the command u", "N"),
+}
+#: `HinfWeights`' weighting filters, each a ``(num, den)`` pair, and what each weighs.
+_HINF_FILTERS = {
+    "actuator": "actuator effort weight W_act",
+    "handling": "handling target: e3 = beta/Handling · susp_travel",
+    "comfort": "comfort target: e2 = (1 - beta)/Comfort · body_acc",
+}
+
+
 @dataclass(frozen=True)
 class HinfWeights:
     """The weights of MATLAB's "Robust Control of an Active Suspension" example.
 
     All transfer functions in rad/s; the controller's output ``u`` is in
     ``force_unit`` newtons (kN in the example).
+
+    Raises
+    ------
+    qc_control.ParameterError
+        A number out of its declared range (``HinfWeights.spec()``: each
+        > 0) or a filter that is not ``(num, den)`` of finite coefficients,
+        naming the field and the value.
     """
 
     road: float = 0.07
@@ -548,6 +573,36 @@ class HinfWeights:
     comfort: tuple = ((0.4 / 0.45, 0.4), (1 / 150, 1.0))  # 0.4 (s/0.45 + 1)/(s/150 + 1)
     actuator_bandwidth: float = 60.0  # ActNom = 1/(s/60 + 1)
     force_unit: float = 1e3
+
+    def __post_init__(self):
+        check_fields(self, _HINF_SPEC)
+        for name in _HINF_FILTERS:
+            self._check_filter(name)
+
+    @classmethod
+    def spec(cls) -> dict[str, Field]:
+        """The number fields, declared: ``{name: Field}`` (description, SI unit,
+        range); the filters ``actuator``, ``handling`` and ``comfort`` are
+        ``(numerator, denominator)`` coefficient pairs, checked as such."""
+        return dict(_HINF_SPEC)
+
+    def _check_filter(self, name: str) -> None:
+        """A weighting filter: ``(num, den)`` of finite real coefficients, den not all 0."""
+        spec = getattr(self, name)
+        try:
+            num, den = (np.asarray(part, dtype=float) for part in spec)
+            ok = num.ndim == den.ndim == 1 and bool(np.all(np.isfinite(num)))
+            ok = ok and bool(np.all(np.isfinite(den))) and bool(np.any(den != 0))
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise ParameterError(
+                name,
+                spec,
+                "(numerator, denominator) coefficients of a transfer function in s [rad/s], "
+                "finite, the denominator not all 0",
+                description=_HINF_FILTERS[name],
+            )
 
 
 #: MATLAB's weights, as published in the example.
@@ -585,6 +640,11 @@ class HinfDesign:
     beta: float
 
 
+#: What `hinf_plant`'s ``beta`` and `hinf_controller`'s ``rtol`` are, for their refusals.
+_BETA = "weight on travel against comfort"
+_RTOL = "relative width of the γ bracket"
+
+
 def _tf(spec) -> control.TransferFunction:
     num, den = spec
     return control.tf(list(num), list(den))
@@ -601,9 +661,7 @@ def hinf_plant(car: VehicleModel, beta: float = 0.5, weights: HinfWeights | None
     ``β`` trades road handling (travel, β → 1) against comfort (β → 0).
     """
     w = MATLAB_ACTIVE_SUSPENSION if weights is None else weights
-    ok = isinstance(beta, (int, float, np.number)) and not isinstance(beta, bool)
-    if not ok or not 0.0 < float(beta) < 1.0:
-        raise ValueError(f"beta must be a number in (0, 1), got {beta!r}")
+    beta = number("beta", beta, low=0.0, high=1.0, low_open=True, high_open=True, description=_BETA)
     _actuated(car)
     sys = car.system
     road = car.corners[0].road
@@ -698,9 +756,8 @@ def hinf_controller(
     """
     w = MATLAB_ACTIVE_SUSPENSION if weights is None else weights
     P = hinf_plant(car, beta, w)
-    gamma_max = _positive("gamma_max", gamma_max, "")
-    if not 0 < _positive("rtol", rtol, "") < 1:
-        raise ValueError(f"rtol (relative width of the γ bracket) must be in (0, 1), got {rtol!r}")
+    gamma_max = positive("gamma_max", gamma_max)
+    rtol = number("rtol", rtol, low=0.0, high=1.0, low_open=True, high_open=True, description=_RTOL)
     if slycot is None:
         raise ImportError(f"hinf_controller needs slycot: {install_hint('robust')}")
     best = _hinf_attempt(P, gamma_max, 1, 2)

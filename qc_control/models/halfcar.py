@@ -58,6 +58,7 @@ from typing import Any, ClassVar
 import control
 import numpy as np
 
+from ..numerics.checks import Field, ParameterError, blamed_field, check_fields, instance_from
 from .quarter import MAX_RATE_SPAN
 from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel, params_as
 
@@ -83,27 +84,28 @@ FULL_CAR_CORNERS = (
     ("rr", "rear right"),
 )
 
-# field kinds: "positive" (> 0), "nonneg" (>= 0), "finite" (any finite number)
-_SPEC: dict[str, tuple[str, str, str]] = {
-    "ms": ("sprung (body) mass", "kg", "positive"),
-    "Ix": ("roll moment of inertia of the body about its CG", "kg·m²", "positive"),
-    "Iy": ("pitch moment of inertia of the body about its CG", "kg·m²", "positive"),
-    "a": ("distance from the CG to the front axle", "m", "positive"),
-    "b": ("distance from the CG to the rear axle", "m", "positive"),
-    "track_front": ("front track width", "m", "positive"),
-    "track_rear": ("rear track width", "m", "positive"),
-    "ks_front": ("front suspension stiffness (per wheel)", "N/m", "positive"),
-    "ks_rear": ("rear suspension stiffness (per wheel)", "N/m", "positive"),
-    "cs_front": ("front suspension damping (per wheel)", "N·s/m", "nonneg"),
-    "cs_rear": ("rear suspension damping (per wheel)", "N·s/m", "nonneg"),
-    "mu_front": ("front unsprung mass (per wheel)", "kg", "positive"),
-    "mu_rear": ("rear unsprung mass (per wheel)", "kg", "positive"),
-    "ku_front": ("front tire stiffness (per wheel)", "N/m", "positive"),
-    "ku_rear": ("rear tire stiffness (per wheel)", "N/m", "positive"),
-    "arb_front": ("front anti-roll bar roll stiffness", "N·m/rad", "nonneg"),
-    "arb_rear": ("rear anti-roll bar roll stiffness", "N·m/rad", "nonneg"),
-    "seat_x": ("seat position ahead of the CG", "m", "finite"),
-    "seat_y": ("seat position left of the CG", "m", "finite"),
+#: Each parameter of both cars declared once: what it is, its SI unit, its
+#: range. The constructors validate from it, `_VehicleParams.table` reports from it.
+_SPEC: dict[str, Field] = {
+    "ms": Field("sprung (body) mass", "kg"),
+    "Ix": Field("roll moment of inertia of the body about its CG", "kg·m²"),
+    "Iy": Field("pitch moment of inertia of the body about its CG", "kg·m²"),
+    "a": Field("distance from the CG to the front axle", "m"),
+    "b": Field("distance from the CG to the rear axle", "m"),
+    "track_front": Field("front track width", "m"),
+    "track_rear": Field("rear track width", "m"),
+    "ks_front": Field("front suspension stiffness (per wheel)", "N/m"),
+    "ks_rear": Field("rear suspension stiffness (per wheel)", "N/m"),
+    "cs_front": Field("front suspension damping (per wheel)", "N·s/m", "nonneg"),
+    "cs_rear": Field("rear suspension damping (per wheel)", "N·s/m", "nonneg"),
+    "mu_front": Field("front unsprung mass (per wheel)", "kg"),
+    "mu_rear": Field("rear unsprung mass (per wheel)", "kg"),
+    "ku_front": Field("front tire stiffness (per wheel)", "N/m"),
+    "ku_rear": Field("rear tire stiffness (per wheel)", "N/m"),
+    "arb_front": Field("front anti-roll bar roll stiffness", "N·m/rad", "nonneg"),
+    "arb_rear": Field("rear anti-roll bar roll stiffness", "N·m/rad", "nonneg"),
+    "seat_x": Field("seat position ahead of the CG", "m", "finite"),
+    "seat_y": Field("seat position left of the CG", "m", "finite"),
 }
 
 
@@ -113,22 +115,13 @@ class _VehicleParams:
     kind: ClassVar[str]
 
     def __post_init__(self):
-        for f in fields(self):  # type: ignore[arg-type]
-            description, unit, kind = _SPEC[f.name]
-            value = getattr(self, f.name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
-                raise ValueError(
-                    f"{f.name} ({description}) must be a number in {unit}, got {value!r}"
-                )
-            value = float(value)
-            if not math.isfinite(value):
-                raise ValueError(f"{f.name} ({description}) must be finite, got {value!r}")
-            if kind == "positive" and value <= 0:
-                raise ValueError(f"{f.name} ({description}) must be > 0 {unit}, got {value!r}")
-            if kind == "nonneg" and value < 0:
-                raise ValueError(f"{f.name} ({description}) must be >= 0 {unit}, got {value!r}")
-            object.__setattr__(self, f.name, value)
+        check_fields(self, self.spec())
         self._check_scales()
+
+    @classmethod
+    def spec(cls) -> dict[str, Field]:
+        """This car's fields, declared: ``{name: Field}`` in field order."""
+        return {f.name: _SPEC[f.name] for f in fields(cls)}  # type: ignore[arg-type]
 
     def _rates(self) -> tuple[dict[str, float], dict[str, float]]:
         """The car's stiffness rates and damping rates [1/s], by plain arithmetic.
@@ -182,17 +175,20 @@ class _VehicleParams:
         rates = {**stiff, **damp}
         bad = next((k for k, r in rates.items() if not math.isfinite(r)), None)
         if bad is not None:
-            raise ValueError(
-                f"the {self.kind} car's matrix would not be finite: {bad} overflows to "
-                f"{rates[bad]!r} ({self._values()})"
+            self._refuse(
+                blamed_field(self, bad),
+                f"a value for which the {self.kind} car's matrix is finite, but it would not "
+                f"be finite: {bad} overflows to {rates[bad]!r} ({self._values()})",
             )
         slow = min(stiff, key=stiff.__getitem__)
         fast = max(rates, key=rates.__getitem__)
         if rates[fast] > MAX_RATE_SPAN * stiff[slow]:
-            raise ValueError(
-                f"the {self.kind} car's time scales span more than {MAX_RATE_SPAN:.0e}: {fast} = "
-                f"{rates[fast]:.3g} 1/s against {slow} = {stiff[slow]:.3g} 1/s; its modes "
-                f"cannot be resolved in double precision ({self._values()})"
+            self._refuse(
+                blamed_field(self, fast),
+                f"a value whose modes can be resolved in double precision, but the "
+                f"{self.kind} car's time scales span more than {MAX_RATE_SPAN:.0e}: {fast} = "
+                f"{rates[fast]:.3g} 1/s against {slow} = {stiff[slow]:.3g} 1/s "
+                f"({self._values()})",
             )
         self._check_lengths()
         self._check_seat()
@@ -205,9 +201,10 @@ class _VehicleParams:
         for name in names:
             value = getattr(self, name)
             if value * MAX_RATE_SPAN < self.wheelbase:
-                raise ValueError(
-                    f"{name} ({_SPEC[name][0]}) = {value!r} m is more than {MAX_RATE_SPAN:.0e} "
-                    f"times shorter than the wheelbase a + b = {self.wheelbase:.6g} m"
+                self._refuse(
+                    name,
+                    f"at most {MAX_RATE_SPAN:.0e} times shorter than the wheelbase a + b = "
+                    f"{self.wheelbase:.6g} m",
                 )
 
     def _check_seat(self) -> None:
@@ -217,22 +214,25 @@ class _VehicleParams:
         for name, limit in reach.items():
             value = getattr(self, name)
             if abs(value) > limit:
-                raise ValueError(
-                    f"{name} ({_SPEC[name][0]}) must be within {limit:.6g} m of the CG (ten "
-                    f"{'wheelbases' if name == 'seat_x' else 'track widths'}), got {value!r}"
+                self._refuse(
+                    name,
+                    f"within {limit:.6g} m of the CG (ten "
+                    f"{'wheelbases' if name == 'seat_x' else 'track widths'})",
                 )
+
+    def _refuse(self, name: str, expected: str) -> None:
+        """A cross-field refusal: a `ParameterError` naming the field ``name``."""
+        raise ParameterError(
+            name, getattr(self, name), expected, description=_SPEC[name].description
+        )
 
     def _values(self) -> str:
         return ", ".join(f"{f.name}={getattr(self, f.name):.6g}" for f in fields(self))  # type: ignore[arg-type]
 
     @classmethod
     def from_mapping(cls, values: Mapping[str, Any]):
-        """Build from a dict; an unknown key raises ``ValueError`` naming it."""
-        names = sorted(f.name for f in fields(cls))  # type: ignore[arg-type]
-        unknown = sorted(set(values) - set(names))
-        if unknown:
-            raise ValueError(f"unknown parameter {unknown[0]!r}; expected one of {names}")
-        return cls(**dict(values))
+        """Build from a dict; an unknown key is a `qc_control.ParameterError` naming it."""
+        return instance_from(cls, values)
 
     def to_dict(self, *, changing: Iterable[str] | None = None) -> dict[str, float]:
         """Every field as a plain dict. ``changing`` is accepted for the sweep
@@ -241,10 +241,7 @@ class _VehicleParams:
 
     def table(self) -> list[tuple[str, str, float, str]]:
         """Rows ``(symbol, description, value, unit)`` for reports."""
-        return [
-            (f.name, _SPEC[f.name][0], getattr(self, f.name), _SPEC[f.name][1])
-            for f in fields(self)  # type: ignore[arg-type]
-        ]
+        return [(n, f.description, getattr(self, n), f.unit) for n, f in self.spec().items()]
 
     def model(self, *, road: bool = False, actuator: bool = False) -> VehicleModel:
         """This car as a `VehicleModel` (`half_car_model` or `full_car_model`)."""
@@ -286,10 +283,13 @@ class HalfCarParams(_VehicleParams):
 
     Raises
     ------
-    ValueError
-        A value that is not a finite number, a mass, inertia, length or
-        stiffness that is not > 0, or a damping < 0; the message names the
-        field, its meaning and the value.
+    qc_control.ParameterError
+        (a ``ValueError``) A value that is not a finite number (a bool is
+        not), a mass, inertia, length or stiffness that is not > 0, a
+        damping < 0, a length or seat out of the car's proportions, or time
+        scales that cannot be resolved; ``.name`` is the field, ``.value``
+        the value, and the message gives the field's meaning (each declared
+        once, in ``_SPEC``).
 
     Examples
     --------

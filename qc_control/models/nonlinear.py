@@ -57,7 +57,8 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from .quarter import OUTPUTS, STATES, UNITS, as_params
+from ..numerics.checks import Field, ParameterError, check_fields, choice
+from .quarter import OUTPUTS, STATES, UNITS, QuarterCarParams, as_params
 from .vehicle import STANDARD_GRAVITY, Corner, SignalRoles, VehicleModel
 
 __all__ = [
@@ -76,24 +77,45 @@ NONLINEAR_OUTPUTS = (*OUTPUTS, "tire_force")
 NONLINEAR_UNITS = {**UNITS, "tire_force": "N"}
 
 _TIRES = ("unilateral", "linear")
-
-
-def _number(name: str, value, *, minimum: float = 0.0, strict: bool = False, inf: bool = False):
-    """``value`` as a float >= minimum (or > when strict), or a ValueError naming it."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
-        raise ValueError(f"{name} must be a number, got {value!r}")
-    value = float(value)
-    if math.isnan(value) or (math.isinf(value) and not inf):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    if value < minimum or (strict and value == minimum):
-        sign = ">" if strict else ">="
-        raise ValueError(f"{name} must be {sign} {minimum:g}, got {value!r}")
-    return value
+#: A progressive spring's cubic coefficient (``spring=k3``), declared once.
+_SPRING_K3 = Field("the cubic coefficient k3 of a progressive spring", "N/m³", "nonneg")
 
 
 def _unset(value) -> bool:
     """None or NaN: a high-speed coefficient left to default to the low-speed one."""
     return value is None or (isinstance(value, float) and math.isnan(value))
+
+
+#: `PiecewiseDamper`'s fields, declared once: what each is, its SI unit, its range.
+_DAMPER_SPEC = {
+    "rebound": Field("low-speed rebound (extension) damping c_r", "N·s/m", "nonneg"),
+    "bound": Field("low-speed bound (compression) damping c_b", "N·s/m", "nonneg"),
+    "knee_rebound": Field("rebound knee velocity v_r (inf: one slope)", "m/s", allow_inf=True),
+    "knee_bound": Field("bound knee velocity v_b (inf: one slope)", "m/s", allow_inf=True),
+    "rebound_high": Field(
+        "high-speed rebound damping (None or NaN: c_r)", "N·s/m", "nonneg", optional=True
+    ),
+    "bound_high": Field(
+        "high-speed bound damping (None or NaN: c_b)", "N·s/m", "nonneg", optional=True
+    ),
+}
+#: `BumpStop`'s fields, declared once.
+_STOP_SPEC = {
+    "clearance_bound": Field(
+        "travel in compression before the bump stop touches (inf: none)",
+        "m",
+        "nonneg",
+        allow_inf=True,
+    ),
+    "stiffness": Field("bump-stop stiffness k", "N/m", "nonneg"),
+    "cubic": Field("bump-stop cubic coefficient k3", "N/m³", "nonneg"),
+    "clearance_rebound": Field(
+        "travel in extension before the rebound stop touches (inf: none)",
+        "m",
+        "nonneg",
+        allow_inf=True,
+    ),
+}
 
 
 @dataclass(frozen=True)
@@ -123,6 +145,12 @@ class PiecewiseDamper:
     rebound_high, bound_high : float, optional
         High-speed coefficients [N·s/m], >= 0; default (None or NaN) the
         low-speed one.
+
+    Raises
+    ------
+    qc_control.ParameterError
+        A value out of its declared range (``PiecewiseDamper.spec()``),
+        naming the field and the value.
     """
 
     rebound: float
@@ -133,15 +161,19 @@ class PiecewiseDamper:
     bound_high: float = math.nan
 
     def __post_init__(self):
-        for name in ("rebound", "bound"):
-            object.__setattr__(self, name, _number(name, getattr(self, name)))
-        for name in ("knee_rebound", "knee_bound"):
-            value = _number(name, getattr(self, name), strict=True, inf=True)
-            object.__setattr__(self, name, value)
+        # None or NaN high-speed coefficient: the low-speed one, once that is checked
+        for name in ("rebound_high", "bound_high"):
+            if _unset(getattr(self, name)):
+                object.__setattr__(self, name, None)
+        check_fields(self, _DAMPER_SPEC)
         for name, low in (("rebound_high", "rebound"), ("bound_high", "bound")):
-            value = getattr(self, name)
-            value = getattr(self, low) if _unset(value) else _number(name, value)
-            object.__setattr__(self, name, value)
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, getattr(self, low))
+
+    @classmethod
+    def spec(cls) -> dict[str, Field]:
+        """The fields, declared: ``{name: Field}`` (description, SI unit, range)."""
+        return dict(_DAMPER_SPEC)
 
     def __call__(self, v: float) -> float:
         if v >= 0:
@@ -193,8 +225,14 @@ class BumpStop:
     cubic : float, default 0
         ``k3`` [N/m³], >= 0.
     clearance_rebound : float, default inf
-        Travel in extension before the rebound stop touches [m], > 0
+        Travel in extension before the rebound stop touches [m], >= 0
         (inf: no rebound stop).
+
+    Raises
+    ------
+    qc_control.ParameterError
+        A value out of its declared range (``BumpStop.spec()``), naming the
+        field and the value.
     """
 
     clearance_bound: float
@@ -203,16 +241,12 @@ class BumpStop:
     clearance_rebound: float = math.inf
 
     def __post_init__(self):
-        object.__setattr__(
-            self, "clearance_bound", _number("clearance_bound", self.clearance_bound, inf=True)
-        )
-        object.__setattr__(
-            self,
-            "clearance_rebound",
-            _number("clearance_rebound", self.clearance_rebound, inf=True),
-        )
-        object.__setattr__(self, "stiffness", _number("stiffness", self.stiffness))
-        object.__setattr__(self, "cubic", _number("cubic", self.cubic))
+        check_fields(self, _STOP_SPEC)
+
+    @classmethod
+    def spec(cls) -> dict[str, Field]:
+        """The fields, declared: ``{name: Field}`` (description, SI unit, range)."""
+        return dict(_STOP_SPEC)
 
     def force(self, d: float) -> float:
         """The stops' force on the body against the extension ``d`` [N] (0 inside the clearance)."""
@@ -266,12 +300,14 @@ def _check_spring(spring, ks: float) -> float | None:
         except Exception as exc:
             raise ValueError(f"spring(0.0) failed: {type(exc).__name__}: {exc}") from None
         if not abs(f0) <= 1e-9 * ks:
-            raise ValueError(
-                f"spring must give 0 N at the static point (d = 0): spring(0.0) = {f0!r}; "
-                "measure its force from the static preload"
+            raise ParameterError(
+                "spring",
+                spring,
+                f"a force law giving 0 N at the static point (d = 0), but spring(0.0) = "
+                f"{f0!r}; measure its force from the static preload",
             )
         return None
-    return _number("spring (the cubic coefficient k3 [N/m³])", spring)
+    return _SPRING_K3.check("spring", spring)
 
 
 def _check_damper(damper) -> None:
@@ -288,7 +324,9 @@ def _check_damper(damper) -> None:
     except Exception as exc:
         raise ValueError(f"damper(0.0) failed: {type(exc).__name__}: {exc}") from None
     if not math.isfinite(f0):
-        raise ValueError(f"damper(0.0) must be finite, got {f0!r}")
+        raise ParameterError(
+            "damper", damper, f"a force law finite at rest, but damper(0.0) = {f0!r}"
+        )
 
 
 def _spring_law(spring, k3: float | None) -> Callable:
@@ -360,15 +398,14 @@ def _road_jumps(road) -> tuple[float, ...]:
     except (TypeError, ValueError):
         jumps = (math.nan,)
     if not all(math.isfinite(t) for t in jumps):
-        raise ValueError(f"road.jumps must be finite times [s], got {given!r}")
+        raise ParameterError("road.jumps", given, "finite times [s]")
     return jumps
 
 
 def _force_elements(p, *, tire: str, bump_stop, damper, spring, gravity: bool, zr_at):
     """``elements(t, x, u, q) -> (F_s + F_d + F_b, F_t - ku δ0, F_t, δ)``, the force
     elements at the state ``x`` (module docstring), checked and built once."""
-    if tire not in _TIRES:
-        raise ValueError(f"tire must be 'unilateral' or 'linear', got {tire!r}")
+    choice("tire", tire, _TIRES)
     if bump_stop is not None and not isinstance(bump_stop, BumpStop):
         raise TypeError(f"bump_stop must be a BumpStop or None, got {type(bump_stop).__name__}")
     if not isinstance(gravity, bool):
@@ -493,7 +530,9 @@ def nonlinear_quarter_car(
     _warn_plain_road(road, stacklevel=2)
     p = as_params(params)
     if p.cu:  # its tire is a spring that may lift off; a tire damper is the linear car's
-        raise ValueError(f"the nonlinear car has no tire damping: cu must be 0, got {p.cu!r}")
+        raise ParameterError(
+            "cu", p.cu, "0 N·s/m: the nonlinear car has no tire damping", description="tire damping"
+        )
     zr_at, inputs, ia = _road_height(road, actuator)
     forces = dict(tire=tire, bump_stop=bump_stop, damper=damper, gravity=gravity, zr_at=zr_at)
     elements = _force_elements(p, spring=spring, **forces)
@@ -596,21 +635,21 @@ def _design_arrays(values: dict) -> dict[str, np.ndarray]:
         try:
             a = np.asarray(values[name], dtype=float)
         except (TypeError, ValueError):
-            raise ValueError(f"{name} must be an array of numbers, got {values[name]!r}") from None
+            raise ParameterError(name, values[name], "an array of numbers") from None
         if a.ndim != 1 or a.size == 0:
-            raise ValueError(f"{name} must be a 1-D array of designs, got shape {a.shape}")
+            raise ParameterError(name, values[name], f"a 1-D array of designs, not shape {a.shape}")
         out[name] = a
     sizes = {name: a.size for name, a in out.items()}
     if len(set(sizes.values())) != 1:
         raise ValueError(
             f"the design arrays must have one length (one value per design), got sizes {sizes}"
         )
+    spec = QuarterCarParams.spec()  # each design's range, as its constructor's
     for name, a in out.items():
-        bad = np.flatnonzero(~np.isfinite(a) | (a < 0 if name == "cs" else a <= 0))
+        bad = np.flatnonzero(~spec[name].holds(a))
         if bad.size:
             i = int(bad[0])
-            need = ">= 0" if name == "cs" else "> 0"
-            raise ValueError(f"{name}[{i}] must be finite and {need}, got {float(a[i])!r}")
+            spec[name].check(f"{name}[{i}]", float(a[i]))  # refuses, naming the design
     return out
 
 

@@ -34,6 +34,7 @@ from typing import Any
 import control
 import numpy as np
 
+from ..numerics.checks import Field, ParameterError, blamed_field, check_fields, instance_from
 from .vehicle import STANDARD_GRAVITY, BatchedModel, Corner, SignalRoles, VehicleModel, params_as
 
 __all__ = [
@@ -79,24 +80,19 @@ UNITS = {
 #: damper's upper end, between the damper and the mount's spring [m].
 MOUNT_STATE = "xd"
 
-_UNITS = {
-    "ms": "kg",
-    "mu": "kg",
-    "ks": "N/m",
-    "ku": "N/m",
-    "zeta": "-",
-    "cs": "N·s/m",
-    "cu": "N·s/m",
+#: Each parameter declared once: what it is, its SI unit, its range. The
+#: constructor validates from it, `QuarterCarParams.table` reports from it.
+_SPEC = {
+    "ms": Field("sprung mass", "kg"),
+    "mu": Field("unsprung mass", "kg"),
+    "ks": Field("suspension stiffness", "N/m"),
+    "ku": Field("tire stiffness", "N/m"),
+    "zeta": Field("nominal damping ratio cs/(2√(ks·ms))", "-", "nonneg", optional=True),
+    "cs": Field("suspension damping", "N·s/m", "nonneg", optional=True),
+    "cu": Field("tire damping", "N·s/m", "nonneg"),
 }
-_DESCRIPTIONS = {
-    "ms": "sprung mass",
-    "mu": "unsprung mass",
-    "ks": "suspension stiffness",
-    "ku": "tire stiffness",
-    "zeta": "nominal damping ratio cs/(2√(ks·ms))",
-    "cs": "suspension damping",
-    "cu": "tire damping",
-}
+#: The damper's top mount (`quarter_car`'s ``mount_stiffness``); None: no mount.
+_MOUNT_STIFFNESS = Field("the damper's top mount", "N/m", optional=True)
 
 
 @dataclass(frozen=True)
@@ -129,10 +125,13 @@ class QuarterCarParams:
 
     Raises
     ------
-    ValueError
-        If a value is not finite, a mass or stiffness is not > 0, a damping
-        value is < 0, or ``zeta`` and ``cs`` are both given and disagree.
-        The message names the field and the value.
+    qc_control.ParameterError
+        (a ``ValueError``) If a value is not a finite number (a bool is
+        not), a mass or stiffness is not > 0, a damping value is < 0,
+        ``zeta`` and ``cs`` are both given and disagree, or the car's time
+        scales cannot be resolved (`_check_scales`). ``.name`` is the field,
+        ``.value`` the value given; each field's description, unit and
+        range are declared once, in ``_SPEC``.
 
     Notes
     -----
@@ -158,26 +157,7 @@ class QuarterCarParams:
     cu: float = 0.0
 
     def __post_init__(self):
-        for name in ("ms", "mu", "ks", "ku", "zeta", "cs", "cu"):
-            value = getattr(self, name)
-            if value is None and name in ("zeta", "cs"):
-                continue
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
-                raise ValueError(
-                    f"{name} ({_DESCRIPTIONS[name]}) must be a number in {_UNITS[name]}, "
-                    f"got {value!r}"
-                )
-            value = float(value)
-            if not math.isfinite(value):
-                raise ValueError(f"{name} must be finite, got {value!r}")
-            if name in ("zeta", "cs", "cu"):
-                if value < 0:
-                    raise ValueError(f"{name} must be >= 0, got {value!r}")
-            elif value <= 0:
-                raise ValueError(
-                    f"{name} ({_DESCRIPTIONS[name]}) must be > 0 {_UNITS[name]}, got {value!r}"
-                )
-            object.__setattr__(self, name, value)
+        check_fields(self, _SPEC)
         # 2·√ks·√ms rather than 2·√(ks·ms): the product overflows first
         critical = 2.0 * math.sqrt(self.ks) * math.sqrt(self.ms)
         if self.cs is None:
@@ -187,11 +167,19 @@ class QuarterCarParams:
         elif self.zeta is None:
             object.__setattr__(self, "zeta", self.cs / critical)
         elif not math.isclose(self.cs, self.zeta * critical, rel_tol=1e-9, abs_tol=1e-12):
-            raise ValueError(
-                f"cs={self.cs!r} and zeta={self.zeta!r} disagree: "
-                f"cs = 2*zeta*sqrt(ks*ms) = {self.zeta * critical:.6g}; give only one"
+            raise ParameterError(
+                "cs",
+                self.cs,
+                f"2*zeta*sqrt(ks*ms) = {self.zeta * critical:.6g} N·s/m, as zeta={self.zeta!r} "
+                f"gives (cs={self.cs!r} and zeta={self.zeta!r} disagree; give only one)",
+                description=_SPEC["cs"].description,
             )
         self._check_scales()
+
+    @classmethod
+    def spec(cls) -> dict[str, Field]:
+        """The fields, declared: ``{name: Field}`` (description, SI unit, range)."""
+        return dict(_SPEC)
 
     def _check_scales(self) -> None:
         """Refuse a vehicle whose matrix overflows or whose modes cannot be resolved.
@@ -217,9 +205,10 @@ class QuarterCarParams:
         }
         if not math.isfinite(sum(ratios.values())):
             what = next(k for k, v in ratios.items() if not math.isfinite(v))
-            raise ValueError(
-                f"{what} overflows to {ratios[what]!r} for ms={ms!r}, mu={mu!r}, ks={ks!r}, "
-                f"ku={ku!r}: the model's matrix would not be finite"
+            self._refuse(
+                what,
+                f"a value for which the model's matrix is finite, but {what} overflows to "
+                f"{ratios[what]!r} for ms={ms!r}, mu={mu!r}, ks={ks!r}, ku={ku!r}",
             )
         rates = {
             "sqrt(ks/ms)": math.sqrt(ratios["ks/ms"]),
@@ -232,12 +221,20 @@ class QuarterCarParams:
         if max(values) > MAX_RATE_SPAN * min(values[:3]):
             fast = max(rates, key=rates.__getitem__)
             slow = min(list(rates)[:3], key=rates.__getitem__)
-            raise ValueError(
-                f"the vehicle's time scales span more than {MAX_RATE_SPAN:.0e}: {fast} = "
-                f"{rates[fast]:.3g} 1/s against {slow} = {rates[slow]:.3g} 1/s (ms="
-                f"{ms!r}, mu={mu!r}, ks={ks!r}, ku={ku!r}, cs={cs:.6g}); its modes cannot "
-                "be resolved in double precision"
+            self._refuse(
+                fast,
+                f"a value whose modes can be resolved in double precision, but the vehicle's "
+                f"time scales span more than {MAX_RATE_SPAN:.0e}: {fast} = {rates[fast]:.3g} "
+                f"1/s against {slow} = {rates[slow]:.3g} 1/s (ms={ms!r}, mu={mu!r}, ks={ks!r}, "
+                f"ku={ku!r}, cs={cs:.6g})",
             )
+
+    def _refuse(self, rate: str, expected: str) -> None:
+        """A `ParameterError` naming the field the refused ``rate`` most likely blames."""
+        name = blamed_field(self, rate)
+        raise ParameterError(
+            name, getattr(self, name), expected, description=_SPEC[name].description
+        )
 
     @property
     def system(self) -> control.StateSpace:
@@ -250,11 +247,8 @@ class QuarterCarParams:
 
     @classmethod
     def from_mapping(cls, values: Mapping[str, Any]) -> QuarterCarParams:
-        """Build from a dict; an unknown key raises ``ValueError`` naming it."""
-        unknown = sorted(set(values) - _FIELDS)
-        if unknown:
-            raise ValueError(f"unknown parameter {unknown[0]!r}; expected one of {sorted(_FIELDS)}")
-        return cls(**dict(values))
+        """Build from a dict; an unknown key is a `qc_control.ParameterError` naming it."""
+        return instance_from(cls, values)
 
     @classmethod
     def from_mappings(cls, designs: Sequence[Any]) -> list[QuarterCarParams | None]:
@@ -298,11 +292,11 @@ class QuarterCarParams:
         zeta, cs = columns.get("zeta", np.nan), columns.get("cs", np.nan)
         has_zeta, has_cs = "zeta" in keys, "cs" in keys
         with np.errstate(all="ignore"):
-            ok = np.isfinite(ms) & np.isfinite(mu) & np.isfinite(ks) & np.isfinite(ku)
-            ok &= (ms > 0) & (mu > 0) & (ks > 0) & (ku > 0)
-            for given, value in ((has_zeta, zeta), (has_cs, cs)):
-                if given:
-                    ok &= np.isfinite(value) & (value >= 0)
+            # each given value in its declared range, as check_fields finds it
+            # (the defaults of the others are in theirs)
+            ok = np.ones(m, dtype=bool)
+            for name, given in columns.items():
+                ok &= _SPEC[name].holds(given)
             critical = 2.0 * np.sqrt(ks) * np.sqrt(ms)
             if not has_cs:
                 zeta = zeta if has_zeta else np.full(m, 0.25)
@@ -343,7 +337,7 @@ class QuarterCarParams:
 
     def table(self) -> list[tuple[str, str, float, str]]:
         """Rows ``(symbol, description, value, unit)`` for reports."""
-        return [(n, _DESCRIPTIONS[n], getattr(self, n), _UNITS[n]) for n in _UNITS]
+        return [(n, f.description, getattr(self, n), f.unit) for n, f in _SPEC.items()]
 
 
 _FIELDS = frozenset(f.name for f in fields(QuarterCarParams))
@@ -415,17 +409,10 @@ def quarter_car_abcd(ms, mu, ks, ku, cs, *, road: bool = False, actuator: bool =
 
 
 def check_mount_stiffness(value) -> float | None:
-    """``value`` as a mount stiffness [N/m]: None (no mount) or a finite number > 0."""
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
-        raise ValueError(
-            f"mount_stiffness (the damper's top mount) must be a number in N/m or None, "
-            f"got {value!r}"
-        )
-    if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"mount_stiffness must be a finite stiffness > 0 N/m, got {value!r}")
-    return float(value)
+    """``value`` as a mount stiffness [N/m]: None (no mount) or a finite number
+    > 0 (as declared in ``_MOUNT_STIFFNESS``), else a `qc_control.ParameterError`
+    naming ``mount_stiffness``."""
+    return _MOUNT_STIFFNESS.check("mount_stiffness", value)
 
 
 def mounted_abcd(A, B, C, D, ms: float, mu: float, cs: float, km: float):
@@ -448,9 +435,11 @@ def mounted_abcd(A, B, C, D, ms: float, mu: float, cs: float, km: float):
     ``body_acc`` still the first row of ``A x + B u``.
     """
     if not cs > 0:
-        raise ValueError(
-            f"a damper top mount needs a damper: cs must be > 0 N·s/m with mount_stiffness, "
-            f"got cs={cs!r}"
+        raise ParameterError(
+            "cs",
+            cs,
+            "> 0 N·s/m with mount_stiffness: a damper top mount needs a damper",
+            description=_SPEC["cs"].description,
         )
     A5 = np.zeros((5, 5))
     A5[:4, :4] = A
@@ -522,9 +511,12 @@ def quarter_car(
     p = as_params(params)
     km = check_mount_stiffness(mount_stiffness)
     if km is not None and p.cu:
-        raise ValueError(
-            f"a damper top mount (mount_stiffness={km!r} N/m) with tire damping (cu={p.cu!r} "
-            "N·s/m) is not modelled; give one of them"
+        raise ParameterError(
+            "mount_stiffness",
+            km,
+            f"None with tire damping (cu={p.cu!r} N·s/m): a damper top mount with tire "
+            "damping is not modelled; give one of them",
+            description=_MOUNT_STIFFNESS.description,
         )
     A, B, C, D = quarter_car_abcd(
         p.ms, p.mu, p.ks, p.ku, p.cs, road=road, actuator=actuator, cu=p.cu

@@ -54,7 +54,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .messages import show
+from .checks import Field, ParameterError, check_fields, number, positive
 from .methods import DORMAND_PRINCE, ButcherTableau
 from .stepper import rk_end, rk_stages, stage_plan
 
@@ -117,6 +117,14 @@ _DOPRI_DENSE = np.array(
 _DENSE = {DORMAND_PRINCE: _DOPRI_DENSE}
 
 
+#: `StepController`'s constants, declared once: what each does, its range.
+_CONTROLLER_SPEC = {
+    "safety": Field("the fraction of the largest step the estimate allows", "", high=1.0),
+    "min_factor": Field("the most a step shrinks at once", "", high=1.0, high_open=True),
+    "max_factor": Field("the most a step grows at once", "", "finite", low=1.0, low_open=True),
+}
+
+
 @dataclass(frozen=True)
 class StepController:
     """The standard step-size controller's constants (HNW I, §II.4, (4.13)).
@@ -150,14 +158,12 @@ class StepController:
     max_factor: float = 10.0
 
     def __post_init__(self):
-        checks = (
-            ("safety", self.safety, 0 < self.safety <= 1, "in (0, 1]"),
-            ("min_factor", self.min_factor, 0 < self.min_factor < 1, "in (0, 1)"),
-            ("max_factor", self.max_factor, 1 < self.max_factor < math.inf, "finite and > 1"),
-        )
-        for name, value, ok, expected in checks:
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not ok:
-                raise ValueError(f"StepController: {name} must be {expected}, got {show(value)}")
+        check_fields(self, _CONTROLLER_SPEC)
+
+    @classmethod
+    def spec(cls) -> dict[str, Field]:
+        """The fields, declared: ``{name: Field}`` (description, range)."""
+        return dict(_CONTROLLER_SPEC)
 
     def factor(self, error_norm: float, exponent: float, rejected: bool) -> float:
         """The factor on ``h`` after an accepted step (``error_norm < 1``)."""
@@ -191,6 +197,11 @@ def check_embedded(tab: ButcherTableau) -> None:
         )
 
 
+#: What ``rtol`` and ``atol`` are, for their refusals.
+_RTOL = "relative tolerance: at least 100 eps, below which the error estimate is rounding"
+_ATOL = "a finite absolute tolerance > 0, a number or one per state"
+
+
 def check_tolerances(rtol, atol, n: int) -> tuple[float, np.ndarray | float]:
     """``(rtol, atol)`` checked: rtol a number in ``[MIN_RTOL, 1)``, atol
     positive and finite, a number or one per state.
@@ -209,24 +220,18 @@ def check_tolerances(rtol, atol, n: int) -> tuple[float, np.ndarray | float]:
     """
     rtol = 1e-3 if rtol is None else rtol
     atol = 1e-6 if atol is None else atol
-    if isinstance(rtol, bool) or not isinstance(rtol, (int, float, np.floating, np.integer)):
-        raise ValueError(f"rtol must be a real number, got {show(rtol)}")
-    if not (math.isfinite(rtol) and MIN_RTOL <= rtol < 1):
-        raise ValueError(
-            f"rtol must be finite, at least 100 eps = {MIN_RTOL:.3g} (below it the error "
-            f"estimate is rounding) and below 1, got {rtol!r}"
-        )
+    rtol = number("rtol", rtol, low=MIN_RTOL, high=1.0, high_open=True, description=_RTOL)
+    if isinstance(atol, (bool, np.bool_)):  # not a tolerance, though NumPy reads it as 1.0
+        raise ParameterError("atol", atol, _ATOL)
     try:
         a = np.asarray(atol, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(
-            f"atol must be a positive number or one per state, got {show(atol)}"
-        ) from None
+        raise ParameterError("atol", atol, _ATOL) from None
     if a.ndim > 1 or (a.ndim == 1 and a.size != n):
-        raise ValueError(f"atol must be a number or have shape ({n},), got shape {a.shape}")
+        raise ParameterError("atol", atol, f"a number or one per state, shape ({n},)")
     if not (np.all(np.isfinite(a)) and np.all(a > 0)):
-        raise ValueError(f"atol must be positive and finite, got {show(atol)}")
-    return float(rtol), (float(a) if a.ndim == 0 else a)
+        raise ParameterError("atol", atol, _ATOL)
+    return rtol, (float(a) if a.ndim == 0 else a)
 
 
 def initial_step(f, t0, x0, f0, t_bound, error_order, rtol, atol, max_step=math.inf) -> float:
@@ -485,14 +490,14 @@ def adaptive_solve(
     AdaptiveRun
     """
     tol = check_tolerances(rtol, atol, x0.size)
-    max_step = _positive("max_step", max_step, allow_inf=True)
+    max_step = positive("max_step", max_step, "s", allow_inf=True)
     loop = _Loop(f, t_out, x0, tab, tol, controller, max_step)
     stops = _stops(loop.t, float(t_out[-1]), breakpoints)
     if first_step is None:
         h_abs = initial_step(f, loop.t, x0, loop.k1, stops[0], _error_order(tab), *tol, max_step)
         loop.nfev += 1
     else:
-        h_abs = _positive("first_step", first_step, allow_inf=False)
+        h_abs = positive("first_step", first_step, "s")
     status, message = "success", ""
     for t_bound in stops:
         while status == "success" and loop.t < t_bound:
@@ -510,18 +515,3 @@ def adaptive_solve(
         status=status,
         message=message,
     )
-
-
-def _positive(name: str, value, allow_inf: bool) -> float:
-    """``value`` as a positive float (finite unless ``allow_inf``), or a ValueError."""
-    ok = (
-        not isinstance(value, bool)
-        and isinstance(value, (int, float, np.integer, np.floating))
-        and value > 0
-        and (allow_inf or math.isfinite(value))
-        and not math.isnan(value)
-    )
-    if not ok:
-        finite = "" if allow_inf else " finite"
-        raise ValueError(f"{name} must be a positive{finite} number of seconds, got {show(value)}")
-    return float(value)

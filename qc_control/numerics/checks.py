@@ -12,9 +12,10 @@ with `check_fields`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import re
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -23,6 +24,8 @@ __all__ = [
     "Field",
     "ParameterError",
     "check_fields",
+    "instance_from",
+    "blamed_field",
     "choice",
     "finite",
     "integer",
@@ -165,34 +168,79 @@ def choice(name: str, value, options: Iterable[Any]) -> Any:
     raise ParameterError(name, value, f"one of {listed}")
 
 
-#: How a `Field` bounds its value: the checker that enforces it.
-_KINDS = {
-    "positive": positive,
-    "nonneg": nonnegative,
-    "finite": finite,
+#: How a `Field`'s kind bounds its value from below: ``(low, low_open)``.
+_KINDS: dict[str, tuple[float | None, bool]] = {
+    "positive": (0.0, True),
+    "nonneg": (0.0, False),
+    "finite": (None, False),
 }
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class Field:
     """One parameter's declaration: what it is, its SI unit, its range.
 
-    ``kind`` is ``"positive"`` (> 0), ``"nonneg"`` (>= 0) or ``"finite"``;
-    ``optional`` lets the value be None (derived later, as ``zeta`` from ``cs``).
+    ``kind`` is ``"positive"`` (> 0), ``"nonneg"`` (>= 0) or ``"finite"``
+    (any finite number, or from ``low``: a lower bound other than 0, as a
+    growth factor's > 1); ``high`` adds an upper bound (a ratio in (0, 1]),
+    ``low_open``/``high_open`` exclude the bounds, ``allow_inf`` lets the
+    value be infinite (a clearance or a knee that is "none"). ``optional``
+    lets the value be None (derived later, as ``zeta`` from ``cs``).
+
+    Examples
+    --------
+    >>> Field("growth factor", "", "finite", low=1.0, low_open=True).check("max_factor", 10)
+    10.0
     """
 
     description: str
     unit: str
     kind: str = "positive"
     optional: bool = False
+    high: float | None = None
+    high_open: bool = False
+    allow_inf: bool = False
+    low: float | None = None
+    low_open: bool = False
 
     def __post_init__(self):
         choice("kind", self.kind, _KINDS)
+        if self.low is not None and self.kind != "finite":
+            raise ParameterError(
+                "low", self.low, f"None with kind {self.kind!r}, whose lower bound is 0"
+            )
+
+    @property
+    def bounds(self) -> dict[str, Any]:
+        """The keyword arguments of `number` that enforce this declaration."""
+        low, low_open = (self.low, self.low_open) if self.low is not None else _KINDS[self.kind]
+        return {
+            "low": low,
+            "low_open": low_open,
+            "high": self.high,
+            "high_open": self.high_open,
+            "allow_inf": self.allow_inf,
+        }
+
+    def holds(self, values) -> np.ndarray:
+        """Elementwise, whether each number of the array ``values`` is in the
+        declared range (`check`'s rule, for many designs at once; NaN never is)."""
+        b = self.bounds
+        a = np.asarray(values, dtype=float)
+        with np.errstate(invalid="ignore"):
+            ok = ~np.isnan(a) if b["allow_inf"] else np.isfinite(a)
+            if b["low"] is not None:
+                ok &= (a > b["low"]) if b["low_open"] else (a >= b["low"])
+            if b["high"] is not None:
+                ok &= (a < b["high"]) if b["high_open"] else (a <= b["high"])
+        return ok
 
     def check(self, name: str, value) -> float | None:
+        """``value`` as a float in the declared range (None if optional and
+        None), or a `ParameterError` naming ``name``, the description and the unit."""
         if value is None and self.optional:
             return None
-        return _KINDS[self.kind](name, value, self.unit, description=self.description)
+        return number(name, value, self.unit, description=self.description, **self.bounds)
 
 
 def check_fields(obj, spec: Mapping[str, Field]) -> None:
@@ -200,3 +248,57 @@ def check_fields(obj, spec: Mapping[str, Field]) -> None:
     declared in ``spec``, refusing the first bad one by name."""
     for name, field in spec.items():
         object.__setattr__(obj, name, field.check(name, getattr(obj, name)))
+
+
+def blamed_field(obj, expression: str) -> str:
+    """The field of the dataclass ``obj`` a refused formula most likely blames.
+
+    Of the fields ``expression`` reads (``ks`` and ``mu`` in
+    ``'sqrt(ks/mu)'``; ``'Σks'``, a sum, is no one field), the one whose
+    value lies the most orders of magnitude from its default,
+    ``|log10(value/default)|``; the first field of ``obj`` if the formula
+    reads none. A check across fields (a vehicle's time scales) refuses with
+    a `ParameterError` naming it, the formula and every value staying in the
+    text, so that a caller who reads ``.name`` is pointed at the parameter
+    the user most likely mistyped.
+
+    Examples
+    --------
+    >>> from dataclasses import dataclass
+    >>> @dataclass
+    ... class Car:
+    ...     ks: float = 3e4
+    ...     mu: float = 100.0
+    >>> blamed_field(Car(mu=1e-305), "ks/mu")
+    'mu'
+    """
+    declared = {f.name: f.default for f in dataclasses.fields(obj)}
+    read = [w for w in re.findall(r"(?<![Σ\w])\w+", expression) if w in declared]
+
+    def distance(name: str) -> float:
+        value, default = getattr(obj, name), declared[name]
+        if not (_real(value) and _real(default)) or value == default:
+            return 0.0
+        if value == 0 or default == 0 or not math.isfinite(value / default):
+            return math.inf
+        return abs(math.log10(abs(value / default)))
+
+    return max(read, key=distance) if read else next(iter(declared))
+
+
+def instance_from(cls, values: Mapping[str, Any]):
+    """``cls(**values)`` for a parameter dataclass ``cls``, an unknown key
+    refused first: a `ParameterError` whose ``.name`` is the key (so that a
+    command line or a TOML loader points at it), listing the parameters
+    ``cls`` has. The ``from_mapping`` of every car's parameter class.
+    """
+    names = sorted(f.name for f in dataclasses.fields(cls))
+    unknown = sorted(set(values) - set(names))
+    if unknown:
+        raise ParameterError(
+            unknown[0],
+            unknown[0],
+            f"a parameter of {cls.__name__}: one of {names}",
+            description="unknown parameter",
+        )
+    return cls(**dict(values))

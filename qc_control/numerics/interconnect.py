@@ -476,6 +476,68 @@ def f_plain(Fx, fw_rows, get, direct):
     return f
 
 
+def _indices(offsets, group) -> np.ndarray:
+    """The positions of the subsystems ``group`` in a vector laid out by ``offsets``."""
+    return np.concatenate(
+        [np.arange(offsets[i], offsets[i + 1]) for i in group] or [np.empty(0, int)]
+    ).astype(int)
+
+
+def _block_diagonal(subs, lin, get, rows: int, cols: int) -> np.ndarray:
+    """One of the linear subsystems' matrices (``get``: A, B, C or D), block-diagonal."""
+    out = np.zeros((rows, cols))
+    r = c = 0
+    for i in lin:
+        m = np.atleast_2d(np.asarray(get(subs[i]), dtype=float))
+        out[r : r + m.shape[0], c : c + m.shape[1]] = m
+        r, c = r + m.shape[0], c + m.shape[1]
+    return out
+
+
+def _eliminate_linear_outputs(CL, DL, K, E, uL, yL, yN_all):
+    """``(Gx, Gn, Gw)`` with ``y_L = Gx x_L + Gn y_N + Gw w`` (module docstring),
+    or None when ``M = I - D_L K_LL`` is singular: an algebraic loop."""
+    M = np.eye(yL.size) - DL @ K[np.ix_(uL, yL)]
+    if yL.size and np.linalg.cond(M) > 1e12:
+        return None
+    Minv = np.linalg.inv(M) if yL.size else np.zeros((0, 0))
+    return Minv @ CL, Minv @ DL @ K[np.ix_(uL, yN_all)], Minv @ DL @ E[uL]
+
+
+def _nonlinear_inputs(Ux, Un, Uw, uN, starts):
+    """Each nonlinear subsystem's input as ``Px x_L + Σ_i Pn_i y_N,i + Pw w``:
+    ``(Px, Pn, Pw)``, with ``Pn[j]`` the ``(i, block)`` of the outputs it reads."""
+    Px, Pn, Pw = [], [], []
+    nn = len(uN)
+    for j in range(nn):
+        rows = uN[j]
+        Px.append(Ux[rows])
+        Pw.append(Uw[rows])
+        deps = []
+        for i in range(nn):
+            block = Un[np.ix_(rows, np.arange(starts[i], starts[i + 1]))]
+            if np.any(block != 0):
+                deps.append((i, block))
+        Pn.append(deps)
+    return Px, Pn, Pw
+
+
+def _evaluation_order(Pn) -> list[int] | None:
+    """An order of the nonlinear subsystems in which each one's inputs are known
+    before it is called; None for a loop through direct feedthrough (control
+    iterates there, and so does its ``_rhs``)."""
+    needs = [{i for i, _ in deps} for deps in Pn]
+    order: list[int] = []
+    done: set[int] = set()
+    while len(order) < len(needs):
+        ready = [j for j in range(len(needs)) if j not in done and needs[j] <= done]
+        if not ready:
+            return None
+        order.extend(ready)
+        done.update(ready)
+    return order
+
+
 def compile_interconnect(sys) -> CompiledInterconnect | None:
     """``sys`` solved once (`CompiledInterconnect`), or None where that does not apply.
 
@@ -495,78 +557,41 @@ def compile_interconnect(sys) -> CompiledInterconnect | None:
     y_off = np.cumsum([0] + [s.noutputs for s in subs])
     lin = [i for i, s in enumerate(subs) if _is_linear(s)]
     non = [i for i, s in enumerate(subs) if not _is_linear(s)]
-
-    def idx(offsets, group):
-        return np.concatenate(
-            [np.arange(offsets[i], offsets[i + 1]) for i in group] or [np.empty(0, int)]
-        ).astype(int)
-
-    xL, uL, yL = idx(x_off, lin), idx(u_off, lin), idx(y_off, lin)
-
-    def blockdiag(get, rows, cols):
-        out = np.zeros((rows, cols))
-        r = c = 0
-        for i in lin:
-            m = np.atleast_2d(np.asarray(get(subs[i]), dtype=float))
-            out[r : r + m.shape[0], c : c + m.shape[1]] = m
-            r, c = r + m.shape[0], c + m.shape[1]
-        return out
-
-    AL = blockdiag(lambda s: s.A, xL.size, xL.size)
-    BL = blockdiag(lambda s: s.B, xL.size, uL.size)
-    CL = blockdiag(lambda s: s.C, yL.size, xL.size)
-    DL = blockdiag(lambda s: s.D, yL.size, uL.size)
+    xL, uL, yL = _indices(x_off, lin), _indices(u_off, lin), _indices(y_off, lin)
+    AL, BL, CL, DL = (
+        _block_diagonal(subs, lin, lambda s, k=k: getattr(s, k), rows, cols)
+        for k, rows, cols in (
+            ("A", xL.size, xL.size),
+            ("B", xL.size, uL.size),
+            ("C", yL.size, xL.size),
+            ("D", yL.size, uL.size),
+        )
+    )
     yN = [np.arange(y_off[i], y_off[i + 1]) for i in non]
     uN = [np.arange(u_off[i], u_off[i + 1]) for i in non]
     yN_all = np.concatenate(yN) if yN else np.empty(0, int)
-    M = np.eye(yL.size) - DL @ K[np.ix_(uL, yL)]
-    if yL.size and np.linalg.cond(M) > 1e12:
+    G = _eliminate_linear_outputs(CL, DL, K, E, uL, yL, yN_all)
+    if G is None:
         return None
-    Minv = np.linalg.inv(M) if yL.size else np.zeros((0, 0))
-    Gx = Minv @ CL
-    Gn = Minv @ DL @ K[np.ix_(uL, yN_all)]
-    Gw = Minv @ DL @ E[uL]
+    Gx, Gn, Gw = G
     # every subsystem input as  Ux x_L + Un y_N + Uw w
     Ux = K[:, yL] @ Gx
     Un = K[:, yL] @ Gn + K[:, yN_all]
     Uw = K[:, yL] @ Gw + E
     # the nonlinear subsystems' inputs, and the order that resolves them
-    nn = len(non)
-    widths = [len(y) for y in yN]
-    starts = np.cumsum([0] + widths)
-    Px, Pn, Pw = [], [], []
-    needs: list[set[int]] = []
-    for j in range(nn):
-        rows = uN[j]
-        Px.append(Ux[rows])
-        Pw.append(Uw[rows])
-        deps = []
-        for i in range(nn):
-            block = Un[np.ix_(rows, np.arange(starts[i], starts[i + 1]))]
-            if np.any(block != 0):
-                deps.append((i, block))
-        Pn.append(deps)
-        needs.append({i for i, _ in deps})
-    order: list[int] = []
-    done: set[int] = set()
-    while len(order) < nn:
-        ready = [j for j in range(nn) if j not in done and needs[j] <= done]
-        if not ready:  # a loop through direct feedthrough: control iterates, so do we
-            return None
-        order.extend(ready)
-        done.update(ready)
+    starts = np.cumsum([0] + [len(y) for y in yN])
+    Px, Pn, Pw = _nonlinear_inputs(Ux, Un, Uw, uN, starts)
+    order = _evaluation_order(Pn)
+    if order is None:
+        return None
+    spans = [np.arange(starts[i], starts[i + 1]) for i in range(len(non))]
     Fx = AL + BL @ Ux[uL]
-    Fn = [BL @ Un[np.ix_(uL, np.arange(starts[i], starts[i + 1]))] for i in range(nn)]
+    Fn = [BL @ Un[np.ix_(uL, span)] for span in spans]
     Fw = BL @ Uw[uL]
     # the outputs read subsystem outputs (O's first columns) and may read subsystem inputs
     Ou = O[:, y_off[-1] :]
     Ox = O[:, yL] @ Gx + Ou @ Ux
-    On = [
-        O[:, yL] @ Gn[:, starts[i] : starts[i + 1]]
-        + O[:, yN[i]]
-        + Ou @ Un[:, starts[i] : starts[i + 1]]
-        for i in range(nn)
-    ]
+    On = [O[:, yL] @ Gn[:, span] + O[:, yN[i]] + Ou @ Un[:, span] for i, span in enumerate(spans)]
     Ow = O[:, yL] @ Gw + Ou @ Uw
     nonlin = [(subs[i], slice(x_off[i], x_off[i + 1]), uN[j]) for j, i in enumerate(non)]
     return CompiledInterconnect(sys, xL, nonlin, order, (Px, Pn, Pw, Fx, Fn, Fw, Ox, On, Ow))
