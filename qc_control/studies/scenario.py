@@ -158,7 +158,7 @@ def _vehicle(values, model: str):
         try:
             return cls.from_mapping(values)
         except ValueError as exc:
-            raise ScenarioError(str(exc), None, _parameter_named(exc, values)) from None
+            raise ScenarioError(str(exc), None, _parameter_named(exc)) from None
     raise ScenarioError(
         f"vehicle must be a {cls.__name__} or a mapping of its parameters (model {model!r}), "
         f"got {type(values).__name__}",
@@ -167,17 +167,9 @@ def _vehicle(values, model: str):
     )
 
 
-def _parameter_named(exc: ValueError, values: Mapping[str, Any]) -> str | None:
-    """The parameter a refusal names: its `ParameterError`'s ``.name``.
-
-    A parameter class that still raises a plain ``ValueError`` names the
-    parameter first in its message ("ms (sprung mass) must be > 0 kg"),
-    which is read until every class raises `ParameterError`.
-    """
-    if isinstance(exc, ParameterError):
-        return exc.name
-    first = str(exc).split(" ", 1)[0]
-    return first if first in values else None
+def _parameter_named(exc: ValueError) -> str | None:
+    """The parameter a refusal names: its `ParameterError`'s ``.name``."""
+    return exc.name if isinstance(exc, ParameterError) else None
 
 
 #: The default step is lowered below a method's stability limit by at most
