@@ -113,7 +113,7 @@ def spectral_axis_rms(
     >>> from qc_control.ride.road import ISO8608Road
     >>> q = ISO8608Road("C", speed=20.0).intensity
     >>> round(spectral_axis_rms(quarter_car_model(road=True), q)["z"], 3)
-    0.826
+    0.665
     """
     q = checks.positive("intensity", intensity, "m²/s")
     posture = checks.choice("posture", posture, POSTURES)
