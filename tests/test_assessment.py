@@ -67,8 +67,9 @@ def test_sine_closed_forms_per_axis(axis, name, f):
 
     The closed forms hold once the filter has started up; the sine's 3 s
     ramp keeps its ringing small (crest factor measured within 0.5 % of
-    √2) and costs the 300 s record about 0.4 % of a_w (the ramp's missing
-    energy: (3/8)·3 s / 300 s) and 0.3 % of VDV: well inside 2 %.
+    √2) and costs the 300 s record about 0.3 % of a_w (the ramp's missing
+    energy, (1 - 3/8)·3 s / 300 s, is 0.6 % of the mean square) and less of
+    the VDV: well inside 2 %.
     """
     A, dt, span = 1.3, 0.002, 300.0
     T, a = _tapered_sine(f, A, span, 3.0, dt)

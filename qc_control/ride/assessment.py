@@ -74,18 +74,37 @@ def running_rms(aw, T, tau: float = guidance.RUNNING_RMS_WINDOW) -> tuple[np.nda
     by linear interpolation (exact for the trapezoid's piecewise-linear
     ``a_w²`` when τ is a whole number of steps).
 
+    Parameters
+    ----------
+    aw : array_like, shape (N,) or (m, N)
+        Weighted accelerations on ``T``.
+    T : array_like, shape (N,)
+        Increasing times [s], spanning at least ``tau``.
+    tau : float, default 1
+        The integration time [s] (§6.3.1 recommends 1 s).
+
     Returns
     -------
     t0, rms : ndarray
-        The times [s] at which a whole window lies in ``T``, and the running
-        RMS there.
+        The times [s] at which a whole window lies in ``T``, ``(K,)``, and the
+        running RMS there, ``(K,)`` or ``(m, K)``.
     """
     T = np.asarray(T, dtype=float)
+    tau = checks.positive("tau", tau, "s")
+    if T[-1] - T[0] < tau * (1 - 1e-9):
+        raise ParameterError(
+            "T", f"{T[-1] - T[0]:g} s", f"a record of at least the running RMS's {tau:g} s window"
+        )
     sq = np.asarray(aw, dtype=float) ** 2
-    cum = np.concatenate([[0.0], np.cumsum(0.5 * (sq[1:] + sq[:-1]) * np.diff(T))])
-    keep = T >= T[0] + tau - 1e-9 * max(tau, T[-1] - T[0])
+    steps = 0.5 * (sq[..., 1:] + sq[..., :-1]) * np.diff(T)
+    cum = np.concatenate([np.zeros(sq.shape[:-1] + (1,)), np.cumsum(steps, axis=-1)], axis=-1)
+    keep = T >= T[0] + tau - 1e-9 * tau
     t0 = T[keep]
-    inside = cum[keep] - np.interp(t0 - tau, T, cum)
+    back = t0 - tau
+    i = np.clip(np.searchsorted(T, back, side="right") - 1, 0, T.size - 2)
+    w = np.clip((back - T[i]) / (T[i + 1] - T[i]), 0.0, 1.0)
+    before = cum[..., i] * (1 - w) + cum[..., i + 1] * w
+    inside = cum[..., keep] - before
     return t0, np.sqrt(np.maximum(inside, 0.0) / tau)
 
 
