@@ -276,6 +276,24 @@ class RideAssessment:
         frame.index.name = "axis"
         return frame
 
+    def summary(self) -> pd.DataFrame:
+        """The whole-ride numbers, one row each: ``value``, ``unit`` and the
+        ``clause`` it follows (what a report cites beside each)."""
+        h = self.health
+        rows = [
+            ("a_v", self.a_v, "m/s²", self.clauses["a_v"]),
+            ("comfort", " / ".join(self.comfort), "", self.clauses["comfort"]),
+            ("crest_factor", self.crest_factor, "-", self.clauses["crest_factor"]),
+            ("additional_methods", self.additional_methods, "", self.clauses["additional_methods"]),
+            ("msdv_z", self.msdv, "m/s^1.5", self.clauses["msdv"]),
+            ("illness", self.illness, "%", self.clauses["illness"]),
+            ("health k·a_w", h.a_w, "m/s²", h.clause),
+            ("health zone", h.zone, "m/s²", h.clause),
+            ("health verdict", h.rms_verdict or h.note, "", h.clause),
+        ]
+        frame = pd.DataFrame(rows, columns=["quantity", "value", "unit", "clause"])
+        return frame.set_index("quantity")
+
     @property
     def verdict(self) -> tuple[str, ...]:
         """The findings in the standard's words, one sentence each, with clauses."""
