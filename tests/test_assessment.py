@@ -179,6 +179,9 @@ def test_a_half_car_response_gives_its_axes_by_role():
     )
     for axis in ("x", "z", "ry"):
         assert result[axis].a_w == pytest.approx(direct[axis].a_w, rel=1e-12)
+    standing = qc.ride_assessment(resp, seat=0.6, posture="standing")
+    assert list(standing.axes) == ["x", "z"]  # §8.2.2.2: the floor's translations only
+    assert standing.health.zone is None  # Annex B is for seated persons
     keep = [i for i, label in enumerate(labels) if label != "pitch_acc"]
     full = model.system
     sub = control.ss(

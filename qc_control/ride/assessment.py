@@ -447,6 +447,10 @@ def ride_assessment(
         raw = dict(signals_or_response)
     else:
         raw, T, notes = axis_signals(signals_or_response, seat=seat, model=model)
+        unused = [axis for axis in raw if axis not in AXIS_RULES[posture]]
+        if unused:  # a car's rotations are not assessed standing (§8.2.2.2)
+            raw = {k: v for k, v in raw.items() if k not in unused}
+            notes += (f"{', '.join(unused)}: not assessed {posture} (ISO 2631-1 §8.2.2)",)
     signals = _checked_signals(raw, posture)
     T, dt = _grid(T, next(iter(signals.values())).size)
     rules = AXIS_RULES[posture]
@@ -540,6 +544,8 @@ def axis_signals(response, *, seat: float | None = None, model: VehicleModel | N
         notes.append(f"x and y are the seat's motion {h:g} m above the pitch and roll axes")
     elif "rx" in signals or "ry" in signals:
         notes.append("no seat height (seat=): the fore-aft and lateral axes are not assessed")
+    elif seat is not None:
+        notes.append(f"{model.name!r} neither pitches nor rolls: the seat height is not used")
     return signals, T, tuple(notes)
 
 
