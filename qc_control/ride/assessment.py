@@ -440,6 +440,17 @@ def ride_assessment(
         An axis the standard does not have (or not for ``posture``), a
         record shorter than 1 s, a step too coarse for a weighting's band,
         a non-finite sample, axes or ``T`` of different lengths.
+
+    Examples
+    --------
+    A 5 Hz vertical sine of 1 m/s² for 10 s: ``a_w ≈ |Wk(5 Hz)|/√2`` (the
+    filter's start-up included), "fairly uncomfortable" (Annex C.2.3).
+
+    >>> import numpy as np
+    >>> T = np.arange(0.0, 10.0, 0.001)
+    >>> result = ride_assessment({"z": np.sin(2 * np.pi * 5 * T)}, T=T)
+    >>> round(result["z"].a_w, 3), result.comfort
+    (0.732, ('fairly uncomfortable',))
     """
     posture = checks.choice("posture", posture, guidance.POSTURES)
     notes: tuple[str, ...] = ()
