@@ -254,8 +254,8 @@ def _rotation_rms(axis: str):
     label, name = _ROTATION_OUTPUTS[axis][0], AXIS_RULES["seated"][axis].weighting
 
     def formula(s, _) -> np.ndarray:
-        if not _rotates(s.roles, axis):
-            return np.zeros(s.output(s.roles.body_acc).shape[0])
+        if not _rotates(s.roles, axis):  # zero per design, through a reduction: it streams
+            return 0.0 * s.peak(s.roles.body_acc)
         return _weighted_rms(s, label, name)
 
     return formula
