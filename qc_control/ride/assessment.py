@@ -209,7 +209,7 @@ class RideAssessment:
     posture : str
     a_v : float
         Vibration total value for comfort ``(Σ k² a_w²)^½`` over the
-        assessed axes [m/s²] (§6.5, factors of §8.2.2).
+        assessed axes [m/s²] (§6.5, factors of §8.2.3).
     msdv : float or None
         Motion sickness dose value of the vertical, Wf-weighted [m/s^1.5]
         (§9.2.2); None without a ``z`` axis.
@@ -333,7 +333,7 @@ class RideAssessment:
 
 
 _CLAUSES = {
-    "a_v": "ISO 2631-1:1997 §6.5, k of §8.2.2",
+    "a_v": "ISO 2631-1:1997 §6.5, k of §8.2.3",
     "comfort": "ISO 2631-1:1997 Annex C.2.3",
     "msdv": "ISO 2631-1:1997 §9.2.2 (Wf)",
     "illness": "ISO 2631-1:1997 Annex D, K_m = 1/3",
@@ -424,7 +424,7 @@ def ride_assessment(
         A response's seat height above the pitch and roll axes [m]: gives
         ``x`` and ``y`` of a half or full car. None: no fore-aft or lateral.
     posture : {'seated', 'standing'}
-        Selects the axes, weightings and factors (§7.2, §8.2.2).
+        Selects the axes, weightings and factors (§7.2, §8.2.3).
     duration : float, optional
         Daily exposure [s] for Annex B's health guidance (10 min to 24 h).
     model : VehicleModel, optional
@@ -459,9 +459,9 @@ def ride_assessment(
     else:
         raw, T, notes = axis_signals(signals_or_response, seat=seat, model=model)
         unused = [axis for axis in raw if axis not in AXIS_RULES[posture]]
-        if unused:  # a car's rotations are not assessed standing (§8.2.2.2)
+        if unused:  # a car's rotations are not assessed standing (§8.2.3)
             raw = {k: v for k, v in raw.items() if k not in unused}
-            notes += (f"{', '.join(unused)}: not assessed {posture} (ISO 2631-1 §8.2.2)",)
+            notes += (f"{', '.join(unused)}: not assessed {posture} (ISO 2631-1 §8.2.3)",)
     signals = _checked_signals(raw, posture)
     T, dt = _grid(T, next(iter(signals.values())).size)
     rules = AXIS_RULES[posture]

@@ -76,14 +76,14 @@ class AxisRule(NamedTuple):
     unit: str
 
 
-_FLOOR = "ISO 2631-1:1997 §8.2.2.2 (comfort, floor, k = 1)"
-_SEAT = "ISO 2631-1:1997 §8.2.2.1 (comfort, seat surface, Wd/Wk, k = 1)"
-_SEAT_ROT = "ISO 2631-1:1997 §8.2.2.1 (comfort, seat-surface rotations, We)"
+_FLOOR = "ISO 2631-1:1997 §8.2.3 (comfort, standing: the floor, k = 1)"
+_SEAT = "ISO 2631-1:1997 §8.2.3 (comfort, seated: the seat surface, k = 1)"
+_SEAT_ROT = "ISO 2631-1:1997 §8.2.3 (comfort, seat-surface rotations, We)"
 #: Per posture, the axes the standard assesses there and their rules. Seated:
 #: the seat surface, translations weighted Wd (x, y) and Wk (z) with k = 1 for
-#: comfort (§8.2.2.1) and k = 1.4, 1.4, 1 for health (§7.2.3); rotations
-#: weighted We with k = 0.63, 0.4, 0.2 m/rad (§8.2.2.1; no health rule).
-#: Standing: the floor, Wd, Wd, Wk, k = 1 (§8.2.2.2); Annex B is for seated
+#: comfort (§8.2.3) and k = 1.4, 1.4, 1 for health (§7.2.3); rotations
+#: weighted We with k = 0.63, 0.4, 0.2 m/rad (§8.2.3; no health rule).
+#: Standing: the floor, Wd, Wd, Wk, k = 1 (§8.2.3); Annex B is for seated
 #: persons, so no health rule.
 AXIS_RULES: dict[str, dict[str, AxisRule]] = {
     "seated": {

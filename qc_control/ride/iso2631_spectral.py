@@ -131,6 +131,6 @@ def spectral_axis_rms(
 
 def spectral_a_v(per_axis, posture: str = "seated"):
     """The vibration total value ``(Σ k² a_w²)^½`` (ISO 2631-1:1997 §6.5, k of
-    §8.2.2) of `spectral_axis_rms`' values [m/s²]."""
+    §8.2.3) of `spectral_axis_rms`' values [m/s²]."""
     rules = AXIS_RULES[checks.choice("posture", posture, POSTURES)]
     return np.sqrt(sum((rules[a].k_comfort * v) ** 2 for a, v in per_axis.items()))
