@@ -263,6 +263,10 @@ def test_iso_axes_and_a_v_of_long_sines():
     quarter = evaluate(RideSignals(T, outputs, ROLES), names)
     assert float(quarter["a_v [m/s²]"][0]) == pytest.approx(got["a_w_z [m/s²]"], rel=1e-12)
     assert float(quarter["a_w_ry [rad/s²]"][0]) == 0.0
+    # a car that pitches, its pitch not given: refused by name, never left out of a_v
+    without = {k: v for k, v in outputs.items() if k != "pitch_acc"}
+    with pytest.raises(ValueError, match="'pitch_acc'"):
+        evaluate(RideSignals(T, without, CAR_ROLES), ["a_v"])
     # the rotations are whole signals: a sweep does not stream them
     assert not MetricStream.supports(metric_columns(["a_w_ry"], CAR_ROLES), CAR_ROLES)
 

@@ -256,6 +256,12 @@ def _rotation_rms(axis: str):
     def formula(s, _) -> np.ndarray:
         if not _rotates(s.roles, axis):  # zero per design, through a reduction: it streams
             return 0.0 * s.peak(s.roles.body_acc)
+        if label not in s.outputs:
+            raise ValueError(
+                f"a_w_{axis} reads the output {label!r}, which these signals do not carry "
+                f"(they have {', '.join(s.outputs)}); pass the model's every output, as "
+                "ride_metrics does"
+            )
         return _weighted_rms(s, label, name)
 
     return formula
