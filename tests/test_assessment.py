@@ -161,6 +161,13 @@ def test_health_zone_scales_as_eq_b1():
     assert two.zone == pytest.approx((0.86, 1.72), rel=1e-12)
     none = qc.ride_assessment({"z": z}, T=T).health
     assert none.zone is None and "duration" in none.note
+    # Figure B.1 spans 10 min to 24 h: no zone outside it, said so
+    short = qc.ride_assessment({"z": z}, T=T, duration=300.0).health
+    assert short.zone is None and "10 min to 24 h" in short.note
+    for posture in ("seated", "standing"):
+        with pytest.raises(qc.ParameterError) as err:
+            qc.ride_assessment({"z": z}, T=T, duration=-1.0, posture=posture)
+        assert err.value.name == "duration"
 
 
 def test_a_half_car_response_gives_its_axes_by_role():

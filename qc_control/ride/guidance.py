@@ -212,6 +212,8 @@ def health_guidance(per_axis, posture: str, span: float, duration) -> HealthGuid
     duration : float or None
         The daily exposure [s].
     """
+    if duration is not None:
+        duration = checks.positive("duration", duration, "s")
     rules = AXIS_RULES[posture]
     scored = {a: v for a, v in per_axis.items() if rules[a].k_health is not None}
     if not scored:
@@ -229,7 +231,6 @@ def health_guidance(per_axis, posture: str, span: float, duration) -> HealthGuid
             f"k·a_w = {a_w:.3g} m/s² ({axis}) against Annex B's caution zone"
         )
         return HealthGuidance(None, a_w, axis, None, None, None, None, note)
-    duration = checks.positive("duration", duration, "s")
     if not HEALTH_DURATIONS[0] <= duration <= HEALTH_DURATIONS[1]:
         note = f"Figure B.1 covers 10 min to 24 h; the exposure {duration:g} s is outside it"
         return HealthGuidance(duration, a_w, axis, None, None, None, None, note)
