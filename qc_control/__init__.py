@@ -134,6 +134,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
         step_response,
     )
     from .ride import road, spectral
+    from .ride.assessment import RideAssessment, ride_assessment
     from .ride.comfort import (
         Transmissibility,
         ride_metrics,
@@ -240,6 +241,9 @@ _LAZY: dict[str, str] = {
     # ISO 2631-1's weightings (Annex A): the transfer function, the weighted signal
     "weighting": "ride.iso2631",
     "weighted": "ride.iso2631",
+    # ISO 2631-1's assessment of a ride: per axis, a_v, MSDV, comfort, health
+    "ride_assessment": "ride.assessment",
+    "RideAssessment": "ride.assessment",
     "wk_weighted": "ride.comfort",
     "max_stable_step": "numerics.stability",
     "numerical_modes": "models.modal",
@@ -396,6 +400,8 @@ __all__ = [
     "wk_filter",
     "weighting",
     "weighted",
+    "ride_assessment",
+    "RideAssessment",
     "wk_weighted",
     "write_report",
     # sampled-data and predictive control

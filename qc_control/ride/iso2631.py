@@ -40,6 +40,7 @@ __all__ = [
     "weighting",
     "weighted",
     "weighting_discrete",
+    "band_top",
     "wk_filter",
     "wk_weighted",
     "wk_discrete",
@@ -199,7 +200,7 @@ def _impulse(name: str, dt: float, N: int) -> tuple[np.ndarray, np.ndarray]:
     return h, v
 
 
-def _band_top(key: str) -> float:
+def band_top(key: str) -> float:
     """The highest frequency [Hz] of the weighting proper (f3 ... f6, not the band
     limit f2): a grid whose Nyquist frequency is below it cannot carry the band."""
     p = WEIGHTINGS[key]
@@ -237,7 +238,7 @@ def weighted(acc, T, name: str) -> np.ndarray:
     if bad.size:
         raise ValueError(f"acc is not finite at sample {int(bad[0, -1])}")
     dt = _uniform(T, key)
-    top = _band_top(key)
+    top = band_top(key)
     if 1 / (2 * dt) < top:
         raise ValueError(
             f"dt = {dt:g} s is too coarse for {key}: its band reaches {top:g} Hz, so the "

@@ -23,7 +23,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..models.vehicle import Corner, SignalRoles
-from .iso2631 import wk_weighted
+from .assessment import running_rms
+from .guidance import AXIS_RULES
+from .iso2631 import weighted, wk_weighted
 
 __all__ = [
     "Metric",
@@ -101,6 +103,7 @@ class RideSignals:
             else tuple(static_load)
         )
         self._weighted: np.ndarray | None = None
+        self._by_weighting: dict[tuple[str, str], np.ndarray] = {}
 
     @property
     def dt(self) -> float:
@@ -127,6 +130,17 @@ class RideSignals:
         if self._weighted is None:
             self._weighted = wk_weighted(self.body_acc, self.T)
         return self._weighted
+
+    def weighted_output(self, label: str, name: str) -> np.ndarray:
+        """An output ``(m, N)`` weighted by ISO 2631-1's ``name`` (`weighted`), once.
+
+        A whole signal, not a reduction: a formula that reads it is not
+        streamed (a sweep simulates its designs' whole responses for it).
+        """
+        key = (label, name)
+        if key not in self._by_weighting:
+            self._by_weighting[key] = weighted(self.output(label), self.T, name)
+        return self._by_weighting[key]
 
     def corner(self, i: int) -> Corner:
         return self.roles.corners[i]
@@ -217,6 +231,67 @@ def _at_corner(signal: str, reduction: str, then=lambda v: v):
     return lambda s, i: then(getattr(s, reduction)(getattr(s.corner(i), signal)))
 
 
+#: ISO 2631-1's seat-surface rotations a car may give, as outputs: ISO axis ->
+#: (output label, the corner word that shows the car has it). The cars count
+#: pitch nose up, ISO's ry nose down: the sign does not change an RMS.
+_ROTATION_OUTPUTS = {"rx": ("roll_acc", "left"), "ry": ("pitch_acc", "rear")}
+
+
+def _weighted_rms(s, label: str, name: str) -> np.ndarray:
+    return np.sqrt(mean_square(s.weighted_output(label, name)))
+
+
+def _rotates(roles: SignalRoles, axis: str) -> bool:
+    """Whether a car's body has the rotation ``axis``, read from its corners'
+    names (a ``rear`` wheel: two axles, so pitch; a ``left`` one: roll)."""
+    word = _ROTATION_OUTPUTS[axis][1]
+    return any(word in c.name for c in roles.corners)
+
+
+def _rotation_rms(axis: str):
+    """The We-weighted RMS of a rotation; zero on a car whose body cannot turn
+    that way (a quarter car neither pitches nor rolls)."""
+    label, name = _ROTATION_OUTPUTS[axis][0], AXIS_RULES["seated"][axis].weighting
+
+    def formula(s, _) -> np.ndarray:
+        if not _rotates(s.roles, axis):  # zero per design, through a reduction: it streams
+            return 0.0 * s.peak(s.roles.body_acc)
+        if label not in s.outputs:
+            raise ValueError(
+                f"a_w_{axis} reads the output {label!r}, which these signals do not carry "
+                f"(they have {', '.join(s.outputs)}); pass the model's every output, as "
+                "ride_metrics does"
+            )
+        return _weighted_rms(s, label, name)
+
+    return formula
+
+
+def _a_v(s, _) -> np.ndarray:
+    """Seated comfort's vibration total value of the body's axes: the vertical
+    (Wk) and, on a car with two axles or two sides, its pitch and roll (We,
+    k = 0.4 and 0.63 m/rad): ISO 2631-1:1997 §6.5, §8.2.3. Which rotations
+    a car has is read from its corners' names (``rear``: pitch, ``left``:
+    roll), so a response without the output is refused, never left out."""
+    rules = AXIS_RULES["seated"]
+    total = s.mean_square(WEIGHTED_ACC)
+    for axis in _ROTATION_OUTPUTS:
+        if _rotates(s.roles, axis):
+            total = total + (rules[axis].k_comfort * _rotation_rms(axis)(s, 0)) ** 2
+    return np.sqrt(total)
+
+
+def _mtvv(s, _) -> np.ndarray:
+    """The largest 1 s running RMS of the Wk-weighted body acceleration (§6.3.1)."""
+    return running_rms(s.weighted_output(s.roles.body_acc, "Wk"), s.T)[1].max(axis=-1)
+
+
+def _msdv(s, _) -> np.ndarray:
+    """``(∫ a_wf² dt)^½`` of the Wf-weighted body acceleration (§9.2.2)."""
+    awf = s.weighted_output(s.roles.body_acc, "Wf")
+    return np.sqrt(mean_square(awf) * (s.T[-1] - s.T[0]))
+
+
 # fmt: off
 _ALL = (
     Metric("rms_body_acc", "m/s²", "RMS body acceleration (trapezoidal time mean): comfort",
@@ -228,6 +303,19 @@ _ALL = (
            lambda s, _: np.sqrt(s.mean_square(WEIGHTED_ACC))),
     Metric("vdv", "m/s^1.75", "vibration dose value (∫ a_w⁴ dt)^¼ (ISO 2631-1:1997, 6.3.2)",
            lambda s, _: s.quartic_integral(WEIGHTED_ACC) ** 0.25),
+    Metric("a_w_z", "m/s²", "ISO 2631-1 weighted RMS of the seat's vertical, Wk "
+           "(ISO 2631-1:1997, 6.1 eq. 1, 8.2.3)",
+           lambda s, _: np.sqrt(s.mean_square(WEIGHTED_ACC))),
+    Metric("a_w_rx", "rad/s²", "ISO 2631-1 weighted RMS of the body's roll acceleration, We "
+           "(ISO 2631-1:1997, 8.2.3)", _rotation_rms("rx")),
+    Metric("a_w_ry", "rad/s²", "ISO 2631-1 weighted RMS of the body's pitch acceleration, We "
+           "(ISO 2631-1:1997, 8.2.3)", _rotation_rms("ry")),
+    Metric("a_v", "m/s²", "ISO 2631-1 vibration total value for comfort of the body's axes: "
+           "z and the rotations (ISO 2631-1:1997, 6.5, 8.2.3)", _a_v),
+    Metric("mtvv", "m/s²", "maximum transient vibration value: the largest 1 s running RMS "
+           "of the Wk-weighted vertical (ISO 2631-1:1997, 6.3.1)", _mtvv),
+    Metric("msdv", "m/s^1.5", "motion sickness dose value of the Wf-weighted vertical "
+           "(ISO 2631-1:1997, 9.2.2)", _msdv),
     Metric("settling_time", "s", "2 % settling time of the body displacement",
            lambda s, _: s.settling_time(s.roles.body_disp)),
     Metric("rms_susp_travel", "m", "RMS suspension travel",

@@ -1,0 +1,103 @@
+"""Exact spectral ISO 2631-1 a_w per axis against long time-domain simulations.
+
+Reference, independent of the Lyapunov solution: the car simulated by
+python-control's exact first-order-hold discretisation (``control.c2d``,
+``method='foh'``: exact for a road linear between samples) on a sampled
+random road whose velocity is white, piecewise constant over each 2 ms step
+with variance ``q/dt`` (the ISO 8608 class C road at 20 m/s, waviness 2),
+weighted in the time domain by `qc.weighted` (itself held to Annex A in
+test_weightings.py), its mean square taken after a 20 s start-up.
+
+The statistical error of a finite record is estimated by batch means (20
+batches); a tolerance is 1 % where that error is below a third of it, else
+three of those errors, stated beside each check.
+"""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+import pytest
+import scipy.signal
+
+import qc_control as qc
+from qc_control.ride.iso2631_spectral import spectral_a_v, spectral_axis_rms
+
+DT = 0.002
+#: ISO 8608 class C at 20 m/s: white road velocity of this intensity [m²/s].
+Q = qc.ISO8608Road("C", speed=20.0).intensity
+
+
+def _simulated(model, rows: dict, span: float, seed: int) -> dict:
+    """Per axis ``(a_w, relative statistical error)`` of a simulated ride; ``rows``
+    maps an axis to ``(weighting, {output label: factor})``."""
+    N = int(round(span / DT)) + 1
+    T = np.arange(N) * DT
+    roads = len(model.road_inputs())
+    rng = np.random.default_rng(seed)
+    velocity = rng.standard_normal((roads, N - 1)) * np.sqrt(Q / DT)
+    zr = np.concatenate([np.zeros((roads, 1)), np.cumsum(velocity * DT, axis=1)], axis=1)
+    labels = list(model.system.output_labels)
+    wanted = sorted({label for _, parts in rows.values() for label in parts})
+    sys = model.system[[labels.index(label) for label in wanted], :]
+    d = control.c2d(sys, DT, method="foh")
+    y = scipy.signal.dlsim((d.A, d.B, d.C, d.D, DT), zr.T)[1].T
+    start = int(round(20.0 / DT))
+    out = {}
+    for axis, (name, parts) in rows.items():
+        acc = sum(factor * y[wanted.index(label)] for label, factor in parts.items())
+        aw = qc.weighted(acc, T, name)[start:]
+        batches = (aw[: aw.size // 20 * 20] ** 2).reshape(20, -1).mean(axis=1)
+        error = batches.std(ddof=1) / np.sqrt(20) / batches.mean() / 2  # of the RMS: half
+        out[axis] = (float(np.sqrt(np.mean(aw**2))), float(error))
+    return out
+
+
+def test_half_car_z_and_pitch_against_240_s():
+    """The half car's seat (Wk) and pitch (We) within three statistical errors of
+    240 s (measured: the seat's error about 0.9 %, the pitch's about 3 %: its
+    1-2 Hz mode decorrelates slowly)."""
+    model = qc.half_car_model(road=True)
+    exact = spectral_axis_rms(model, Q)
+    rows = {"z": ("Wk", {"seat_acc": 1.0}), "ry": ("We", {"pitch_acc": -1.0})}
+    sim = _simulated(model, rows, 240.0, 1)
+    assert sim["z"][1] < 0.01
+    for axis, (value, error) in sim.items():
+        assert exact[axis] == pytest.approx(value, rel=3 * error), axis
+
+
+@pytest.mark.slow
+def test_full_car_every_axis_against_1200_s():
+    """The full car, seat 0.5 m above the axes: z within 1 % of 1200 s (its
+    statistical error measured 0.47 %, so 1 % is two of them; the difference
+    measured 0.01 % and, for another seed, 0.06 %); the slower pitch and roll
+    axes (We, and x, y from them) within three of their statistical errors
+    (measured 0.7-1.3 %; the differences 0.3-1.3 %)."""
+    h = 0.5
+    model = qc.full_car_model(road=True)
+    exact = spectral_axis_rms(model, Q, seat=h)
+    assert list(exact) == ["x", "y", "z", "rx", "ry"]
+    rows = {
+        "x": ("Wd", {"pitch_acc": -h}),
+        "y": ("Wd", {"roll_acc": -h}),
+        "z": ("Wk", {"seat_acc": 1.0}),
+        "rx": ("We", {"roll_acc": 1.0}),
+        "ry": ("We", {"pitch_acc": -1.0}),
+    }
+    sim = _simulated(model, rows, 1200.0, 2)
+    assert sim["z"][1] < 0.005
+    assert exact["z"] == pytest.approx(sim["z"][0], rel=0.01)
+    for axis in ("x", "y", "rx", "ry"):
+        value, error = sim[axis]
+        assert exact[axis] == pytest.approx(value, rel=3 * error), axis
+    k = {"x": 1.0, "y": 1.0, "z": 1.0, "rx": 0.63, "ry": 0.4}  # §8.2.3, seated
+    expected = np.sqrt(sum((k[a] * exact[a]) ** 2 for a in k))
+    assert spectral_a_v(exact) == pytest.approx(expected, rel=1e-12)
+
+
+def test_refuses_a_nonlinear_car_and_a_bad_intensity():
+    with pytest.raises(qc.ParameterError) as err:
+        spectral_axis_rms(qc.half_car_model(road=True), -1.0)
+    assert err.value.name == "intensity"
+    with pytest.raises(ValueError, match="nonlinear"):
+        spectral_axis_rms(qc.get_model("nonlinear").model(road=True), Q)
