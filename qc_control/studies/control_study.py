@@ -436,7 +436,7 @@ def compare_controllers(
             "cs": list(np.geomspace(0.1, 3.0, 40) * critical),
             "ks": [k * p.ks for k in (0.5, 0.75, 1.0, 1.5, 2.0)],
         },
-        road=(road_class, speed),
+        road=road.ISO8608Road(road_class, speed=speed),
         controllers={n: m for n, m in linear.items() if not n.startswith("passive")},
     )
     table = pd.DataFrame.from_dict(rows, orient="index").astype(float)

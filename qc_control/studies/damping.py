@@ -48,7 +48,7 @@ import scipy.optimize
 
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
 from ..models.vehicle import STANDARD_GRAVITY, VehicleModel
-from ..ride.road import positive
+from ..ride.road import ISO8608Road, positive
 from ..ride.spectral import (
     iso8608_intensity,
     require_linear,
@@ -80,10 +80,19 @@ OBJECTIVES = {
 
 
 def _intensity(road) -> float:
-    """White road-velocity intensity [m²/s] from ``road``."""
+    """White road-velocity intensity [m²/s] from ``road``: unit for None, an
+    `ISO8608Road`'s ``intensity``, or an intensity given as a number."""
     if road is None:
         return 1.0
+    if isinstance(road, ISO8608Road):
+        return road.intensity
     if isinstance(road, tuple) and len(road) == 2:
+        warnings.warn(
+            f"road={road!r}: a (class, speed) pair is deprecated and will be removed in the "
+            f"next release: use road=qc.road.ISO8608Road({road[0]!r}, speed={road[1]!r})",
+            DeprecationWarning,
+            stacklevel=3,
+        )
         return iso8608_intensity(road[0], road[1])
     return positive("road (white road-velocity intensity)", road, "m²/s")
 
@@ -95,9 +104,10 @@ def spectral_ride(model: VehicleModel, road=None, *, batch=None, wk: bool = Fals
     ----------
     model : VehicleModel
         A linear vehicle with a road input (one corner is read: the first).
-    road : None, float or (road_class, speed)
-        Unit intensity (None), an intensity [m²/s], or an ISO 8608 road
-        (class letter, speed [m/s]).
+    road : None, ISO8608Road or float
+        Unit intensity (None), an ISO 8608 road (`qc_control.road.ISO8608Road`:
+        its intensity ``2π² n0² Gd(n0) v``), or an intensity [m²/s]. A
+        ``(class, speed)`` pair still works, with a DeprecationWarning.
     batch : BatchedModel, optional
         Many designs of ``model`` at once.
     wk : bool
@@ -248,7 +258,7 @@ def optimal_damping(
         ``'comfort'``, ``'comfort_wk'``, ``'road_holding'``, or weights
         ``{'comfort': 1, 'road_holding': 50, 'travel': 0}`` of the summed
         variances (``'travel'`` alone has no finite optimum: ValueError).
-    road : None, float or (road_class, speed)
+    road : None, ISO8608Road or float
         See `spectral_ride`; it scales every variance by ``q`` and so moves
         the optimum only through ``travel_limit``.
     travel_limit : float, optional
@@ -398,7 +408,7 @@ def pareto_front(
     vary: Mapping[str, Sequence[float]] | None = None,
     objectives: Sequence[str] = ("comfort", "road_holding"),
     *,
-    road=("C", 20.0),
+    road=ISO8608Road("C", speed=20.0),
     travel_limit: float | None = None,
     sigmas: float = 3.0,
     controllers: Mapping[str, Any] | None = None,
@@ -420,8 +430,8 @@ def pareto_front(
         critical damping (60 values).
     objectives : sequence of str
         Two or more of `OBJECTIVES`; the figure plots the first two.
-    road : None, float or (road_class, speed)
-        Default ISO 8608 class C at 20 m/s.
+    road : None, ISO8608Road or float
+        See `spectral_ride`; default ISO 8608 class C at 20 m/s.
     travel_limit : float, optional
         Rattle space [m].
     sigmas : float, default 3
