@@ -48,10 +48,12 @@ import scipy.optimize
 
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
 from ..models.vehicle import STANDARD_GRAVITY, VehicleModel
-from ..ride.road import ISO8608Road, positive
+from ..numerics.checks import positive
+from ..ride.road import ISO8608Road
 from ..ride.spectral import (
-    iso8608_intensity,
+    DEFAULT_ROAD,
     require_linear,
+    road_intensity,
     white_velocity_variances,
     white_velocity_wk_variance,
 )
@@ -79,24 +81,6 @@ OBJECTIVES = {
 }
 
 
-def _intensity(road) -> float:
-    """White road-velocity intensity [m²/s] from ``road``: unit for None, an
-    `ISO8608Road`'s ``intensity``, or an intensity given as a number."""
-    if road is None:
-        return 1.0
-    if isinstance(road, ISO8608Road):
-        return road.intensity
-    if isinstance(road, tuple) and len(road) == 2:
-        warnings.warn(
-            f"road={road!r}: a (class, speed) pair is deprecated and will be removed in the "
-            f"next release: use road=qc.road.ISO8608Road({road[0]!r}, speed={road[1]!r})",
-            DeprecationWarning,
-            stacklevel=3,
-        )
-        return iso8608_intensity(road[0], road[1])
-    return positive("road (white road-velocity intensity)", road, "m²/s")
-
-
 def spectral_ride(model: VehicleModel, road=None, *, batch=None, wk: bool = False) -> pd.DataFrame:
     """Exact RMS ride metrics of linear designs on white road velocity.
 
@@ -106,8 +90,9 @@ def spectral_ride(model: VehicleModel, road=None, *, batch=None, wk: bool = Fals
         A linear vehicle with a road input (one corner is read: the first).
     road : None, ISO8608Road or float
         Unit intensity (None), an ISO 8608 road (`qc_control.road.ISO8608Road`:
-        its intensity ``2π² n0² Gd(n0) v``), or an intensity [m²/s]. A
-        ``(class, speed)`` pair still works, with a DeprecationWarning.
+        its intensity ``2π² n0² Gd(n0) v``), or an intensity ``q`` [m²/s]
+        (`qc_control.ride.spectral.road_intensity`). A ``(class, speed)``
+        pair still works, with a DeprecationWarning naming the ISO8608Road.
     batch : BatchedModel, optional
         Many designs of ``model`` at once.
     wk : bool
@@ -118,7 +103,7 @@ def spectral_ride(model: VehicleModel, road=None, *, batch=None, wk: bool = Fals
     pandas.DataFrame
         One row per design: the columns of `OBJECTIVES` (Wk only with ``wk``).
     """
-    q = _intensity(road)
+    q = road_intensity(road, stacklevel=2)
     corner = model.corners[0]
     var = white_velocity_variances(
         model,
@@ -305,7 +290,7 @@ def optimal_damping(
     if method not in ("auto", "closed form", "numerical"):
         raise ValueError(f"solver must be 'auto', 'closed form' or 'numerical', got {method!r}")
     sigmas = positive("sigmas", sigmas, "")
-    q = _intensity(road)
+    q = road_intensity(road, stacklevel=2)
     model = (
         params
         if isinstance(params, VehicleModel)
@@ -408,7 +393,7 @@ def pareto_front(
     vary: Mapping[str, Sequence[float]] | None = None,
     objectives: Sequence[str] = ("comfort", "road_holding"),
     *,
-    road=ISO8608Road("C", speed=20.0),
+    road: ISO8608Road | float | None = DEFAULT_ROAD,
     travel_limit: float | None = None,
     sigmas: float = 3.0,
     controllers: Mapping[str, Any] | None = None,
@@ -431,7 +416,8 @@ def pareto_front(
     objectives : sequence of str
         Two or more of `OBJECTIVES`; the figure plots the first two.
     road : None, ISO8608Road or float
-        See `spectral_ride`; default ISO 8608 class C at 20 m/s.
+        See `spectral_ride`; default `qc_control.ride.spectral.DEFAULT_ROAD`, ISO 8608
+        class C at 20 m/s.
     travel_limit : float, optional
         Rattle space [m].
     sigmas : float, default 3
@@ -446,6 +432,7 @@ def pareto_front(
     ParetoFront
     """
     p = as_params(params)
+    q = road_intensity(road, stacklevel=2)  # read once: every design sees the same number
     objectives = list(objectives)
     if len(objectives) < 2 or any(o not in OBJECTIVES for o in objectives):
         raise ValueError(
@@ -458,7 +445,7 @@ def pareto_front(
     model = quarter_car_model(p, road=True)
     batch = model.batch([QuarterCarParams.from_mapping(d) for d in designs])
     wk = "comfort_wk" in objectives
-    table = spectral_ride(model, road, batch=batch, wk=wk)
+    table = spectral_ride(model, q, batch=batch, wk=wk)
     frame = pd.concat([pd.DataFrame(designs)[list(vary)], table], axis=1)
     travel = frame[OBJECTIVES["travel"][0]].to_numpy()
     feasible = np.ones(len(frame), dtype=bool)
@@ -476,17 +463,17 @@ def pareto_front(
     front = frame[pareto].sort_values(cols[0]).reset_index(drop=True)
 
     marks: dict[str, pd.Series] = {}
-    seed_row = spectral_ride(model, road, wk=wk).iloc[0]
+    seed_row = spectral_ride(model, q, wk=wk).iloc[0]
     marks["passive (this car)"] = seed_row
     for goal in ("comfort", "road_holding"):
-        opt = optimal_damping(p, goal, road=road, travel_limit=travel_limit, sigmas=sigmas)
+        opt = optimal_damping(p, goal, road=q, travel_limit=travel_limit, sigmas=sigmas)
         marks[f"passive optimum: {goal} (cs={opt.cs:.0f})"] = spectral_ride(
-            quarter_car_model(opt.params, road=True), road, wk=wk
+            quarter_car_model(opt.params, road=True), q, wk=wk
         ).iloc[0]
     for name, ctrl in (controllers or {}).items():
         if isinstance(ctrl, VehicleModel):
             require_linear(ctrl, f"controllers[{name!r}]: the closed loop")
-            marks[name] = spectral_ride(ctrl, road, wk=wk).iloc[0]
+            marks[name] = spectral_ride(ctrl, q, wk=wk).iloc[0]
         else:
             marks[name] = pd.Series(dict(ctrl))
     markers = pd.DataFrame(marks).T
