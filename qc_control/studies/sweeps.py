@@ -248,6 +248,12 @@ class _ChunkTask:
     metric_items: list
     keep_states: bool
 
+    @property
+    def h(self) -> float:
+        """The grid's step [s]: ``T`` is uniform (`_sweep_signals`), so its span over
+        its intervals, as `qc_control.numerics.integrate.uniform_step` computes it."""
+        return (self.T[-1] - self.T[0]) / (self.T.size - 1)
+
 
 class _ChunkResult(NamedTuple):
     """One chunk's designs: ``stable (m,)``, column -> ``(m,)``, states or None."""
@@ -302,7 +308,7 @@ def _run_designs(batch: BatchedModel, task: _ChunkTask, *, eig=None) -> _ChunkRe
     rows = [labels.index(label) for label in wanted]
     y, x = _trajectories(batch, task, rows)
     T, method, substeps = task.T, task.method, task.substeps
-    H = (T[-1] - T[0]) / (T.size - 1)
+    H = task.h
     with np.errstate(over="ignore", invalid="ignore"):
         lam = np.linalg.eigvals(batch.A) if eig is None else eig[0]
         stable = step_is_stable(method, H / substeps, lam)
@@ -328,7 +334,7 @@ def _trajectories(batch: BatchedModel, task: _ChunkTask, rows: list[int]):
     A, B, C, D = batch.A, batch.B, batch.C[:, rows], batch.D[:, rows]
     T, U, X0 = task.T, task.U, task.X0
     m, n = A.shape[0], A.shape[-1]
-    H = (T[-1] - T[0]) / (T.size - 1)
+    H = task.h
     phi, g0, g1 = step_matrices(task.method, A, B, H, task.substeps)
     W = None
     if U is not None:
@@ -383,7 +389,7 @@ def _stream_chunk(batch: BatchedModel, task: _ChunkTask, items, eig=None) -> _Ch
     stream = MetricStream(items, task.roles, T, batch.tire_stiffness, batch.static_load)
     read = list(stream.labels)
     rows = [labels.index(label) for label in read]
-    H = (T[-1] - T[0]) / (T.size - 1)
+    H = task.h
     phi, g0, g1 = step_matrices(task.method, batch.A, batch.B, H, task.substeps)
     scan = _Scan(phi, np.broadcast_to(task.X0, (m, n)), batch.C[:, rows], batch.D[:, rows], g0, g1)
     if stream.weighted:
