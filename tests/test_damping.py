@@ -168,3 +168,22 @@ def test_the_old_method_keyword_warns_and_means_solver():
     assert old.cs == qc.optimal_damping(SEED, "comfort", solver="closed form").cs
     with pytest.raises(ValueError, match="give solver alone"):
         qc.optimal_damping(SEED, method="numerical", solver="numerical")
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda: qc.optimal_damping(SEED, "speed"), "objective"),
+        (lambda: qc.optimal_damping(SEED, {"comfort": 1.0, "speed": 1.0}), "objective['speed']"),
+        (lambda: qc.optimal_damping(SEED, {"comfort": 0.0}), "objective"),
+        (lambda: qc.optimal_damping(SEED, {"comfort": -1.0}), "weight of 'comfort'"),
+        (lambda: qc.optimal_damping(SEED, solver="newton"), "solver"),
+        (lambda: qc.optimal_damping(SEED, solver="numerical", method="numerical"), "method"),
+        (lambda: qc.optimal_damping(SEED, solver="numerical", bounds=(10.0, 1.0)), "bounds"),
+        (lambda: qc.optimal_damping(SEED, road=C20, sigmas=0.0), "sigmas"),
+    ],
+)
+def test_bad_input_is_a_parameter_error_naming_it(call, name):
+    with pytest.raises(qc.ParameterError) as err:
+        call()
+    assert err.value.name == name

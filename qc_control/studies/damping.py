@@ -48,7 +48,7 @@ import scipy.optimize
 
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
 from ..models.vehicle import STANDARD_GRAVITY, VehicleModel
-from ..numerics.checks import positive
+from ..numerics.checks import ParameterError, choice, positive
 from ..ride.road import ISO8608Road
 from ..ride.spectral import (
     DEFAULT_ROAD,
@@ -174,9 +174,8 @@ class DampingOptimum:
 def _weights(objective) -> dict[str, float]:
     if isinstance(objective, str):
         if objective not in OBJECTIVES:
-            raise ValueError(
-                f"objective must be one of {sorted(OBJECTIVES)} or a mapping of weights, "
-                f"got {objective!r}"
+            raise ParameterError(
+                "objective", objective, f"one of {sorted(OBJECTIVES)} or a mapping of weights"
             )
         return {objective: 1.0}
     if not isinstance(objective, Mapping) or not objective:
@@ -187,12 +186,10 @@ def _weights(objective) -> dict[str, float]:
     out = {}
     for k, v in objective.items():
         if k not in OBJECTIVES:
-            raise ValueError(
-                f"unknown objective {k!r} in the weights; expected {sorted(OBJECTIVES)}"
-            )
+            raise ParameterError(f"objective[{k!r}]", k, f"one of {sorted(OBJECTIVES)}")
         out[k] = positive(f"weight of {k!r}", v, "") if v != 0 else 0.0
     if not any(out.values()):
-        raise ValueError(f"the weights {dict(objective)!r} are all zero")
+        raise ParameterError("objective", dict(objective), "weights not all zero")
     return out
 
 
@@ -278,7 +275,7 @@ def optimal_damping(
         )
     if method is not None:
         if solver != "auto":
-            raise ValueError("method is the old name of solver: give solver alone")
+            raise ParameterError("method", method, "not given beside solver: give solver alone")
         warnings.warn(
             "optimal_damping(method=...) is deprecated and will be removed in the next minor "
             "release: use solver=... (method names an integration method elsewhere)",
@@ -287,8 +284,7 @@ def optimal_damping(
         )
         solver = method
     method = solver
-    if method not in ("auto", "closed form", "numerical"):
-        raise ValueError(f"solver must be 'auto', 'closed form' or 'numerical', got {method!r}")
+    choice("solver", method, ("auto", "closed form", "numerical"))
     sigmas = positive("sigmas", sigmas, "")
     q = road_intensity(road, stacklevel=2)
     model = (
@@ -329,7 +325,7 @@ def optimal_damping(
         lo, hi = bounds if bounds is not None else (0.01 * critical, 100 * critical)
         lo, hi = positive("bounds[0]", lo, "N·s/m"), positive("bounds[1]", hi, "N·s/m")
         if hi <= lo:
-            raise ValueError(f"bounds must be increasing, got {bounds!r}")
+            raise ParameterError("bounds", bounds, "(low, high) with low < high N·s/m")
 
         def f(log_cs: float) -> float:
             return objective_value(model.rebuild(_with_cs(p, math.exp(log_cs))))[0]

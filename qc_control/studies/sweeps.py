@@ -19,7 +19,7 @@ from tqdm.auto import tqdm
 from ..models.quarter import SEED_X0, quarter_car_model
 from ..models.registry import model_for_params
 from ..models.vehicle import BatchedModel, SignalRoles, VehicleModel
-from ..numerics.checks import ParameterError
+from ..numerics.checks import ParameterError, integer
 from ..numerics.integrate import check_substeps, check_time_grid, uniform_step
 from ..numerics.limits import check_memory
 from ..numerics.lti import OutputStream, TailBound, affine_scan, step_matrices
@@ -689,10 +689,8 @@ def sweep(
     tab = get_method(method)
     T, X0, U = _sweep_signals(model.system, T, X0, U)
     substeps = check_substeps(substeps)
-    if chunk_size is not None and (
-        isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1
-    ):
-        raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
+    if chunk_size is not None:
+        chunk_size = integer("chunk_size", chunk_size, minimum=1)
     metric_items = _metric_items(metrics, model.roles)
     # by default the designs computed together (a nonlinear sweep: VECTOR_DESIGNS)
     nl_chunk = VECTOR_DESIGNS if chunk_size is None else chunk_size
