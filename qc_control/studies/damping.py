@@ -194,10 +194,8 @@ def _weights(objective) -> dict[str, float]:
 
 
 def _with_cs(params, cs: float):
-    if isinstance(params, QuarterCarParams):
-        return QuarterCarParams.from_mapping({**params.to_dict(changing=["cs"]), "cs": cs})
-    values = params.to_dict(changing=["cs"])
-    return type(params).from_mapping({**values, "cs": cs})
+    """``params`` with the damping ``cs`` [N·s/m], rebuilt (and checked) by its own class."""
+    return type(params).from_mapping({**params.to_dict(changing=["cs"]), "cs": cs})
 
 
 def _travel_floor(p: QuarterCarParams, q: float, travel_limit, sigmas: float) -> float:
