@@ -91,14 +91,27 @@ def test_sweep_on_a_road_is_the_sweep_on_its_samples(the_road):
     )
 
 
-def test_sweep_of_a_half_car_on_a_road_reaches_the_rear_a_wheelbase_later():
-    p = qc.HalfCarParams()
-    model = qc.half_car_model(p, road=True)
+@pytest.mark.parametrize("kind", ["half", "full"])
+def test_sweep_of_a_car_on_axles_reaches_the_rear_a_wheelbase_later(kind):
+    p = qc.HalfCarParams() if kind == "half" else qc.FullCarParams()
+    model = p.model(road=True)
+    iso = road.ISO8608Road("C", speed=10.0, seed=4)
     designs = {"cs_front": [1000.0, 2000.0]}
-    on_road = qc.sweep(designs, T, np.zeros(8), road=BUMP, model=model)
-    U, _ = BUMP.wheel_inputs(T, "axles", wheelbase=p.a + p.b)
-    sampled = qc.sweep(designs, T, np.zeros(8), U=U, model=model)
+    X = np.zeros(model.system.nstates)
+    on_road = qc.sweep(designs, T, X, road=iso, model=model)
+    if kind == "half":
+        U, _ = iso.wheel_inputs(T, "axles", wheelbase=p.a + p.b)
+    else:  # two tracks of one isotropic road, the rear a wheelbase later
+        U, _ = iso.wheel_inputs(T, "corners", wheelbase=p.a + p.b, track=p.track_front)
+    sampled = qc.sweep(designs, T, X, U=U, model=model)
     assert on_road.metrics.equals(sampled.metrics)
+
+
+def test_sweep_of_the_nonlinear_car_on_a_road_is_the_sweep_on_its_samples():
+    model = qc.nonlinear_quarter_car_model(road=True)
+    designs = {"cs": [1000.0, 2000.0]}
+    on_road = qc.sweep(designs, T, X0, road=BUMP, model=model)
+    assert on_road.metrics.equals(qc.sweep(designs, T, X0, U=BUMP.samples(T), model=model).metrics)
 
 
 def test_a_sweep_on_no_road_is_the_free_sweep():
