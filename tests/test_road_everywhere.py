@@ -118,10 +118,13 @@ def test_a_sweep_on_no_road_is_the_free_sweep():
     assert qc.sweep(DESIGNS, T, road=road.NoRoad()).metrics.equals(qc.sweep(DESIGNS, T).metrics)
 
 
-def test_a_sweep_refuses_a_road_beside_its_samples_by_name():
+def test_a_sweep_refuses_a_road_beside_its_samples_or_a_car_without_road_input_by_name():
     with pytest.raises(qc.ParameterError, match="road") as err:
         qc.sweep(DESIGNS, T, X0, U=STEP.samples(T), road=STEP)
     assert err.value.name == "road"
+    with pytest.raises(qc.ParameterError, match="a model with road inputs") as err:
+        qc.sweep(DESIGNS, T, X0, road=STEP, model=qc.quarter_car_model())
+    assert err.value.name == "model"
 
 
 # ------------------------------------------- the spectral studies: road=ISO8608Road

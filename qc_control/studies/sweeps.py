@@ -735,6 +735,10 @@ def _on_road(
         raise ParameterError("road", road, "given alone: the road gives U, its samples on T")
     if model is None:
         model = quarter_car_model(road=not isinstance(road, NoRoad))
+    elif not isinstance(road, NoRoad) and not model.road_inputs():
+        raise ParameterError(
+            "model", model.name, f"a model with road inputs (road=True) to drive {road.noun}"
+        )
     samples, _ = road_inputs(road, T, model_for_params(model.params), model.params)
     return model, samples
 
