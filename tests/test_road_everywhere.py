@@ -196,6 +196,9 @@ def test_ride_metrics_spectral_on_an_iso_road_is_the_older_arguments(exact):
     with pytest.raises(qc.ParameterError) as err:
         qc.ride_metrics_spectral(None, iso, 25.0)  # the speed twice
     assert err.value.name == "speed"
+    with pytest.raises(qc.ParameterError, match="ISO8608Road") as err:
+        qc.ride_metrics_spectral(None, BUMP)
+    assert err.value.name == "road"
 
 
 def test_ride_metrics_spectral_default_is_the_default_road_without_a_warning():

@@ -22,7 +22,7 @@ from ..numerics.checks import ParameterError, positive
 from ..numerics.integrate import uniform_step
 from .iso2631 import wk_filter, wk_weighted
 from .metrics import METRICS, RIDE_METRICS, RideSignals, evaluate
-from .road import ISO8608_BAND, ISO8608_N0, ISO8608Road, road_class_psd
+from .road import ISO8608_BAND, ISO8608_N0, ISO8608Road, Road, road_class_psd
 from .spectral import (
     DEFAULT_ROAD,
     SPECTRAL_CAPABLE,
@@ -305,6 +305,8 @@ def _older_road(road, speed, band, road_class) -> ISO8608Road:
             name, value = ("speed", speed) if speed is not None else ("band", band)
             raise ParameterError(name, value, "not given beside road= (the road holds it)")
         return DEFAULT_ROAD if road is None else road
+    if isinstance(road, Road):  # a step or a bump has no stationary spectrum
+        raise ParameterError("road", road, "a qc.road.ISO8608Road (a random road's spectrum)")
     cls = DEFAULT_ROAD.road_class if road is None else road
     v = DEFAULT_ROAD.speed if speed is None else speed
     band = ISO8608_BAND if band is None else band
