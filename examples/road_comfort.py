@@ -29,7 +29,7 @@ classes, speeds = "ABCD", (10.0, 20.0, 30.0)
 rows = []
 for c in classes:
     for v in speeds:
-        m = qc.ride_metrics_spectral(params, c, v)
+        m = qc.ride_metrics_spectral(params, qc.road.ISO8608Road(c, speed=v))
         rows.append(
             {
                 "class": c,

@@ -26,6 +26,7 @@ from qc_control.models.vehicle import STANDARD_GRAVITY
 from qc_control.studies import damping as D
 
 SEED = qc.QuarterCarParams()
+C20 = qc.road.ISO8608Road("C", speed=20.0)
 
 
 def lyapunov_variances(p):
@@ -76,20 +77,20 @@ def test_comfort_optimum_is_the_published_closed_form():
     ["comfort", "road_holding", {"comfort": 1.0, "road_holding": 100.0, "travel": 1e4}],
 )
 def test_closed_form_optimum_agrees_with_scipy_on_the_spectral_metric(objective):
-    closed = qc.optimal_damping(SEED, objective, road=("C", 20.0))
-    numeric = qc.optimal_damping(SEED, objective, road=("C", 20.0), solver="numerical")
+    closed = qc.optimal_damping(SEED, objective, road=C20)
+    numeric = qc.optimal_damping(SEED, objective, road=C20, solver="numerical")
     assert numeric.method == "scipy.optimize"
     assert math.isclose(closed.cs, numeric.cs, rel_tol=1e-6)
     assert closed.value <= numeric.value * (1 + 1e-12)
 
 
 def test_wk_comfort_is_optimised_numerically_and_is_a_minimum():
-    opt = qc.optimal_damping(SEED, "comfort_wk", road=("C", 20.0))
+    opt = qc.optimal_damping(SEED, "comfort_wk", road=C20)
     assert opt.method == "scipy.optimize"
 
     def value(cs):
         p = qc.QuarterCarParams(ms=SEED.ms, mu=SEED.mu, ks=SEED.ks, ku=SEED.ku, cs=cs)
-        row = D.spectral_ride(qc.quarter_car_model(p, road=True), ("C", 20.0), wk=True)
+        row = D.spectral_ride(qc.quarter_car_model(p, road=True), C20, wk=True)
         return float(row["rms_body_acc_wk [m/s²]"].iloc[0])
 
     # a minimum: 1 % either side is worse
@@ -98,9 +99,9 @@ def test_wk_comfort_is_optimised_numerically_and_is_a_minimum():
 
 def test_travel_limit_is_honoured():
     q = qc.spectral.iso8608_intensity("C", 20.0)
-    free = qc.optimal_damping(SEED, "comfort", road=("C", 20.0))
+    free = qc.optimal_damping(SEED, "comfort", road=C20)
     limit = 0.9 * 3 * free.metrics["rms_susp_travel [m]"]  # tighter than the free optimum
-    opt = qc.optimal_damping(SEED, "comfort", road=("C", 20.0), travel_limit=limit, sigmas=3)
+    opt = qc.optimal_damping(SEED, "comfort", road=C20, travel_limit=limit, sigmas=3)
     assert opt.method.endswith("travel limit") and opt.cs > free.cs
     rms_travel = math.sqrt(q * (SEED.ms + SEED.mu) / (2 * opt.cs))  # closed form
     assert math.isclose(3 * rms_travel, limit, rel_tol=1e-12)
@@ -111,7 +112,7 @@ def test_pareto_front_is_the_non_dominated_feasible_set():
     crit = 2 * math.sqrt(SEED.ks * SEED.ms)
     vary = {"cs": list(np.geomspace(0.1, 3.0, 12) * crit), "ks": [2e4, 3e4, 4e4, 6e4]}
     limit = 0.03
-    pf = qc.pareto_front(SEED, vary, road=("C", 20.0), travel_limit=limit, sigmas=3)
+    pf = qc.pareto_front(SEED, vary, road=C20, travel_limit=limit, sigmas=3)
     allp = pf.all_designs
     x, y = "rms_body_acc [m/s²]", "rms_tire_load / static [-]"
     feasible = allp[3 * allp["rms_susp_travel [m]"] <= limit]
@@ -167,3 +168,22 @@ def test_the_old_method_keyword_warns_and_means_solver():
     assert old.cs == qc.optimal_damping(SEED, "comfort", solver="closed form").cs
     with pytest.raises(ValueError, match="give solver alone"):
         qc.optimal_damping(SEED, method="numerical", solver="numerical")
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda: qc.optimal_damping(SEED, "speed"), "objective"),
+        (lambda: qc.optimal_damping(SEED, {"comfort": 1.0, "speed": 1.0}), "objective['speed']"),
+        (lambda: qc.optimal_damping(SEED, {"comfort": 0.0}), "objective"),
+        (lambda: qc.optimal_damping(SEED, {"comfort": -1.0}), "weight of 'comfort'"),
+        (lambda: qc.optimal_damping(SEED, solver="newton"), "solver"),
+        (lambda: qc.optimal_damping(SEED, solver="numerical", method="numerical"), "method"),
+        (lambda: qc.optimal_damping(SEED, solver="numerical", bounds=(10.0, 1.0)), "bounds"),
+        (lambda: qc.optimal_damping(SEED, road=C20, sigmas=0.0), "sigmas"),
+    ],
+)
+def test_bad_input_is_a_parameter_error_naming_it(call, name):
+    with pytest.raises(qc.ParameterError) as err:
+        call()
+    assert err.value.name == name

@@ -31,12 +31,13 @@ import control
 import numpy as np
 import pandas as pd
 import pytest
+import scipy.linalg
 from reports_shared import placeholder_figures, quick_figures, untimed  # noqa: F401  (fixtures)
 
 import qc_control as qc
 from qc_control.cli.console import main
 from qc_control.cli.parser import build_parser, scenario_from_args
-from qc_control.models.registry import MODELS
+from qc_control.models.registry import MODELS, vehicle_model
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -291,6 +292,55 @@ def test_sweep_against_control(seated):
         assert abs(row[list(result.metrics.columns).index("rms_body_acc [m/s²]")] - rms) <= (
             bound * (1 + 1e-6) + 1e-9
         )
+
+
+def test_vehicle_model_builds_each_registered_model_from_its_parameters(seated):
+    half, p = qc.HalfCarParams(), SeatedCarParams(md=80.0)
+    for params, built in (
+        (half, qc.half_car_model(half, road=True)),
+        (p, seated_car_model(p, road=True)),
+        ({"ks": 25e3}, qc.quarter_car_model(qc.QuarterCarParams(ks=25e3), road=True)),
+        (None, qc.quarter_car_model(road=True)),
+    ):
+        model = vehicle_model(params, road=True)
+        assert model.system.input_labels == built.system.input_labels
+        for k in "ABCD":
+            assert np.array_equal(getattr(model.system, k), getattr(built.system, k))
+
+
+def test_ride_metrics_of_its_parameters_go_through_its_entry(seated):
+    """The ride metrics take the seated car's parameters as they take a quarter
+    car's: the registry builds its model, no branch in the ride layer names it."""
+    p = SeatedCarParams(cd=900.0)
+    model = seated.model(p, road=True)
+    T = np.linspace(0.0, 2.0, 401)
+    resp = control.forced_response(model.system, T, qc.road.step(T, height=0.02, t0=0.2))
+    names = ["rms_body_acc", "peak_susp_travel", "rms_tire_load / static"]
+    assert qc.ride_metrics(resp, p, names).equals(qc.ride_metrics(resp, model, names))
+    # The exact stationary RMS of the driver's acceleration on white road velocity of
+    # intensity q, from a Lyapunov equation solved here by scipy (Bartels-Stewart) on
+    # the car's own matrices: with x̃ = x + A⁻¹B zr the road velocity w enters as
+    # A⁻¹B w, and an acceleration has no static gain from the road height. Two
+    # backward-stable solves of a well-conditioned 6×6 equation: 1e-9 relative.
+    q = qc.road.iso8608_intensity("C", 20.0)
+    A, B, C = (np.asarray(getattr(model.system, k)) for k in "ABC")
+    Bw = np.linalg.solve(A, B)
+    P = scipy.linalg.solve_continuous_lyapunov(A, -Bw @ Bw.T)
+    c = C[OUTPUTS.index("driver_acc")]
+    expected = math.sqrt(q * c @ P @ c)
+    got = qc.ride_metrics_spectral(p, qc.road.ISO8608Road("C", speed=20.0), exact=True)
+    assert got["rms_body_acc [m/s²]"] == pytest.approx(expected, rel=1e-9)
+
+
+def test_fit_parameters_are_fields_of_its_parameters():
+    from qc_control.studies.identification import PHYSICAL
+
+    # the quarter car's entry names what identification fits today
+    assert qc.get_model("quarter").fit_parameters == PHYSICAL
+    assert ENTRY.fit_parameters == ()  # a model not identified
+    with pytest.raises(qc.ParameterError) as err:
+        dataclasses.replace(ENTRY, fit_parameters=("md", "nope"))
+    assert err.value.name == "fit_parameters"
 
 
 @pytest.mark.slow

@@ -109,7 +109,7 @@ def test_spectral_rms_agrees_with_long_simulated_iso_roads():
         r.time[keep], r.outputs[:, keep], issiso=False, output_labels=r.output_labels
     )
     sim = ride_metrics(window, p)
-    spec = ride_metrics_spectral(p, "C", 20.0)
+    spec = ride_metrics_spectral(p, road.ISO8608Road("C", speed=20.0))
     for key in (
         "rms_body_acc [m/s²]",
         "rms_body_acc_wk [m/s²]",
@@ -136,6 +136,6 @@ def test_bad_inputs():
         ValueError,
         match="road_class must be an ISO 8608 class, one of A, B, C, D, E, F, G, H, got 'Q'",
     ):
-        ride_metrics_spectral(None, "Q")
+        ride_metrics_spectral(None, road.ISO8608Road("Q"))
     with pytest.raises(ValueError, match="speed must be a finite number > 0 m/s, got 0.0"):
-        ride_metrics_spectral(None, "C", speed=0.0)
+        ride_metrics_spectral(None, road.ISO8608Road("C", speed=0.0))

@@ -105,7 +105,7 @@ def test_quadrature_over_a_wide_band_equals_lyapunov():
     response's tails beyond are below 1e-7 of each variance: the tire
     deflection's decays slowest, as 1/f), agrees with the Lyapunov value to
     1e-6 relative, the Wk-weighted one included."""
-    wide = ride_metrics_spectral(band=(1e-6, 1e7), points=20000)
+    wide = ride_metrics_spectral(road=road.ISO8608Road(band=(1e-6, 1e7)), points=20000)
     exact = ride_metrics_spectral(exact=True)
     for key in (
         "rms_body_acc [m/s²]",
@@ -122,8 +122,8 @@ def test_seed_car_class_c_band_against_unbounded():
     """Issue 16's numbers for the seed's car on class C at 20 m/s: RMS body
     acceleration 1.25911 unbounded against 1.25899 in the ISO band (printed
     to 6 digits: half a unit in the last), tire load changed by ~2e-3."""
-    exact = ride_metrics_spectral(None, "C", 20.0, exact=True)
-    band = ride_metrics_spectral(None, "C", 20.0)
+    exact = ride_metrics_spectral(None, road.ISO8608Road("C", speed=20.0), exact=True)
+    band = ride_metrics_spectral(None, road.ISO8608Road("C", speed=20.0))
     assert exact["rms_body_acc [m/s²]"] == pytest.approx(1.25911, abs=5e-6)
     assert band["rms_body_acc [m/s²]"] == pytest.approx(1.25899, abs=5e-6)
     change = 1 - band["rms_tire_load / static [-]"] / exact["rms_tire_load / static [-]"]
@@ -197,7 +197,7 @@ def test_spectral_sweep_equals_single_designs():
         if d["zeta"] == 0.0:
             assert not row["stable"] and np.isnan(row["rms_body_acc [m/s²]"])
             continue
-        single = ride_metrics_spectral(qc.QuarterCarParams(**d), "D", 25.0, exact=True)
+        single = ride_metrics_spectral(qc.QuarterCarParams(**d), road_, exact=True)
         assert row["stable"]
         for column in (
             "rms_body_acc [m/s²]",
@@ -212,12 +212,16 @@ def test_spectral_sweep_bad_input():
     from qc_control.ride.spectral import ISO8608Road
 
     road_ = ISO8608Road("C", 20.0)
-    with pytest.raises(ValueError, match="takes no T or U"):
-        qc.sweep({"ks": [2e4]}, np.linspace(0, 1, 11), road=road_)
+    with pytest.raises(ValueError, match="takes no U"):
+        qc.sweep({"ks": [2e4]}, U=np.zeros(11), road=road_)
     with pytest.raises(ValueError, match="'peak_body_acc' has no stationary spectral value"):
         qc.sweep({"ks": [2e4]}, road=road_, metrics=["peak_body_acc"])
-    with pytest.raises(TypeError, match="road must be an ISO8608Road"):
+    with pytest.raises(qc.ParameterError, match="road must be a qc_control.road.Road") as err:
         qc.sweep({"ks": [2e4]}, road="C")
+    assert err.value.name == "road"
+    with pytest.raises(qc.ParameterError, match="an ISO8608Road for a spectral sweep") as err:
+        qc.sweep({"ks": [2e4]}, road=qc.road.Step())  # a step has no stationary spectrum
+    assert err.value.name == "road"
     with pytest.raises(ValueError, match="give T"):
         qc.sweep({"ks": [2e4]})
     with pytest.raises(ValueError, match="speed must be a finite number > 0"):

@@ -170,7 +170,7 @@ def test_progress_bar_when_asked(capsys):
         (dict(T=[0, 0.1, 0.3]), ValueError, "uniformly spaced"),
         (dict(X0=[0, 0.05]), ValueError, "X0 must be 4 finite numbers"),
         (dict(U=np.zeros(5)), ValueError, "U must be finite, of shape \\(2001,\\)"),
-        (dict(chunk_size=0), ValueError, "chunk_size must be a positive integer"),
+        (dict(chunk_size=0), qc.ParameterError, "chunk_size must be a whole number >= 1, got 0"),
         (dict(metrics=["comfort"]), ValueError, "unknown metric 'comfort'"),
         (dict(executor="pool"), TypeError, "executor must be a concurrent.futures.Executor"),
         (dict(method="rk5"), ValueError, "unknown method"),

@@ -29,6 +29,7 @@ from ..models.registry import MODELS, ModelOption, get_model, parameter_help, pa
 from ..numerics.messages import install_hint
 from ..report import ReportError, check_target, report_lock, report_path, write_report
 from ..report.control import unavailable_designs, write_control_report
+from ..ride.road import ISO8608Road
 from ..studies.compare import ReferenceBudgetError
 from ..studies.control_study import DESIGNS, compare_controllers
 from ..studies.scenario import Scenario
@@ -681,8 +682,7 @@ def _control_report(args, params: QuarterCarParams, designs: list[str], out: Pat
         cmp = compare_controllers(
             params,
             designs=designs,
-            road_class=args.road_class,
-            speed=args.speed,
+            road=ISO8608Road(args.road_class, speed=args.speed),
             road_duration=args.road_duration,
             bump_duration=args.bump_duration,
             method=args.method,

@@ -13,13 +13,17 @@ about a kind of vehicle:
 - how its road inputs follow one road (`RoadLayout`: one wheel, two axles
   a wheelbase apart, or four corners on two tracks);
 - what its figures draw besides the body (``wheel_disp``: the wheel's
-  displacement output).
+  displacement output);
+- which of its parameters a grey-box identification may fit
+  (``fit_parameters``; none: the model is not identified).
 
 `qc_control.compare_methods`, `qc_control.Scenario`, the command line and the
 report ask the registry; none of them names a model. `register_model` adds
 one (also as ``qc.register_model``), `unregister_model` takes it away again
 (tests), `get_model` finds one by name, `model_for_params` by the type of
-its parameters.
+its parameters, and `vehicle_model` builds the model of any registered
+vehicle's parameters (the ride metrics and the transmissibility take a
+half car's parameters as they take a quarter car's).
 """
 
 from __future__ import annotations
@@ -31,9 +35,16 @@ from typing import Any
 
 import numpy as np
 
+from ..numerics.checks import ParameterError
 from .halfcar import FullCarParams, HalfCarParams, full_car_model, half_car_model
 from .nonlinear import BumpStop, nonlinear_quarter_car_model
-from .quarter import SEED_X0, QuarterCarParams, check_mount_stiffness, quarter_car_model
+from .quarter import (
+    SEED_X0,
+    QuarterCarParams,
+    as_params,
+    check_mount_stiffness,
+    quarter_car_model,
+)
 from .vehicle import VehicleModel
 
 __all__ = [
@@ -47,6 +58,7 @@ __all__ = [
     "get_model",
     "model_for_params",
     "model_for_system",
+    "vehicle_model",
     "parameter_keys",
     "parameter_help",
 ]
@@ -161,6 +173,10 @@ class ModelEntry:
     wheel_disp : str or None
         The output the report draws as the wheel's displacement beside the
         body's (None: the body alone).
+    fit_parameters : tuple of str
+        The parameters (fields of ``params``) a grey-box identification of
+        measured records may fit; empty (the default) for a model that is
+        not identified.
     """
 
     name: str
@@ -172,6 +188,7 @@ class ModelEntry:
     road_layout: RoadLayout = "single"
     road_function: bool = False
     wheel_disp: str | None = None
+    fit_parameters: tuple[str, ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.isidentifier():
@@ -185,6 +202,11 @@ class ModelEntry:
         if self.road_layout not in _LAYOUTS:
             raise ValueError(
                 f"road_layout must be one of {', '.join(_LAYOUTS)}, got {self.road_layout!r}"
+            )
+        unknown = [n for n in self.fit_parameters if n not in {f.name for f in fields(self.params)}]
+        if unknown:
+            raise ParameterError(
+                "fit_parameters", self.fit_parameters, f"fields of {self.params.__name__}"
             )
 
     def model(self, params=None, *, road: Any = False, **options) -> VehicleModel:
@@ -282,6 +304,31 @@ def model_for_system(sys) -> ModelEntry | None:
     return prefix
 
 
+def vehicle_model(params=None, *, road: Any = False, **options) -> VehicleModel:
+    """The `VehicleModel` of a vehicle's parameters, built by its registered entry.
+
+    The entry is found by the parameters' type (`model_for_params`: the
+    first registered for it, the linear quarter car for `QuarterCarParams`);
+    anything else is read as the quarter car's (`as_params`: None is the
+    seed's car, a dict its fields), and a `VehicleModel` is returned as it
+    is. ``road`` and ``options`` go to the entry's ``build`` (`ModelEntry.model`).
+
+    Raises
+    ------
+    qc_control.ParameterError
+        For parameters no registered model takes.
+    """
+    if isinstance(params, VehicleModel):
+        return params
+    entry = model_for_params(params)
+    if entry is None:  # None, a dict: the quarter car's (as_params refuses the rest)
+        params = as_params(params)
+        entry = model_for_params(params)
+    if entry is None:
+        raise ParameterError("params", params, "the parameters of a registered model")
+    return entry.model(params, road=road, **options)
+
+
 def parameter_keys() -> dict[str, list[str]]:
     """Every parameter name of every registered model, each once in order,
     with the models that take it."""
@@ -377,6 +424,7 @@ for _entry in (
         ),
         defaults=DefaultRun(x0=SEED_X0),
         wheel_disp="xu",
+        fit_parameters=("ms", "mu", "ks", "ku", "cs", "cu"),
     ),
     ModelEntry(
         "half",

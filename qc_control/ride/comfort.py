@@ -8,6 +8,7 @@ and road holding (dynamic tire load against the static wheel load).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -15,16 +16,17 @@ import control
 import numpy as np
 import pandas as pd
 
-from ..models.halfcar import FullCarParams, HalfCarParams
-from ..models.quarter import as_params, quarter_car, quarter_car_model
+from ..models.registry import vehicle_model
 from ..models.vehicle import VehicleModel
+from ..numerics.checks import ParameterError, positive
 from ..numerics.integrate import uniform_step
 from .iso2631 import wk_filter, wk_weighted
 from .metrics import METRICS, RIDE_METRICS, RideSignals, evaluate
-from .road import ISO8608_BAND, ISO8608_N0, band_limits, positive, road_class_psd
+from .road import ISO8608_BAND, ISO8608_N0, ISO8608Road, Road, road_class_psd
 from .spectral import (
+    DEFAULT_ROAD,
     SPECTRAL_CAPABLE,
-    iso8608_intensity,
+    iso8608_spelling,
     spectral_metrics,
     white_velocity_variances,
 )
@@ -45,15 +47,13 @@ _SIGNALS = ("xs", "body_acc", "susp_travel", "tire_defl")
 _UNITS = {"xs": "m/m", "body_acc": "(m/s²)/m", "susp_travel": "m/m", "tire_defl": "m/m"}
 
 
-def _road_system(sys_or_params):
-    if isinstance(sys_or_params, control.StateSpace):
-        if "zr" not in sys_or_params.input_labels:
-            raise ValueError(
-                f"system {sys_or_params.name!r} has no road input 'zr'; build it "
-                "with quarter_car(params, road=True)"
-            )
-        return sys_or_params
-    return quarter_car(as_params(sys_or_params), road=True)
+def _road_system(sys: control.StateSpace) -> control.StateSpace:
+    """``sys``, refused unless it has the quarter car's road input ``zr``."""
+    if "zr" in sys.input_labels:
+        return sys
+    raise ValueError(
+        f"system {sys.name!r} has no road input 'zr'; build it with quarter_car(params, road=True)"
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -186,8 +186,8 @@ def transmissibility(sys_or_params=None, freqs_hz=None, *, speed=None) -> Transm
     f = np.logspace(-1, 2, 200) if freqs_hz is None else np.asarray(freqs_hz, dtype=float)
     if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("freqs_hz must be a 1-D array of finite frequencies > 0 Hz")
-    if isinstance(sys_or_params, (HalfCarParams, FullCarParams)):
-        sys_or_params = sys_or_params.model(road=True)
+    if not isinstance(sys_or_params, (VehicleModel, control.StateSpace)):
+        sys_or_params = vehicle_model(sys_or_params, road=True)
     if isinstance(sys_or_params, VehicleModel) and len(sys_or_params.corners) > 1:
         return _axle_transmissibility(sys_or_params, f, speed)
     if isinstance(sys_or_params, VehicleModel):
@@ -241,14 +241,6 @@ def _gain_unit(unit: str) -> str:
     return f"({unit})/m" if "/" in unit else f"{unit}/m"
 
 
-def _road_model(params) -> VehicleModel:
-    if isinstance(params, VehicleModel):
-        return params
-    if isinstance(params, (HalfCarParams, FullCarParams)):
-        return params.model(road=True)
-    return quarter_car_model(as_params(params), road=True)
-
-
 def ride_metrics(response, params=None, metrics=RIDE_METRICS) -> pd.Series:
     """Comfort, rattle space and road holding of a road response.
 
@@ -285,7 +277,7 @@ def ride_metrics(response, params=None, metrics=RIDE_METRICS) -> pd.Series:
     RMS values are time averages over the response (trapezoidal rule); the
     formulas are those of `qc_control.ride.metrics`.
     """
-    model = _road_model(params)
+    model = vehicle_model(params, road=True)
     T = np.asarray(response.time, dtype=float)
     if uniform_step(T) is None:
         raise ValueError("the response's time grid must be uniform for the ride metrics")
@@ -300,33 +292,64 @@ def ride_metrics(response, params=None, metrics=RIDE_METRICS) -> pd.Series:
     )
 
 
+def _older_road(road, speed, band, road_class) -> ISO8608Road:
+    """The `ISO8608Road` of `ride_metrics_spectral`'s arguments: ``road`` itself, or
+    from 0.1's ``road_class, speed, band`` (positional or by name) with a
+    DeprecationWarning naming the new form at the caller's caller."""
+    if road_class is not None:
+        if road is not None:
+            raise ParameterError("road_class", road_class, "not given beside road= (give road=)")
+        road = road_class
+    if isinstance(road, ISO8608Road) or (road is None and speed is None and band is None):
+        if speed is not None or band is not None:
+            name, value = ("speed", speed) if speed is not None else ("band", band)
+            raise ParameterError(name, value, "not given beside road= (the road holds it)")
+        return DEFAULT_ROAD if road is None else road
+    if isinstance(road, Road):  # a step or a bump has no stationary spectrum
+        raise ParameterError("road", road, "a qc.road.ISO8608Road (a random road's spectrum)")
+    cls = DEFAULT_ROAD.road_class if road is None else road
+    v = DEFAULT_ROAD.speed if speed is None else speed
+    band = ISO8608_BAND if band is None else band
+    new = ISO8608Road(cls, speed=v, band=band)  # a bad class, speed or band refused by name
+    warnings.warn(
+        "ride_metrics_spectral(params, road_class, speed, band) is deprecated and will be "
+        f"removed in the next minor release: use road={iso8608_spelling(cls, v, 0, band)}",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+    return new
+
+
 def ride_metrics_spectral(
     params=None,
-    road_class: str = "C",
-    speed: float = 20.0,
-    band=ISO8608_BAND,
+    road: ISO8608Road | None = None,
+    speed: float | None = None,
+    band=None,
     points: int = 4000,
     *,
     exact: bool = False,
+    road_class: str | None = None,
 ) -> pd.Series:
     """RMS ride metrics on an ISO 8608 road: band-limited, or exact over the unbounded band.
 
     Two values of the same stationary RMS, which differ only by the band:
 
-    - ``exact=False`` (default): the road's spectrum restricted to the
-      standard's band of spatial frequencies (``band``, 0.011–2.83 cycles/m),
-      integrated against the vehicle's frequency response:
+    - ``exact=False`` (default): the road's spectrum restricted to its band
+      of spatial frequencies (``road.band``, by default the standard's
+      0.011–2.83 cycles/m), integrated against the vehicle's frequency
+      response:
 
       .. math:: σ_y^2 = \\int_{v n_{min}}^{v n_{max}} \\sum_r |H_{y r}(j2πf)|^2\\,
                 G_t(f)\\, df, \\qquad G_t(f) = \\frac{G_d(f/v)}{v}
 
       (trapezoidal rule in ``ln f`` on ``points`` log-spaced frequencies),
-      what a road generated by `qc_control.ride.road.iso8608` on that band gives;
+      what a road sampled by ``road.samples`` (`qc_control.ride.road.iso8608`)
+      on that band gives;
     - ``exact=True``: the same spectrum over all frequencies, which is white
       road velocity of intensity ``q = 2π² n0² Gd(n0) v``
-      (`qc_control.ride.spectral.iso8608_intensity`), from the Lyapunov equation
+      (``road.intensity``), from the Lyapunov equation
       (`qc_control.ride.spectral.white_velocity_variances`): no quadrature, exact
-      to rounding; ``band`` and ``points`` are not used.
+      to rounding; the band and ``points`` are not used.
 
     For the seed's car on class C at 20 m/s the band changes the RMS body
     acceleration by about 1e-4 relative (1.25911 exact, 1.25899 in band)
@@ -335,13 +358,18 @@ def ride_metrics_spectral(
 
     Parameters
     ----------
-    params : QuarterCarParams, dict or VehicleModel, optional
-        The vehicle; a `VehicleModel` with road inputs (each road input an
-        independent track of the same class). The seed's car by default.
-    road_class : {'A', ..., 'H'}
-    speed : float
-        [m/s], > 0.
-    band : (n_min, n_max), default ``(0.011, 2.83)`` cycles/m
+    params : vehicle parameters, dict or VehicleModel, optional
+        The vehicle (its registered model with road inputs,
+        `qc_control.models.registry.vehicle_model`); a `VehicleModel` with
+        road inputs (each road input an independent track of the same
+        class). The seed's car by default.
+    road : qc.road.ISO8608Road, optional
+        The road: its class, speed [m/s] and band; default
+        `qc_control.ride.spectral.DEFAULT_ROAD` (class C at 20 m/s).
+    speed, band, road_class
+        Deprecated: 0.1's ``ride_metrics_spectral(params, road_class, speed,
+        band)``, read as ``road=qc.road.ISO8608Road(road_class, speed=speed,
+        band=band)`` with a DeprecationWarning naming it.
     points : int, default 4000
     exact : bool, default False
 
@@ -355,8 +383,10 @@ def ride_metrics_spectral(
         unbounded band the road height is a random walk). ``.attrs["band"]``
         says which value it is.
     """
-    model = _road_model(params)
-    q = iso8608_intensity(road_class, speed)
+    road = _older_road(road, speed, band, road_class)
+    speed = road.speed
+    model = vehicle_model(params, road=True)
+    q = road.intensity
     roles = model.roles
     labels = [roles.body_acc]
     labels += [label for c in roles.corners for label in (c.susp_travel, c.tire_defl)]
@@ -370,12 +400,18 @@ def ride_metrics_spectral(
         series = pd.Series(values)
         series.attrs["band"] = "exact: Lyapunov, unbounded band (white road velocity)"
         return series
-    lo, hi = band_limits(band)
+    lo, hi = road.band
     if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 2:
         raise ValueError(
             f"points must be an integer >= 2 (frequencies in the band), got {points!r}"
         )
-    g0 = road_class_psd(road_class)
+    if not isinstance(road.road_class, str):
+        raise ParameterError(
+            "road_class",
+            road.road_class,
+            "a class A-H for the band's value (Gd(n0) in m³ gives the exact one alone)",
+        )
+    g0 = road_class_psd(road.road_class)
     f = np.geomspace(speed * lo, speed * hi, points)
     sys = model.system
     roads = [list(sys.input_labels).index(r) for r in model.road_inputs()]

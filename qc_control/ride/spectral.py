@@ -24,16 +24,18 @@ quarter car); Dahlberg, J. Sound Vib. 58(2), 1978; Kwakernaak & Sivan,
 from __future__ import annotations
 
 import functools
+import warnings
 
 import control
 import numpy as np
 import scipy.linalg
 
 from ..models.vehicle import VehicleModel
+from ..numerics.checks import ParameterError, positive
 from ..numerics.threads import one_blas_thread
 from .iso2631 import wk_filter
 from .metrics import metric_columns
-from .road import ISO8608Road, iso8608_intensity, positive
+from .road import ISO8608_BAND, ISO8608Road, iso8608_intensity
 
 __all__ = [
     "lyapunov_variances",
@@ -43,6 +45,9 @@ __all__ = [
     "white_velocity_wk_variance",
     "iso8608_intensity",
     "ISO8608Road",
+    "road_intensity",
+    "iso8608_spelling",
+    "DEFAULT_ROAD",
     "spectral_metrics",
     "SPECTRAL_METRICS",
     "SPECTRAL_CAPABLE",
@@ -349,6 +354,86 @@ def white_velocity_wk_variance(model: VehicleModel, *, intensity: float = 1.0, b
 def _wk_matrices() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     sys = control.ss(wk_filter())
     return tuple(np.asarray(getattr(sys, k), dtype=float) for k in "ABCD")  # type: ignore[return-value]
+
+
+#: What a stationary (spectral) metric takes as its road.
+_SPECTRAL_ROAD = (
+    "an ISO8608Road (white road velocity), a white road-velocity intensity q > 0 m²/s, "
+    "or None (q = 1)"
+)
+
+
+#: The random road of the spectral studies unless told otherwise: ISO 8608
+#: class C (average) at 20 m/s (72 km/h), seed 0, the standard's band.
+DEFAULT_ROAD = ISO8608Road("C", speed=20.0)
+
+
+def iso8608_spelling(road_class, speed, seed=0, band=ISO8608_BAND) -> str:
+    """``"qc.road.ISO8608Road('C', speed=20.0)"``: an ISO 8608 road as a user writes it,
+    for a DeprecationWarning that names the new form of an older one (the seed
+    and the band only when they are not the defaults)."""
+    more = f", seed={seed!r}" if seed != 0 else ""
+    more += f", band={tuple(band)!r}" if tuple(band) != tuple(ISO8608_BAND) else ""
+    return f"qc.road.ISO8608Road({road_class!r}, speed={speed!r}{more})"
+
+
+def road_intensity(road=None, *, stacklevel: int = 2) -> float:
+    """The white road-velocity intensity ``q`` [m²/s] a stationary metric reads from ``road``.
+
+    The variances of a linear car on white road velocity are proportional to
+    ``q``; an ISO 8608 road of waviness 2 at a constant speed is white road
+    velocity of intensity
+
+    .. math:: q = 2 π^2 n_0^2 G_d(n_0)\\, v
+
+    (`iso8608_intensity`; ISO 8608:2016, Gobbi & Mastinu, 2001).
+
+    Parameters
+    ----------
+    road : None, ISO8608Road or float
+        ``None``: unit intensity, ``q = 1`` (every variance per unit of
+        ``q``); an `ISO8608Road`: its ``intensity``; a number: ``q`` itself
+        [m²/s], > 0, the level of a road's white velocity spectrum (a
+        measured road's, which has no class or speed). A ``(class, speed)``
+        pair, the older form, is read as ``ISO8608Road(class, speed=speed)``
+        with a DeprecationWarning naming it.
+    stacklevel : int, default 2
+        The frame the DeprecationWarning points at, counted from this
+        function's caller (2: the caller's caller, a user calling a study).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    qc_control.ParameterError
+        For another kind of road (a step or a bump has no stationary
+        spectrum: simulate it) or an intensity that is not a number > 0.
+
+    Examples
+    --------
+    >>> road_intensity(ISO8608Road("C", speed=20.0)) == iso8608_intensity("C", 20.0)
+    True
+    """
+    if road is None:
+        return 1.0
+    if isinstance(road, ISO8608Road):
+        return road.intensity
+    if isinstance(road, tuple) and len(road) == 2:
+        new = ISO8608Road(road[0], speed=road[1])  # a bad class or speed is refused by name
+        warnings.warn(
+            f"road={road!r}: a (class, speed) pair is deprecated and will be removed in the "
+            f"next minor release: use road={iso8608_spelling(*road)}",
+            DeprecationWarning,
+            stacklevel=stacklevel + 1,
+        )
+        return new.intensity
+    if isinstance(road, (bool, np.bool_)) or not isinstance(
+        road, (int, float, np.integer, np.floating)
+    ):
+        raise ParameterError("road", road, _SPECTRAL_ROAD)
+    return positive("road", road, "m²/s", description="white road-velocity intensity q")
 
 
 #: The metrics a spectral sweep computes unless told otherwise (the

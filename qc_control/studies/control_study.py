@@ -22,8 +22,9 @@ Every number is here; `qc_control.report.control` formats them.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import control
 import numpy as np
@@ -33,17 +34,25 @@ from ..models import controllers, mpc
 from ..models.controllers import closed_loop
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
 from ..models.vehicle import VehicleModel
+from ..numerics.checks import ParameterError, positive
 from ..numerics.integrate import check_time_grid
 from ..numerics.limits import check_memory
 from ..numerics.steps import auto_substeps
 from ..responses.timeresp import forced_response, input_output_response
-from ..ride import road
 from ..ride.comfort import ride_metrics
 from ..ride.metrics import mean_square
-from ..ride.road import positive
+from ..ride.road import Bump, ISO8608Road, as_road
+from ..ride.spectral import DEFAULT_ROAD, iso8608_spelling
 from .damping import ParetoFront, optimal_damping, pareto_front, spectral_ride
 
-__all__ = ["ControlComparison", "compare_controllers", "DESIGNS", "BUMP_METRICS", "ROAD_METRICS"]
+__all__ = [
+    "ControlComparison",
+    "compare_controllers",
+    "DESIGNS",
+    "BUMP_METRICS",
+    "ROAD_METRICS",
+    "DEFAULT_BUMP",
+]
 
 #: The designs compared by default, in order.
 DESIGNS = (
@@ -63,6 +72,9 @@ DESIGNS = (
     "MPC, preview 0.2 s",
     "MPC, preview 0.5 s",
 )
+#: The bump of the bump run: 5 cm high, 1 m long, met at 10 m/s at t = 0.5 s
+#: (`qc_control.ride.road.bump`'s own length, speed and start).
+DEFAULT_BUMP = Bump(height=0.05, length=1.0, speed=10.0, t0=0.5)
 #: Metrics of the bump run (names of `qc_control.ride.metrics`).
 BUMP_METRICS = ("peak_body_acc", "peak_susp_travel", "settling_time")
 #: Metrics of the road run.
@@ -100,9 +112,11 @@ class ControlComparison:
         Linear design -> ``{'body_acc': |H|, 'tire_defl': |H|}`` from the
         road height.
     bump : dict
-        ``height`` [m], ``length`` [m], ``speed`` [m/s], ``duration`` [s].
+        The bump run's `Bump`: ``height`` [m], ``length`` [m], ``speed`` [m/s],
+        ``t0`` [s], and the run's ``duration`` [s].
     road : dict
-        ``road_class``, ``speed`` [m/s], ``duration`` [s], ``seed``.
+        The road run's `ISO8608Road`: ``road_class``, ``speed`` [m/s], ``seed``, and
+        the run's ``duration`` [s].
     method : str
     dt : dict
         The time step [s] of the bump and road runs.
@@ -130,7 +144,7 @@ class ControlComparison:
     notes: list = field(default_factory=list)
 
 
-def _design_set(p: QuarterCarParams, road_class, speed, cmax, which, hinf_beta):
+def _design_set(p: QuarterCarParams, iso: ISO8608Road, cmax, which, hinf_beta):
     """name -> (VehicleModel, description): every design on the same car."""
     car = quarter_car_model(p, road=True, actuator=True)
     c_sky, c_gnd = 3000.0, 1000.0
@@ -158,7 +172,7 @@ def _design_set(p: QuarterCarParams, road_class, speed, cmax, which, hinf_beta):
     }
     makers: dict[str, Callable[[], tuple[VehicleModel, str]]] = {
         "passive (seed)": lambda: (quarter_car_model(p, road=True), f"cs = {p.cs:.0f} N·s/m"),
-        "passive optimum": lambda: _passive_optimum(p, road_class, speed),
+        "passive optimum": lambda: _passive_optimum(p, iso),
         **{name: _closed(car, laws[name], what[name]) for name in laws},
         "H∞": lambda: _hinf(car, hinf_beta),
         **_sampled_designs(car),
@@ -200,8 +214,8 @@ def _sampled_designs(car: VehicleModel) -> dict[str, Callable[[], tuple[VehicleM
     }
 
 
-def _passive_optimum(p, road_class, speed):
-    opt = optimal_damping(p, "comfort", road=(road_class, speed))
+def _passive_optimum(p, iso: ISO8608Road):
+    opt = optimal_damping(p, "comfort", road=iso)
     model = quarter_car_model(opt.params, road=True)
     return model, f"comfort optimum (closed form), cs = {opt.cs:.0f} N·s/m, ζ = {opt.zeta:.2f}"
 
@@ -215,9 +229,9 @@ def _hinf(car, beta):
     return closed_loop(car, design.controller), what
 
 
-def _exact_table(linear: dict[str, VehicleModel], road_spec) -> pd.DataFrame:
+def _exact_table(linear: dict[str, VehicleModel], iso: ISO8608Road) -> pd.DataFrame:
     """The exact stationary metrics of the linear designs (empty when none is chosen)."""
-    rows = [spectral_ride(m, road_spec).set_axis([n]) for n, m in linear.items()]
+    rows = [spectral_ride(m, iso).set_axis([n]) for n, m in linear.items()]
     exact = pd.concat(rows) if rows else pd.DataFrame()
     exact.index.name = "design"
     return exact
@@ -347,20 +361,67 @@ def _transmissibility(model: VehicleModel, f: np.ndarray) -> dict[str, np.ndarra
     return {s: np.abs(H[model.output(s), j]) for s in ("body_acc", "tire_defl")}
 
 
+def _older_roads(road, bump, road_class, speed, road_seed, bump_height) -> tuple[ISO8608Road, Bump]:
+    """``(road, bump)`` from 0.1's keywords: ``road_class``, ``speed`` and ``road_seed``
+    give ``ISO8608Road(road_class, speed=speed, seed=road_seed)`` and ``bump_height``
+    gives `DEFAULT_BUMP` of that height, each with a DeprecationWarning naming the new form
+    (at the caller of `compare_controllers`); beside ``road=`` or ``bump=`` they are
+    refused by name."""
+    given = {"road_class": road_class, "speed": speed, "road_seed": road_seed}
+    given = {k: v for k, v in given.items() if v is not None}
+    if given:
+        first = next(iter(given))
+        if road is not DEFAULT_ROAD:
+            raise ParameterError(first, given[first], "not given beside road= (give road= alone)")
+        cls = DEFAULT_ROAD.road_class if road_class is None else road_class
+        v = DEFAULT_ROAD.speed if speed is None else speed
+        seed = DEFAULT_ROAD.seed if road_seed is None else road_seed
+        road = ISO8608Road(cls, speed=v, seed=seed)  # a bad value is refused by name
+        warnings.warn(
+            f"compare_controllers({'=, '.join(given)}=) is deprecated and will be removed in "
+            f"the next minor release: use road={iso8608_spelling(cls, v, seed)}",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+    if bump_height is not None:
+        if bump is not DEFAULT_BUMP:
+            raise ParameterError(
+                "bump_height", bump_height, "not given beside bump= (give bump= alone)"
+            )
+        bump = replace(DEFAULT_BUMP, height=bump_height)  # the height refused by name
+        warnings.warn(
+            "compare_controllers(bump_height=) is deprecated and will be removed in the next "
+            f"minor release: use bump=qc.road.Bump(height={bump_height!r}, "
+            f"length={DEFAULT_BUMP.length!r}, speed={DEFAULT_BUMP.speed!r})",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+    iso, pulse = as_road(road), as_road(bump, where="bump")
+    if not isinstance(iso, ISO8608Road):
+        raise ParameterError(
+            "road", iso, "a qc.road.ISO8608Road (its RMS metrics, exact values and Pareto front)"
+        )
+    if not isinstance(pulse, Bump):
+        raise ParameterError("bump", pulse, "a qc.road.Bump (the bump run's 1 − cos bump)")
+    return iso, pulse
+
+
 def compare_controllers(
     params=None,
     *,
     designs: Sequence[str] = DESIGNS,
-    road_class: str = "C",
-    speed: float = 20.0,
+    road: ISO8608Road = DEFAULT_ROAD,
+    bump: Bump = DEFAULT_BUMP,
     road_duration: float = 10.0,
-    road_seed: int = 0,
-    bump_height: float = 0.05,
     bump_duration: float = 15.0,
     method: str = "rk4",
     cmax: float = 4000.0,
     hinf_beta: float = 0.5,
     freqs_hz=None,
+    road_class: str | None = None,
+    speed: float | None = None,
+    road_seed: int | None = None,
+    bump_height: float | None = None,
 ) -> ControlComparison:
     """Run every design over a bump and an ISO 8608 road, and tabulate.
 
@@ -372,13 +433,17 @@ def compare_controllers(
         A subset of `DESIGNS`, at least one (``'H∞'`` needs slycot). A
         selection without a linear design has no transmissibility and no
         exact metrics; the Pareto front is then the passive one alone.
-    road_class, speed, road_duration, road_seed
-        The ISO 8608 road [-, m/s, s, -], sampled at 5 ms (within
-        `qc_control.ride.road.largest_step` up to 35 m/s).
-    bump_height, bump_duration
-        The 1 m long 1 - cos bump met at 10 m/s [m, s], sampled at 2 ms;
-        the run must be long enough for the body to settle (the seed car's
-        body mode needs about 9 s to reach 2 %).
+    road : qc.road.ISO8608Road, default `DEFAULT_ROAD`
+        The random road of the road run (class C at 20 m/s, seed 0),
+        sampled at 5 ms (within `qc_control.ride.road.largest_step` up to
+        35 m/s); its white road-velocity intensity gives the exact metrics
+        and the Pareto front.
+    bump : qc.road.Bump, default `DEFAULT_BUMP`
+        The bump of the bump run (5 cm high, 1 m long, met at 10 m/s at
+        0.5 s), sampled at 2 ms.
+    road_duration, bump_duration : float
+        The runs' lengths [s]; the bump run must be long enough for the body
+        to settle (the seed car's body mode needs about 9 s to reach 2 %).
     method : str
         The fixed-step method of both runs.
     cmax : float
@@ -387,6 +452,11 @@ def compare_controllers(
         The H∞ design's travel/comfort weight (MATLAB's β).
     freqs_hz : array_like, optional
         Transmissibility frequencies; default 200 from 0.1 to 30 Hz.
+    road_class, speed, road_seed, bump_height
+        Deprecated: the road's class, speed [m/s] and seed, and the bump's
+        height [m], the older form of ``road=qc.road.ISO8608Road(road_class,
+        speed=speed, seed=road_seed)`` and ``bump=qc.road.Bump(height=...,
+        length=1.0, speed=10.0)``; each warns naming that form.
 
     Returns
     -------
@@ -395,14 +465,15 @@ def compare_controllers(
     Raises
     ------
     ValueError
-        For an unknown or empty ``designs``, a bad value (named), or runs
-        whose samples would not fit in memory
-        (`qc_control.numerics.limits.ResourceLimitError`, before any is made).
+        For an unknown or empty ``designs``, a bad value
+        (`qc_control.ParameterError` naming it), or runs whose samples would
+        not fit in memory (`qc_control.numerics.limits.ResourceLimitError`,
+        before any is made).
     TypeError
         If ``designs`` is a string or not a sequence.
     """
+    iso, pulse = _older_roads(road, bump, road_class, speed, road_seed, bump_height)
     p = as_params(params)
-    speed = positive("speed", speed, "m/s")
     road_duration = positive("road_duration", road_duration, "s")
     bump_duration = positive("bump_duration", bump_duration, "s")
     for name, value, dt in (("road", road_duration, DT_ROAD), ("bump", bump_duration, DT_BUMP)):
@@ -412,13 +483,13 @@ def compare_controllers(
                 f"{name} run; give at least {dt:g} s"
             )
     positive("cmax", cmax, "N·s/m")
-    built = _design_set(p, road_class, speed, float(cmax), _design_names(designs), hinf_beta)
+    built = _design_set(p, iso, float(cmax), _design_names(designs), hinf_beta)
     _check_run_length(built, road_duration, bump_duration)
     T_road = check_time_grid(np.arange(0.0, road_duration + DT_ROAD / 2, DT_ROAD), "T")
     T_bump = check_time_grid(np.arange(0.0, bump_duration + DT_BUMP / 2, DT_BUMP), "T")
     runs = {
-        "bump": (T_bump, road.bump(T_bump, height=bump_height)),
-        "road": (T_road, road.iso8608(T_road, road_class, speed=speed, seed=road_seed)),
+        "bump": (T_bump, pulse.samples(T_bump)),
+        "road": (T_road, iso.samples(T_road)),
     }
     f = np.geomspace(0.1, 30.0, 200) if freqs_hz is None else np.asarray(freqs_hz, float)
     rows, trans, notes = {}, {}, []
@@ -436,7 +507,7 @@ def compare_controllers(
             "cs": list(np.geomspace(0.1, 3.0, 40) * critical),
             "ks": [k * p.ks for k in (0.5, 0.75, 1.0, 1.5, 2.0)],
         },
-        road=(road_class, speed),
+        road=iso,
         controllers={n: m for n, m in linear.items() if not n.startswith("passive")},
     )
     table = pd.DataFrame.from_dict(rows, orient="index").astype(float)
@@ -460,16 +531,22 @@ def compare_controllers(
         table=table,
         freqs_hz=f,
         transmissibility=trans,
-        bump={"height": bump_height, "length": 1.0, "speed": 10.0, "duration": bump_duration},
+        bump={
+            "height": pulse.height,
+            "length": pulse.length,
+            "speed": pulse.speed,
+            "t0": pulse.t0,
+            "duration": bump_duration,
+        },
         road={
-            "road_class": road_class,
-            "speed": speed,
+            "road_class": iso.road_class,
+            "speed": iso.speed,
             "duration": road_duration,
-            "seed": road_seed,
+            "seed": iso.seed,
         },
         method=method,
         dt={"bump": DT_BUMP, "road": DT_ROAD},
-        exact=_exact_table(linear, (road_class, speed)),
+        exact=_exact_table(linear, iso),
         pareto=front,
         notes=notes,
     )

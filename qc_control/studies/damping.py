@@ -48,10 +48,12 @@ import scipy.optimize
 
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
 from ..models.vehicle import STANDARD_GRAVITY, VehicleModel
-from ..ride.road import positive
+from ..numerics.checks import ParameterError, choice, positive
+from ..ride.road import ISO8608Road
 from ..ride.spectral import (
-    iso8608_intensity,
+    DEFAULT_ROAD,
     require_linear,
+    road_intensity,
     white_velocity_variances,
     white_velocity_wk_variance,
 )
@@ -79,15 +81,6 @@ OBJECTIVES = {
 }
 
 
-def _intensity(road) -> float:
-    """White road-velocity intensity [m²/s] from ``road``."""
-    if road is None:
-        return 1.0
-    if isinstance(road, tuple) and len(road) == 2:
-        return iso8608_intensity(road[0], road[1])
-    return positive("road (white road-velocity intensity)", road, "m²/s")
-
-
 def spectral_ride(model: VehicleModel, road=None, *, batch=None, wk: bool = False) -> pd.DataFrame:
     """Exact RMS ride metrics of linear designs on white road velocity.
 
@@ -95,9 +88,11 @@ def spectral_ride(model: VehicleModel, road=None, *, batch=None, wk: bool = Fals
     ----------
     model : VehicleModel
         A linear vehicle with a road input (one corner is read: the first).
-    road : None, float or (road_class, speed)
-        Unit intensity (None), an intensity [m²/s], or an ISO 8608 road
-        (class letter, speed [m/s]).
+    road : None, ISO8608Road or float
+        Unit intensity (None), an ISO 8608 road (`qc_control.road.ISO8608Road`:
+        its intensity ``2π² n0² Gd(n0) v``), or an intensity ``q`` [m²/s]
+        (`qc_control.ride.spectral.road_intensity`). A ``(class, speed)``
+        pair still works, with a DeprecationWarning naming the ISO8608Road.
     batch : BatchedModel, optional
         Many designs of ``model`` at once.
     wk : bool
@@ -108,7 +103,7 @@ def spectral_ride(model: VehicleModel, road=None, *, batch=None, wk: bool = Fals
     pandas.DataFrame
         One row per design: the columns of `OBJECTIVES` (Wk only with ``wk``).
     """
-    q = _intensity(road)
+    q = road_intensity(road, stacklevel=2)
     corner = model.corners[0]
     var = white_velocity_variances(
         model,
@@ -179,9 +174,8 @@ class DampingOptimum:
 def _weights(objective) -> dict[str, float]:
     if isinstance(objective, str):
         if objective not in OBJECTIVES:
-            raise ValueError(
-                f"objective must be one of {sorted(OBJECTIVES)} or a mapping of weights, "
-                f"got {objective!r}"
+            raise ParameterError(
+                "objective", objective, f"one of {sorted(OBJECTIVES)} or a mapping of weights"
             )
         return {objective: 1.0}
     if not isinstance(objective, Mapping) or not objective:
@@ -192,20 +186,16 @@ def _weights(objective) -> dict[str, float]:
     out = {}
     for k, v in objective.items():
         if k not in OBJECTIVES:
-            raise ValueError(
-                f"unknown objective {k!r} in the weights; expected {sorted(OBJECTIVES)}"
-            )
+            raise ParameterError(f"objective[{k!r}]", k, f"one of {sorted(OBJECTIVES)}")
         out[k] = positive(f"weight of {k!r}", v, "") if v != 0 else 0.0
     if not any(out.values()):
-        raise ValueError(f"the weights {dict(objective)!r} are all zero")
+        raise ParameterError("objective", dict(objective), "weights not all zero")
     return out
 
 
 def _with_cs(params, cs: float):
-    if isinstance(params, QuarterCarParams):
-        return QuarterCarParams.from_mapping({**params.to_dict(changing=["cs"]), "cs": cs})
-    values = params.to_dict(changing=["cs"])
-    return type(params).from_mapping({**values, "cs": cs})
+    """``params`` with the damping ``cs`` [N·s/m], rebuilt (and checked) by its own class."""
+    return type(params).from_mapping({**params.to_dict(changing=["cs"]), "cs": cs})
 
 
 def _travel_floor(p: QuarterCarParams, q: float, travel_limit, sigmas: float) -> float:
@@ -248,7 +238,7 @@ def optimal_damping(
         ``'comfort'``, ``'comfort_wk'``, ``'road_holding'``, or weights
         ``{'comfort': 1, 'road_holding': 50, 'travel': 0}`` of the summed
         variances (``'travel'`` alone has no finite optimum: ValueError).
-    road : None, float or (road_class, speed)
+    road : None, ISO8608Road or float
         See `spectral_ride`; it scales every variance by ``q`` and so moves
         the optimum only through ``travel_limit``.
     travel_limit : float, optional
@@ -283,7 +273,7 @@ def optimal_damping(
         )
     if method is not None:
         if solver != "auto":
-            raise ValueError("method is the old name of solver: give solver alone")
+            raise ParameterError("method", method, "not given beside solver: give solver alone")
         warnings.warn(
             "optimal_damping(method=...) is deprecated and will be removed in the next minor "
             "release: use solver=... (method names an integration method elsewhere)",
@@ -292,10 +282,9 @@ def optimal_damping(
         )
         solver = method
     method = solver
-    if method not in ("auto", "closed form", "numerical"):
-        raise ValueError(f"solver must be 'auto', 'closed form' or 'numerical', got {method!r}")
+    choice("solver", method, ("auto", "closed form", "numerical"))
     sigmas = positive("sigmas", sigmas, "")
-    q = _intensity(road)
+    q = road_intensity(road, stacklevel=2)
     model = (
         params
         if isinstance(params, VehicleModel)
@@ -334,7 +323,7 @@ def optimal_damping(
         lo, hi = bounds if bounds is not None else (0.01 * critical, 100 * critical)
         lo, hi = positive("bounds[0]", lo, "N·s/m"), positive("bounds[1]", hi, "N·s/m")
         if hi <= lo:
-            raise ValueError(f"bounds must be increasing, got {bounds!r}")
+            raise ParameterError("bounds", bounds, "(low, high) with low < high N·s/m")
 
         def f(log_cs: float) -> float:
             return objective_value(model.rebuild(_with_cs(p, math.exp(log_cs))))[0]
@@ -398,7 +387,7 @@ def pareto_front(
     vary: Mapping[str, Sequence[float]] | None = None,
     objectives: Sequence[str] = ("comfort", "road_holding"),
     *,
-    road=("C", 20.0),
+    road: ISO8608Road | float | None = DEFAULT_ROAD,
     travel_limit: float | None = None,
     sigmas: float = 3.0,
     controllers: Mapping[str, Any] | None = None,
@@ -420,8 +409,9 @@ def pareto_front(
         critical damping (60 values).
     objectives : sequence of str
         Two or more of `OBJECTIVES`; the figure plots the first two.
-    road : None, float or (road_class, speed)
-        Default ISO 8608 class C at 20 m/s.
+    road : None, ISO8608Road or float
+        See `spectral_ride`; default `qc_control.ride.spectral.DEFAULT_ROAD`, ISO 8608
+        class C at 20 m/s.
     travel_limit : float, optional
         Rattle space [m].
     sigmas : float, default 3
@@ -436,6 +426,7 @@ def pareto_front(
     ParetoFront
     """
     p = as_params(params)
+    q = road_intensity(road, stacklevel=2)  # read once: every design sees the same number
     objectives = list(objectives)
     if len(objectives) < 2 or any(o not in OBJECTIVES for o in objectives):
         raise ValueError(
@@ -448,7 +439,7 @@ def pareto_front(
     model = quarter_car_model(p, road=True)
     batch = model.batch([QuarterCarParams.from_mapping(d) for d in designs])
     wk = "comfort_wk" in objectives
-    table = spectral_ride(model, road, batch=batch, wk=wk)
+    table = spectral_ride(model, q, batch=batch, wk=wk)
     frame = pd.concat([pd.DataFrame(designs)[list(vary)], table], axis=1)
     travel = frame[OBJECTIVES["travel"][0]].to_numpy()
     feasible = np.ones(len(frame), dtype=bool)
@@ -466,17 +457,17 @@ def pareto_front(
     front = frame[pareto].sort_values(cols[0]).reset_index(drop=True)
 
     marks: dict[str, pd.Series] = {}
-    seed_row = spectral_ride(model, road, wk=wk).iloc[0]
+    seed_row = spectral_ride(model, q, wk=wk).iloc[0]
     marks["passive (this car)"] = seed_row
     for goal in ("comfort", "road_holding"):
-        opt = optimal_damping(p, goal, road=road, travel_limit=travel_limit, sigmas=sigmas)
+        opt = optimal_damping(p, goal, road=q, travel_limit=travel_limit, sigmas=sigmas)
         marks[f"passive optimum: {goal} (cs={opt.cs:.0f})"] = spectral_ride(
-            quarter_car_model(opt.params, road=True), road, wk=wk
+            quarter_car_model(opt.params, road=True), q, wk=wk
         ).iloc[0]
     for name, ctrl in (controllers or {}).items():
         if isinstance(ctrl, VehicleModel):
             require_linear(ctrl, f"controllers[{name!r}]: the closed loop")
-            marks[name] = spectral_ride(ctrl, road, wk=wk).iloc[0]
+            marks[name] = spectral_ride(ctrl, q, wk=wk).iloc[0]
         else:
             marks[name] = pd.Series(dict(ctrl))
     markers = pd.DataFrame(marks).T

@@ -25,6 +25,7 @@ from ..models.quarter import QuarterCarParams, quarter_car
 from ..numerics.reference import exact_response
 from ..responses.timeresp import initial_response
 from ..ride.comfort import ride_metrics_spectral
+from ..ride.road import ISO8608Road
 
 __all__ = ["EXERCISES", "Exercise", "check"]
 
@@ -35,7 +36,7 @@ _SPAN = 10.0
 _TARGET = 1e-3
 #: Exercise 5's grid of nominal damping ratios and road.
 _ZETAS = np.round(np.arange(0.10, 1.01, 0.05), 2)
-_ROAD_CLASS, _SPEED = "C", 20.0
+_ROAD = ISO8608Road("C", speed=20.0)
 #: Exercise 5 accepts a ratio whose Wk RMS is within this fraction of the
 #: lowest: 0.3 % is one pixel of Section 5's plot (its axis spans about 0.38
 #: m/s² over about 250 px), so anything a student can tell apart on the plot
@@ -243,7 +244,7 @@ def _judge_4(answer) -> str | None:
 
 
 def _wk_rms(zeta: float) -> float:
-    metrics = ride_metrics_spectral(QuarterCarParams(zeta=zeta), _ROAD_CLASS, _SPEED)
+    metrics = ride_metrics_spectral(QuarterCarParams(zeta=zeta), _ROAD)
     return float(metrics[[k for k in metrics.index if "wk" in k.lower()][0]])
 
 

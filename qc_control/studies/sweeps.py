@@ -17,7 +17,9 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from ..models.quarter import SEED_X0, quarter_car_model
+from ..models.registry import model_for_params
 from ..models.vehicle import BatchedModel, SignalRoles, VehicleModel
+from ..numerics.checks import ParameterError, integer
 from ..numerics.integrate import check_substeps, check_time_grid, uniform_step
 from ..numerics.limits import check_memory
 from ..numerics.lti import OutputStream, TailBound, affine_scan, step_matrices
@@ -34,8 +36,10 @@ from ..ride.metrics import (
     RideSignals,
     metric_columns,
 )
+from ..ride.road import NoRoad, Road, as_road
 from ..ride.spectral import SPECTRAL_METRICS, ISO8608Road, require_linear, spectral_metrics
 from .nlsweep import nonlinear_sweep
+from .on_road import road_inputs
 
 __all__ = [
     "sweep",
@@ -78,9 +82,10 @@ class SweepResult:
         The rejected designs: ``index``, ``value`` and ``error``.
     states : ndarray or None
         ``(designs, 4, len(T))`` when asked for (NaN for rejected designs).
-    road : ISO8608Road or None
-        The road of a spectral sweep (then ``T`` and ``method`` are None, and
-        ``stable`` says the design's ``A`` is Hurwitz).
+    road : qc_control.road.Road or None
+        The road the designs drove (``road=``); for a spectral sweep an
+        `ISO8608Road`, and then ``T`` and ``method`` are None and ``stable``
+        says the design's ``A`` is Hurwitz.
     """
 
     T: np.ndarray | None
@@ -88,7 +93,7 @@ class SweepResult:
     metrics: pd.DataFrame
     errors: pd.DataFrame
     states: np.ndarray | None = None
-    road: ISO8608Road | None = None
+    road: Road | None = None
 
 
 #: Bytes a sweep holds per design besides its chunks: the design's dict, its
@@ -243,6 +248,12 @@ class _ChunkTask:
     metric_items: list
     keep_states: bool
 
+    @property
+    def h(self) -> float:
+        """The grid's step [s]: ``T`` is uniform (`_sweep_signals`), so its span over
+        its intervals, as `qc_control.numerics.integrate.uniform_step` computes it."""
+        return (self.T[-1] - self.T[0]) / (self.T.size - 1)
+
 
 class _ChunkResult(NamedTuple):
     """One chunk's designs: ``stable (m,)``, column -> ``(m,)``, states or None."""
@@ -297,7 +308,7 @@ def _run_designs(batch: BatchedModel, task: _ChunkTask, *, eig=None) -> _ChunkRe
     rows = [labels.index(label) for label in wanted]
     y, x = _trajectories(batch, task, rows)
     T, method, substeps = task.T, task.method, task.substeps
-    H = (T[-1] - T[0]) / (T.size - 1)
+    H = task.h
     with np.errstate(over="ignore", invalid="ignore"):
         lam = np.linalg.eigvals(batch.A) if eig is None else eig[0]
         stable = step_is_stable(method, H / substeps, lam)
@@ -323,7 +334,7 @@ def _trajectories(batch: BatchedModel, task: _ChunkTask, rows: list[int]):
     A, B, C, D = batch.A, batch.B, batch.C[:, rows], batch.D[:, rows]
     T, U, X0 = task.T, task.U, task.X0
     m, n = A.shape[0], A.shape[-1]
-    H = (T[-1] - T[0]) / (T.size - 1)
+    H = task.h
     phi, g0, g1 = step_matrices(task.method, A, B, H, task.substeps)
     W = None
     if U is not None:
@@ -378,7 +389,7 @@ def _stream_chunk(batch: BatchedModel, task: _ChunkTask, items, eig=None) -> _Ch
     stream = MetricStream(items, task.roles, T, batch.tire_stiffness, batch.static_load)
     read = list(stream.labels)
     rows = [labels.index(label) for label in read]
-    H = (T[-1] - T[0]) / (T.size - 1)
+    H = task.h
     phi, g0, g1 = step_matrices(task.method, batch.A, batch.B, H, task.substeps)
     scan = _Scan(phi, np.broadcast_to(task.X0, (m, n)), batch.C[:, rows], batch.D[:, rows], g0, g1)
     if stream.weighted:
@@ -563,7 +574,7 @@ def sweep(
     substeps: int = 1,
     chunk_size: int | None = None,
     progress: bool | None = None,
-    road: ISO8608Road | None = None,
+    road: Road | None = None,
     events: bool = False,
 ) -> SweepResult:
     """Simulate many designs of a vehicle at once and tabulate their metrics.
@@ -623,15 +634,21 @@ def sweep(
     progress : bool, optional
         Show a tqdm bar. By default it appears on a terminal when the sweep
         outlasts 1 s, and never when standard error is not a terminal.
-    road : ISO8608Road, optional
-        A spectral sweep instead of a simulation: the exact stationary RMS
-        metrics on this road (`qc_control.ride.spectral.spectral_metrics`, the
-        Lyapunov equation of each design on white road velocity, batched),
-        for a linear model with road inputs (default
-        ``quarter_car_model(road=True)``). Give no ``T``, ``U`` or ``X0``;
-        ``metrics`` among `qc_control.ride.spectral.SPECTRAL_CAPABLE` (default
-        `qc_control.ride.spectral.SPECTRAL_METRICS`). Runs here, vectorised over
-        all designs (``executor`` is not used).
+    road : qc_control.road.Road, optional
+        The road every design drives. With ``T``: sampled on ``T`` under
+        every wheel in the model's layout (`qc_control.road.Road.wheel_inputs`,
+        the rear wheels a wheelbase later; `qc_control.studies.on_road`) and
+        simulated, the same numbers as its samples given as ``U`` (give one
+        of ``road`` and ``U``); the default model then has road inputs.
+        Without ``T``, an `ISO8608Road` is a spectral sweep instead of a
+        simulation: the exact stationary RMS metrics on this road
+        (`qc_control.ride.spectral.spectral_metrics`, the Lyapunov equation of
+        each design on white road velocity, batched), for a linear model
+        with road inputs (default ``quarter_car_model(road=True)``). Give no
+        ``U`` or ``X0`` then; ``metrics`` among
+        `qc_control.ride.spectral.SPECTRAL_CAPABLE` (default
+        `qc_control.ride.spectral.SPECTRAL_METRICS`). Runs here, vectorised
+        over all designs (``executor`` is not used).
     events : bool, default False
         Nonlinear models only: locate each kink (contact, stop, damper knee)
         inside its step, for the designs that have one in that step
@@ -662,17 +679,18 @@ def sweep(
     and value, with NaN metrics; the other designs are unaffected.
     """
     if road is not None:
-        return _spectral_sweep(designs, T, U, road, metrics, model)
+        road = as_road(road)
+        if T is None:
+            return _spectral_sweep(designs, U, road, metrics, model)
+        model, U = _on_road(road, T, U, model)
     if T is None:
         raise ValueError("give T (a time grid) for a simulated sweep, or road= for a spectral one")
     model = quarter_car_model(road=U is not None) if model is None else model
     tab = get_method(method)
     T, X0, U = _sweep_signals(model.system, T, X0, U)
     substeps = check_substeps(substeps)
-    if chunk_size is not None and (
-        isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1
-    ):
-        raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
+    if chunk_size is not None:
+        chunk_size = integer("chunk_size", chunk_size, minimum=1)
     metric_items = _metric_items(metrics, model.roles)
     # by default the designs computed together (a nonlinear sweep: VECTOR_DESIGNS)
     nl_chunk = VECTOR_DESIGNS if chunk_size is None else chunk_size
@@ -703,7 +721,26 @@ def sweep(
         results = _chunk_results(executor, chunks, batch, task, eig)
         stable, table, kept = _gather(chunks, results, len(designs), task, progress)
     frame, err_frame = _tables(designs, params, errors, model, stable, table)
-    return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept)
+    return SweepResult(T=T, method=tab, metrics=frame, errors=err_frame, states=kept, road=road)
+
+
+def _on_road(
+    road: Road, T, U, model: VehicleModel | None
+) -> tuple[VehicleModel, np.ndarray | None]:
+    """``(model, U)`` of a sweep on ``road`` over ``T``: the model (by default the
+    quarter car with its road input) and the road's samples in its layout
+    (`qc_control.studies.on_road.road_inputs`, the registry's entry for the
+    model's parameters), refused beside samples of its own."""
+    if U is not None:
+        raise ParameterError("road", road, "given alone: the road gives U, its samples on T")
+    if model is None:
+        model = quarter_car_model(road=not isinstance(road, NoRoad))
+    elif not isinstance(road, NoRoad) and not model.road_inputs():
+        raise ParameterError(
+            "model", model.name, f"a model with road inputs (road=True) to drive {road.noun}"
+        )
+    samples, _ = road_inputs(road, T, model_for_params(model.params), model.params)
+    return model, samples
 
 
 def _design_list(designs, model: VehicleModel, check) -> list:
@@ -857,13 +894,18 @@ def _tables(designs, params, errors, model, stable, table) -> tuple[pd.DataFrame
     return frame, err_frame
 
 
-def _spectral_sweep(designs, T, U, road, metrics, model) -> SweepResult:
-    """`sweep` with ``road=``: exact stationary RMS metrics, no simulation."""
+def _spectral_sweep(designs, U, road: Road, metrics, model) -> SweepResult:
+    """`sweep` with ``road=`` and no ``T``: exact stationary RMS metrics, no simulation."""
     if not isinstance(road, ISO8608Road):
-        raise TypeError(f"road must be an ISO8608Road, got {type(road).__name__}")
-    if T is not None or U is not None:
+        raise ParameterError(
+            "road",
+            road,
+            "an ISO8608Road for a spectral sweep (without T); give T to simulate the designs "
+            "on this road",
+        )
+    if U is not None:
         raise ValueError(
-            "a spectral sweep (road=) takes no T or U: its metrics are stationary, "
+            "a spectral sweep (road= without T) takes no U: its metrics are stationary, "
             "over the unbounded band"
         )
     model = quarter_car_model(road=True) if model is None else model
