@@ -47,6 +47,7 @@ and ``bump_length``) are read for one more release, each with a
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import json
 import math
@@ -840,8 +841,8 @@ class Scenario:
     def run(self, progress: Callable[[str], None] | None = None) -> MethodComparison:
         """Run the comparison: `qc_control.compare_methods` on this scenario.
 
-        Returns its `MethodComparison`, with ``cmp.scenario`` set to this
-        scenario (the report records it and its `command`).
+        Returns its `MethodComparison` with ``scenario`` this scenario (the
+        report records it and its `command`).
         """
         vehicle, T, U, description = self.problem()
         cmp = compare_methods(
@@ -856,9 +857,8 @@ class Scenario:
             **self.option_arguments("compare"),
         )
         if self.kind == "stiff" and cmp.ride is not None:  # on the road: a ride answer
-            cmp.ride_cost = stiff_car_ride_cost(cmp, progress=progress)
-        cmp.scenario = self
-        return cmp
+            cmp = dataclasses.replace(cmp, ride_cost=stiff_car_ride_cost(cmp, progress=progress))
+        return dataclasses.replace(cmp, scenario=self)  # the comparison is frozen
 
     # ------------------------------------------------------ reading, writing
 

@@ -63,7 +63,7 @@ class Provenance(Protocol):
         ...
 
 
-@dataclass(eq=False)
+@dataclass(frozen=True, eq=False)
 class ComparisonProblem:
     """What every method of a comparison solves, as `compare_methods` checked it.
 

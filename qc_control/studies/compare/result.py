@@ -26,12 +26,16 @@ from .problem import (
 )
 
 
-@dataclass(eq=False)
+@dataclass(frozen=True, eq=False)
 class MethodComparison(ComparisonProblem):
     """The numbers of a method comparison. See `compare_methods`.
 
     Its problem (system, grid, start, input, step, methods) is that of
-    `ComparisonProblem`.
+    `ComparisonProblem`. Frozen: every number is computed before it is
+    built, once; what a later step adds (a stiff car's ``ride_cost``, the
+    ``scenario`` a run came from) makes a new one with
+    ``dataclasses.replace(cmp, ride_cost=...)``. Its column names are named
+    in `qc_control.studies.columns`.
 
     Attributes
     ----------
@@ -74,8 +78,8 @@ class MethodComparison(ComparisonProblem):
         Under a road input: the road-to-ride frequency responses.
     scenario : Provenance or None
         The run this comparison came from, when it came from one (the
-        command line's Scenario sets itself here); the report prints its
-        command and saves its TOML.
+        command line's Scenario returns ``dataclasses.replace(cmp,
+        scenario=self)``); the report prints its command and saves its TOML.
     nonlinear : NonlinearStudy or None
         On a nonlinear system: events, the order with and without them,
         where Midpoint and Heun part, the linearisation behind ``modes``.
@@ -88,7 +92,7 @@ class MethodComparison(ComparisonProblem):
         step limits the comparison reports (the controller acts only at the
         ticks); the reference is then `sampled_reference`.
     ride_cost : RideCost or None
-        Set by the stiff car's run (`qc_control.studies.ride_cost`): each
+        Given by the stiff car's run (`qc_control.studies.ride_cost`): each
         method's and peer's cheapest setting whose ride metric is within a
         target of the exact one, with its evaluations and time.
     cost_checks : list of CostCheck or None

@@ -58,9 +58,14 @@ def _cost_columns(problem: ComparisonProblem, responses: dict) -> pd.DataFrame:
 
 
 def _comparison(
-    problem: ComparisonProblem, measured: Measured, input_description: str
+    problem: ComparisonProblem,
+    measured: Measured,
+    input_description: str,
+    peers: WorkPrecision | None = None,
+    sampled_car: control.StateSpace | None = None,
 ) -> MethodComparison:
-    """The comparison from what either path measured: errors, modes, cost, ride."""
+    """The comparison from what either path measured: errors, modes, cost, ride; with
+    the peers' study and a sampled loop's car, each computed before (the result is frozen)."""
     reference, responses, tabs = measured.reference, measured.responses, problem.methods
     numerical, stability = mode_errors(tabs, problem.h, measured.linear, measured.modes)
     span = float(problem.T[-1] - problem.T[0])
@@ -109,6 +114,8 @@ def _comparison(
         ride_error=ride_error,
         transmissibility=measured.transmissibility,
         nonlinear=measured.nonlinear,
+        peers=peers,
+        sampled_car=sampled_car,
     )
 
 
@@ -262,9 +269,7 @@ def compare_methods(
                 "the clock"
             )
         measured = measure_sampled(problem, repeats, timing, progress)
-        cmp = _comparison(problem, measured, input_description)
-        cmp.sampled_car = measured.linear
-        return cmp
+        return _comparison(problem, measured, input_description, sampled_car=measured.linear)
     elif is_nonlinear_system(sys):
         measured = measure_nonlinear(problem, events, levels, timing, progress)
     else:
@@ -274,10 +279,8 @@ def compare_methods(
                 "no switching and always refines h five times"
             )
         measured = measure_linear(problem, repeats, timing, progress)
-    cmp = _comparison(problem, measured, input_description)
-    if peers:
-        cmp.peers = _peer_study(problem, measured, peers, rtols, progress)
-    return cmp
+    study = _peer_study(problem, measured, peers, rtols, progress) if peers else None
+    return _comparison(problem, measured, input_description, peers=study)
 
 
 def _peer_study(
