@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import pandas as pd
 
-from ..studies.timing import TIME_COLUMNS
+from ..studies import columns as col
 from .document import Code, Heading, Image, Paragraph, Table, fmt
 from .figures import (
     convergence_figure,
@@ -434,22 +434,22 @@ def _accuracy_blocks(cmp, figs: dict[str, Image]) -> list:
 
 def _convergence_blocks(cmp, figs: dict[str, Image]) -> list:
     """The error at each refinement of h, and the order observed from it."""
-    conv = cmp.convergence.pivot(index="h", columns="method", values="error")
+    conv = cmp.convergence.pivot(index=col.H, columns=col.METHOD, values=col.ERROR)
     conv = conv.sort_index(ascending=False)[[t.name for t in cmp.methods]]
-    conv.index.name = "h [s]"
-    finest = 2 ** int(cmp.convergence["level"].max())
+    conv.index.name = col.STEP
+    finest = 2 ** int(cmp.convergence[col.LEVEL].max())
     return [
         Heading("Convergence"),
         figs["convergence.png"],
         Table(conv, f"Max |{_body(cmp)} error| [m] at h, h/2, …, h/{finest}"),
         Table(
-            cmp.table[["order", "observed order"]],
+            cmp.table[[col.ORDER, col.OBSERVED_ORDER]],
             "Observed order: least-squares slope of log error against log h over h, h/2 and h/4",
         ),
     ]
 
 
-_COST_COLUMNS = ["stages", "steps", "RHS evals", *TIME_COLUMNS]
+_COST_COLUMNS = [col.STAGES, col.STEPS, col.RHS_EVALS, *col.TIME_COLUMNS]
 
 
 def _cost_table(cmp) -> Table:
@@ -476,9 +476,9 @@ def _reach_table(cmp) -> Table:
     reach = cmp.cost.T.copy()
     reach.columns = [f"to {fmt(t)} m" for t in cmp.cost.index]
     kinds = cmp.cost_kind.T
-    for col, tol in zip(reach.columns, cmp.cost.index):
-        reach[col] = [f"{fmt(v)} ({k[0]})" for v, k in zip(reach[col], kinds[tol])]
-    reach.index.name = "method"
+    for column, tol in zip(reach.columns, cmp.cost.index):
+        reach[column] = [f"{fmt(v)} ({k[0]})" for v, k in zip(reach[column], kinds[tol])]
+    reach.index.name = col.METHOD
     return Table(
         reach,
         f"RHS evaluations to reach each max |{_body(cmp)} error| "
@@ -490,7 +490,7 @@ def _reach_table(cmp) -> Table:
 
 def _stability_blocks(cmp, figs: dict[str, Image]) -> list:
     table = cmp.table
-    columns = ["h_max [s]", "limited by", "stable"] + [
+    columns = [col.H_MAX, col.LIMITED_BY, col.STABLE] + [
         c for c in table.columns if "freq err" in c or "zeta err" in c
     ]
     return [
@@ -563,13 +563,13 @@ def build_blocks(cmp, command: str | None = None) -> list:
 
 
 def _csv_tables(cmp) -> dict[str, pd.DataFrame]:
-    nm = pd.concat(cmp.numerical_modes, names=["method"])
+    nm = pd.concat(cmp.numerical_modes, names=[col.METHOD])
     cost = cmp.cost.copy()
     for name in cost.columns:
         cost[f"{name} kind"] = cmp.cost_kind[name]
     return {
         "methods.csv": cmp.table,
-        "convergence.csv": cmp.convergence.set_index("method"),
+        "convergence.csv": cmp.convergence.set_index(col.METHOD),
         "cost_to_reach.csv": cost,
         "modes.csv": cmp.modes.to_frame(),
         "numerical_modes.csv": nm,

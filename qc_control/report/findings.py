@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from ..studies import columns as col
 from ..studies.timing import same_work
 from .document import fmt
 
@@ -43,21 +44,21 @@ def _step_limits(cmp) -> list[str]:
     out = []
     if "euler" in t.index:
         row = t.loc["euler"]
-        if row["h_max [s]"] > 0:
+        if row[col.H_MAX] > 0:
             out.append(
-                f"Euler's step limit is h = {fmt(row['h_max [s]'])} s, set by the "
-                f"{row['limited by']} mode (|1 + hλ| ≤ 1, i.e. h ≤ −2·Re λ/|λ|²); the chosen "
-                f"h = {fmt(cmp.h)} s is {fmt(100 * cmp.h / row['h_max [s]'])}% of it."
+                f"Euler's step limit is h = {fmt(row[col.H_MAX])} s, set by the "
+                f"{row[col.LIMITED_BY]} mode (|1 + hλ| ≤ 1, i.e. h ≤ −2·Re λ/|λ|²); the chosen "
+                f"h = {fmt(cmp.h)} s is {fmt(100 * cmp.h / row[col.H_MAX])}% of it."
             )
         else:  # Re λ = 0: the limit −2·Re λ/|λ|² is zero
             out.append(
-                f"Euler has no stable step: the {row['limited by']} mode is undamped "
+                f"Euler has no stable step: the {row[col.LIMITED_BY]} mode is undamped "
                 "(Re λ = 0), so |1 + hλ| > 1 for every h > 0 and its amplitude grows at any step."
             )
-    others = [f"{m} {fmt(r['h_max [s]'])} s" for m, r in t.iterrows() if m != "euler"]
+    others = [f"{m} {fmt(r[col.H_MAX])} s" for m, r in t.iterrows() if m != "euler"]
     if others:
         out.append("The other limits: " + ", ".join(others) + ".")
-    unstable = [m for m, r in t.iterrows() if not r["stable"]]
+    unstable = [m for m, r in t.iterrows() if not r[col.STABLE]]
     if unstable:
         out.append(
             f"At h = {fmt(cmp.h)} s {', '.join(unstable)} "
@@ -87,7 +88,7 @@ def coincidence_groups(cmp) -> list[list[str]]:
 
 def _coincidence(cmp) -> list[str]:
     out = []
-    orders = cmp.table["order"]
+    orders = cmp.table[col.ORDER]
     for group in coincidence_groups(cmp):
         gap = max(v for k, v in cmp.coincident.items() if set(k) <= set(group))
         names = ", ".join(group[:-1]) + " and " + group[-1]
@@ -150,12 +151,12 @@ def _damping(cmp) -> list[str]:
 
 def _orders(cmp) -> list[str]:
     t = cmp.table
-    parts = [f"{m} {fmt(r['observed order'])} (theory {r['order']})" for m, r in t.iterrows()]
+    parts = [f"{m} {fmt(r[col.OBSERVED_ORDER])} (theory {r[col.ORDER]})" for m, r in t.iterrows()]
     out = ["Observed orders from h, h/2, h/4: " + ", ".join(parts) + "."]
     off = [
         m
         for m, r in t.iterrows()
-        if math.isfinite(r["observed order"]) and abs(r["observed order"] - r["order"]) > 0.15
+        if math.isfinite(r[col.OBSERVED_ORDER]) and abs(r[col.OBSERVED_ORDER] - r[col.ORDER]) > 0.15
     ]
     if off:
         out.append(

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 
 from ..numerics.methods import get_method
+from ..studies import columns as col
 from .document import fmt
 from .figures import body_wheel_road
 
@@ -24,7 +25,7 @@ SUMMARY_TOLERANCE = 1e-3
 
 def _limits(cmp) -> list[str]:
     t = cmp.table
-    beyond = [(m, r["h_max [s]"]) for m, r in t.iterrows() if not r["stable"]]
+    beyond = [(m, r[col.H_MAX]) for m, r in t.iterrows() if not r[col.STABLE]]
     if not beyond:
         return []
     named = ", ".join(
@@ -39,7 +40,7 @@ def _limits(cmp) -> list[str]:
 
 
 def _as_run(cmp, body: str) -> str:
-    column = f"max |{body} err| [m]"
+    column = col.max_error(body, "m")
     errors = cmp.table[column] if column in cmp.table else cmp.table.iloc[:, 0]
     listed = ", ".join(f"{m} {fmt(e)} m" for m, e in errors.items())
     return f"As run (h = {fmt(cmp.h)} s), the largest |{body} error| of each method: {listed}."

@@ -1,7 +1,7 @@
 """Compare fixed-step methods against python-control's exact response.
 
 `compare_methods` computes every number of the comparison once, into a
-`MethodComparison`; the report writers in `qc_control.report` only
+frozen `MethodComparison`; the report writers in `qc_control.report` only
 format them. The package is in rooms of one concept each, whose names it
 hands on (``from qc_control.studies.compare import X`` as before the split):
 
@@ -16,6 +16,8 @@ hands on (``from qc_control.studies.compare import X`` as before the split):
 - `sampled`: a sampled-data loop against its exact loop, tick by tick;
 - `result`: `MethodComparison` and `NonlinearStudy`;
 - `study`: `compare_methods`, which runs the path its system needs.
+
+The column names of its frames are named once, in `qc_control.studies.columns`.
 """
 
 from __future__ import annotations

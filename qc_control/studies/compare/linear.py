@@ -31,7 +31,8 @@ from ...responses.timeresp import (
     initial_response,
 )
 from ...ride.comfort import transmissibility
-from ..timing import TIME_COLUMNS, interleaved_times
+from .. import columns as col
+from ..timing import interleaved_times
 from .measures import (
     Reference,
     Refinement,
@@ -191,8 +192,8 @@ def method_timings(
     return pd.DataFrame.from_dict(
         {
             tab.name: {
-                "wall time [ms]": 1e3 * times[tab.name, "generic"].wall,
-                "LTI engine [ms]": 1e3 * times[tab.name, "auto"].wall,
+                col.WALL_TIME: 1e3 * times[tab.name, "generic"].wall,
+                col.LTI_ENGINE: 1e3 * times[tab.name, "auto"].wall,
             }
             for tab in methods
         },
@@ -220,13 +221,13 @@ def _timed_ladder(
             _simulate, sys, refined(problem.T, level), X0,
             refined_input(problem.T, problem.U, level), tabs[method], substeps, "generic",
         )
-        for method, level in zip(convergence["method"], convergence["level"])
+        for method, level in zip(convergence[col.METHOD], convergence[col.LEVEL])
     }  # fmt: skip
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DivergenceWarning)
         # no warm-up: the convergence study has just made each run
         times = interleaved_times(runs, max(1, rounds), warmup=False)
-    keyed = [times[key] for key in zip(convergence["method"], convergence["level"])]
+    keyed = [times[key] for key in zip(convergence[col.METHOD], convergence[col.LEVEL])]
     return convergence.assign(
         time=[t.wall for t in keyed],
         time_low=[t.low for t in keyed],
@@ -247,23 +248,21 @@ def _linear_times(
     `method_timings`'."""
     names = [t.name for t in problem.methods]
     if not timing:
-        return pd.DataFrame(math.nan, index=names, columns=TIME_COLUMNS)
-    at_h = convergence[convergence["level"] == 0].set_index("method").reindex(names)
+        return pd.DataFrame(math.nan, index=names, columns=col.TIME_COLUMNS)
+    at_h = convergence[convergence[col.LEVEL] == 0].set_index(col.METHOD).reindex(names)
     sys, T, X0, U = problem.system, problem.T, problem.X0, problem.U
-    lti = method_timings(sys, T, X0, U, problem.methods, problem.substeps, repeats)[
-        "LTI engine [ms]"
-    ]
+    lti = method_timings(sys, T, X0, U, problem.methods, problem.substeps, repeats)[col.LTI_ENGINE]
     times = pd.DataFrame(
         {
-            "wall time [ms]": 1e3 * at_h["time"],
-            "wall min [ms]": 1e3 * at_h["time_low"],
-            "wall max [ms]": 1e3 * at_h["time_high"],
-            "CPU time [ms]": 1e3 * at_h["cpu_time"],
-            "LTI engine [ms]": lti,
+            col.WALL_TIME: 1e3 * at_h[col.TIME],
+            col.WALL_MIN: 1e3 * at_h[col.TIME_LOW],
+            col.WALL_MAX: 1e3 * at_h[col.TIME_HIGH],
+            col.CPU_TIME: 1e3 * at_h[col.CPU],
+            col.LTI_ENGINE: lti,
         },
         index=names,
     )
-    times["time / control"] = times["wall time [ms]"] / (1e3 * reference.time)
+    times[col.PER_CONTROL] = times[col.WALL_TIME] / (1e3 * reference.time)
     return times
 
 
@@ -315,13 +314,13 @@ def engine_times(problem: ComparisonProblem, convergence: pd.DataFrame) -> pd.Da
     by step (a diverging run, never among the cheapest): its time is the
     convergence study's, which timed that same run.
     """
-    if is_nonlinear_system(problem.system) or convergence["time"].isna().all():
+    if is_nonlinear_system(problem.system) or convergence[col.TIME].isna().all():
         return convergence
     tabs = {t.name: t for t in problem.methods}
     eig = np.linalg.eigvals(np.asarray(problem.system.A, dtype=float))
     times = []
     for method, level, stepped in zip(
-        convergence["method"], convergence["level"], convergence["time"]
+        convergence[col.METHOD], convergence[col.LEVEL], convergence[col.TIME]
     ):
         T, U = refined(problem.T, level), refined_input(problem.T, problem.U, level)
         if _stepped_by_default(tabs[method], T, problem.substeps, eig):

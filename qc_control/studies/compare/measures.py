@@ -25,6 +25,7 @@ from ...numerics.methods import ButcherTableau
 from ...numerics.sampled import linear_input
 from ...numerics.stability import max_stable_step, numerical_modes
 from ...ride.comfort import ride_metrics
+from .. import columns as col
 from .problem import (
     ROUNDING_FLOOR,
     TOLERANCES,
@@ -79,15 +80,15 @@ def _cost_to_reach(conv: pd.DataFrame, method: ButcherTableau, span: float, h_ma
     never beyond the stability limit ('extrapolated').
     """
     rows = conv[
-        (conv["method"] == method.name)
-        & conv["stable"]
-        & np.isfinite(conv["error"])
-        & (conv["error"] > ROUNDING_FLOOR)
-    ].sort_values("nfev")
+        (conv[col.METHOD] == method.name)
+        & conv[col.STABLE]
+        & np.isfinite(conv[col.ERROR])
+        & (conv[col.ERROR] > ROUNDING_FLOOR)
+    ].sort_values(col.NFEV)
     result = {}
     if rows.empty:
         return {tol: (math.nan, "unreached") for tol in TOLERANCES}
-    log_n, log_e = np.log(rows["nfev"].to_numpy(float)), np.log(rows["error"].to_numpy())
+    log_n, log_e = np.log(rows[col.NFEV].to_numpy(float)), np.log(rows[col.ERROR].to_numpy())
     fewest = method.stages * math.ceil(span / h_max) if h_max > 0 else math.inf
     for tol in TOLERANCES:
         lt = math.log(tol)
@@ -179,14 +180,14 @@ def error_table(responses: dict, reference: Reference, model: VehicleModel) -> p
             row = {}
             for i, label in enumerate(labels):
                 unit = model.unit(label)
-                row[f"max |{label} err| [{unit}]"] = float(np.max(np.abs(err[i])))
-                row[f"rms {label} err [{unit}]"] = float(np.sqrt(np.mean(err[i] ** 2)))
-        row[f"final |{model.body_disp} err| [{model.unit(model.body_disp)}]"] = float(
+                row[col.max_error(label, unit)] = float(np.max(np.abs(err[i])))
+                row[col.rms_error(label, unit)] = float(np.sqrt(np.mean(err[i] ** 2)))
+        row[col.final_error(model.body_disp, model.unit(model.body_disp))] = float(
             abs(err[body, -1])
         )
         rows[name] = row
     frame = pd.DataFrame.from_dict(rows, orient="index")
-    frame.index.name = "method"
+    frame.index.name = col.METHOD
     return frame
 
 
@@ -295,12 +296,14 @@ def observed_orders(
     steps, per method; NaN when a step is unstable or errors are below ``floor``
     (rounding, or within reach of a reference's own error)."""
     out = {}
-    for name, rows in convergence.groupby("method", sort=False):
-        mine = rows[rows["level"] <= levels]
+    for name, rows in convergence.groupby(col.METHOD, sort=False):
+        mine = rows[rows[col.LEVEL] <= levels]
         out[name] = (
-            _observed_order(mine["h"], mine["error"], floor) if mine["stable"].all() else math.nan
+            _observed_order(mine[col.H], mine[col.ERROR], floor)
+            if mine[col.STABLE].all()
+            else math.nan
         )
-    return pd.Series(out, name="observed order", dtype=float)
+    return pd.Series(out, name=col.OBSERVED_ORDER, dtype=float)
 
 
 def cost_to_reach(
@@ -313,7 +316,7 @@ def cost_to_reach(
     reach = {tab.name: _cost_to_reach(convergence, tab, span, h_max[tab.name]) for tab in methods}
     cost = pd.DataFrame({m: {tol: v[0] for tol, v in r.items()} for m, r in reach.items()})
     kind = pd.DataFrame({m: {tol: v[1] for tol, v in r.items()} for m, r in reach.items()})
-    cost.index.name = kind.index.name = "tolerance [m]"
+    cost.index.name = kind.index.name = col.TOLERANCE
     return cost, kind
 
 
@@ -333,16 +336,16 @@ def mode_errors(
         per_method[tab.name] = nm
         h_max = max_stable_step(tab, eig)
         row = {
-            "h_max [s]": h_max,
-            "limited by": _limiting_mode(tab, modes),
-            "stable": bool(h <= h_max),
+            col.H_MAX: h_max,
+            col.LIMITED_BY: _limiting_mode(tab, modes),
+            col.STABLE: bool(h <= h_max),
         }
         for mode_name, mrow in nm.iterrows():
-            row[f"{mode_name} freq err [%]"] = mrow["freq error [%]"]
-            row[f"{mode_name} zeta err"] = mrow["zeta error"]
+            row[col.freq_error(str(mode_name))] = mrow["freq error [%]"]
+            row[col.zeta_error(str(mode_name))] = mrow["zeta error"]
         rows[tab.name] = row
     frame = pd.DataFrame.from_dict(rows, orient="index")
-    frame.index.name = "method"
+    frame.index.name = col.METHOD
     return per_method, frame
 
 

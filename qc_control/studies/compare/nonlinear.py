@@ -26,6 +26,7 @@ from ...numerics.stability import max_stable_step
 from ...responses.timeresp import (
     input_output_response,
 )
+from .. import columns as col
 from .measures import (
     ConvergencePoint,
     Reference,
@@ -301,7 +302,7 @@ def _event_convergence(
             )
             rows += [(events, point) for point in points]
     frame = pd.DataFrame([point for _, point in rows])
-    frame.insert(1, "events", [events for events, _ in rows])
+    frame.insert(1, col.EVENTS, [events for events, _ in rows])
     return _EventConvergence(frame, at_h)
 
 
@@ -310,23 +311,23 @@ def _event_orders(convergence: pd.DataFrame, names: list[str], floor: float, lev
     orders = pd.DataFrame(
         {
             column: observed_orders(
-                convergence[convergence["events"] == events], levels, floor
+                convergence[convergence[col.EVENTS] == events], levels, floor
             ).reindex(names)
-            for events, column in ((True, "with events"), (False, "without events"))
+            for events, column in ((True, col.WITH_EVENTS), (False, col.WITHOUT_EVENTS))
         }
     )
-    orders.index.name = "method"
+    orders.index.name = col.METHOD
     return orders
 
 
 def _nonlinear_times(convergence: pd.DataFrame, names: list[str]) -> pd.DataFrame:
     """The wall-time columns: each method's run at h; no LTI engine, no exact call."""
-    at_h = convergence[convergence["level"] == 0].set_index("method")
+    at_h = convergence[convergence[col.LEVEL] == 0].set_index(col.METHOD)
     return pd.DataFrame(
         {
-            "wall time [ms]": 1e3 * at_h["time"].reindex(names),
-            "LTI engine [ms]": math.nan,
-            "time / control": math.nan,
+            col.WALL_TIME: 1e3 * at_h[col.TIME].reindex(names),
+            col.LTI_ENGINE: math.nan,
+            col.PER_CONTROL: math.nan,
         },
         index=names,
     )
@@ -357,7 +358,7 @@ def measure_nonlinear(
     names = [t.name for t in problem.methods]
     responses = {name: runs.at_h[name, events] for name in names}
     long = runs.frame
-    convergence = long[long["events"] == events].drop(columns="events").reset_index(drop=True)
+    convergence = long[long[col.EVENTS] == events].drop(columns=col.EVENTS).reset_index(drop=True)
     orders = _event_orders(long, names, solved.floor, levels)
     parting, gap = _parting(responses, sys, problem.model, T)
     signs, flights = _event_signs(sys, T, problem.X0, problem.U, solved.solution, switching)
@@ -378,12 +379,12 @@ def measure_nonlinear(
         linearization=lin,
         linearization_note=note,
     )
-    main = "with events" if events else "without events"
+    main = col.WITH_EVENTS if events else col.WITHOUT_EVENTS
     table_orders = pd.DataFrame(
         {
-            "observed order": orders[main],
-            "observed order (events)": orders["with events"],
-            "observed order (no events)": orders["without events"],
+            col.OBSERVED_ORDER: orders[main],
+            col.OBSERVED_ORDER_EVENTS: orders[col.WITH_EVENTS],
+            col.OBSERVED_ORDER_NO_EVENTS: orders[col.WITHOUT_EVENTS],
         }
     )
     times = _nonlinear_times(convergence, names)

@@ -13,6 +13,7 @@ import pandas as pd
 
 from ...models.modal import ModalAnalysis
 from ...ride.comfort import Transmissibility
+from .. import columns as col
 from ..confirm import CostCheck
 from ..peers import WorkPrecision
 from ..ride_cost import RideCost
@@ -129,12 +130,12 @@ class MethodComparison(ComparisonProblem):
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""
         model = self.model
-        errors = [f"max |{model.body_disp if model else 'xs'} err| [m]"]
+        errors = [col.max_error(model.body_disp if model else "xs", "m")]
         if model is not None and len(model.corners) > 1:  # each corner's travel error
-            errors += [f"max |{c.susp_travel} err| [m]" for c in model.corners]
+            errors += [col.max_error(c.susp_travel, "m") for c in model.corners]
         else:
-            errors.append("max |xu err| [m]")
-        cols = ["order", "RHS evals", "wall time [ms]", *errors, "observed order", "h_max [s]"]
+            errors.append(col.max_error("xu", "m"))
+        cols = [col.ORDER, col.RHS_EVALS, col.WALL_TIME, *errors, col.OBSERVED_ORDER, col.H_MAX]
         return self.table[[c for c in cols if c in self.table.columns]]
 
 

@@ -18,6 +18,7 @@ from ...numerics.sampled import linear_input
 from ...responses.timeresp import (
     input_output_response,
 )
+from .. import columns as col
 from .measures import (
     Reference,
     Refinement,
@@ -208,12 +209,12 @@ def _sampled_times(
 ) -> pd.DataFrame:
     """The wall-time columns: each method's run at h against the exact loop's."""
     names = [t.name for t in problem.methods]
-    at_h = convergence[convergence["level"] == 0].set_index("method")["time"].reindex(names)
+    at_h = convergence[convergence[col.LEVEL] == 0].set_index(col.METHOD)[col.TIME].reindex(names)
     return pd.DataFrame(
         {
-            "wall time [ms]": 1e3 * at_h,
-            "LTI engine [ms]": math.nan,
-            "time / control": at_h / reference.time,
+            col.WALL_TIME: 1e3 * at_h,
+            col.LTI_ENGINE: math.nan,
+            col.PER_CONTROL: at_h / reference.time,
         },
         index=names,
     )

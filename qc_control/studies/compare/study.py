@@ -14,6 +14,7 @@ import pandas as pd
 from ...numerics.checks import ParameterError
 from ...numerics.lti import is_nonlinear_system
 from ...ride.road import Road
+from .. import columns as col
 from ..confirm import confirmed_costs
 from ..on_road import road_problem
 from ..peers import RTOLS, WorkPrecision, check_solvers, work_precision
@@ -47,30 +48,27 @@ def _cost_columns(problem: ComparisonProblem, responses: dict) -> pd.DataFrame:
     tabs, names = problem.methods, [t.name for t in problem.methods]
     return pd.DataFrame(
         {
-            "order": [t.order for t in tabs],
-            "stages": [t.stages for t in tabs],
-            "h [s]": problem.h,
-            "steps": [responses[n].steps for n in names],
-            "RHS evals": [responses[n].nfev for n in names],
+            col.ORDER: [t.order for t in tabs],
+            col.STAGES: [t.stages for t in tabs],
+            col.STEP: problem.h,
+            col.STEPS: [responses[n].steps for n in names],
+            col.RHS_EVALS: [responses[n].nfev for n in names],
         },
         index=names,
     )
 
 
 def _comparison(
-    problem: ComparisonProblem,
-    measured: Measured,
-    input_description: str,
-    peers: WorkPrecision | None = None,
-    sampled_car: control.StateSpace | None = None,
+    problem: ComparisonProblem, measured: Measured, input_description: str, **added: Any
 ) -> MethodComparison:
-    """The comparison from what either path measured: errors, modes, cost, ride; with
-    the peers' study and a sampled loop's car, each computed before (the result is frozen)."""
+    """The comparison from what either path measured: errors, modes, cost, ride; ``added``:
+    the fields a path computed besides (the peers' study, a sampled loop's car), each
+    before the result is built (it is frozen)."""
     reference, responses, tabs = measured.reference, measured.responses, problem.methods
     numerical, stability = mode_errors(tabs, problem.h, measured.linear, measured.modes)
     span = float(problem.T[-1] - problem.T[0])
     cost, cost_kind = cost_to_reach(
-        measured.convergence, tabs, span, stability["h_max [s]"].to_dict()
+        measured.convergence, tabs, span, stability[col.H_MAX].to_dict()
     )
     checks = None
     if isinstance(problem.system, control.StateSpace):  # an exact reference to run against
@@ -88,12 +86,13 @@ def _comparison(
         ],
         axis=1,
     )
-    table.index.name = "method"
+    table.index.name = col.METHOD
     ride, ride_error = (
         ride_comparison(reference, responses, problem.model) if on_road(problem) else (None, None)
     )
     return MethodComparison(
         **vars(problem),
+        **added,
         table=table,
         modes=measured.modes,
         numerical_modes=numerical,
@@ -114,8 +113,6 @@ def _comparison(
         ride_error=ride_error,
         transmissibility=measured.transmissibility,
         nonlinear=measured.nonlinear,
-        peers=peers,
-        sampled_car=sampled_car,
     )
 
 
