@@ -452,20 +452,22 @@ def _convergence_blocks(cmp, figs: dict[str, Image]) -> list:
 _COST_COLUMNS = [col.STAGES, col.STEPS, col.RHS_EVALS, *col.TIME_COLUMNS]
 
 
-def _cost_table(cmp) -> Table:
-    """What each method's run at h cost: evaluations and wall time."""
+def _cost_table(cmp, work_precision: str) -> Table:
+    """What each method's run at h cost: evaluations and wall time, timed with the runs
+    of the work-precision figure (labelled ``work_precision``): one measurement."""
     if getattr(cmp, "nonlinear", None) is not None:
         return Table(
             cmp.table[_COST_COLUMNS[:4]],
             f"Cost at h = {fmt(cmp.h)} s: wall time of one run through "
             "qc.input_output_response (depends on the machine; a nonlinear system has "
-            "no LTI engine); steps include those ending at events",
+            f"no LTI engine), the run at h of {work_precision}; steps include those ending "
+            "at events",
         )
     return Table(
         cmp.table[[c for c in _COST_COLUMNS if c in cmp.table.columns]],
         f"Cost at h = {fmt(cmp.h)} s (wall times depend on the machine): the step-by-step "
-        "loop, as the seed runs it, timed with every run of Figure 9 in interleaved rounds "
-        "(median, lowest and highest, and this process's CPU time); qc_control's LTI "
+        f"loop, as the seed runs it, timed with every run of {work_precision} in interleaved "
+        "rounds (median, lowest and highest, and this process's CPU time); qc_control's LTI "
         "engine, which computes the same trajectory; control's exact response took "
         f"{fmt(cmp.reference_time * 1e3)} ms",
     )
@@ -479,12 +481,18 @@ def _reach_table(cmp) -> Table:
     for column, tol in zip(reach.columns, cmp.cost.index):
         reach[column] = [f"{fmt(v)} ({k[0]})" for v, k in zip(reach[column], kinds[tol])]
     reach.index.name = col.METHOD
+    estimates = (
+        "; on a nonlinear car every cost is an estimate: there is no exact reference to "
+        "run it against"
+        if getattr(cmp, "nonlinear", None) is not None
+        else ""
+    )
     return Table(
         reach,
         f"RHS evaluations to reach each max |{_body(cmp)} error| "
         "(c: confirmed by a run at that count; estimates no run checked: i: interpolated "
         "between refinements, e: extrapolated with e = C·h^p, never beyond h_max; "
-        "m: missed by the runs from its estimate, u: unreached)",
+        f"m: missed by the runs from its estimate, u: unreached){estimates}",
     )
 
 
@@ -549,7 +557,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
             *_convergence_blocks(cmp, figs),
             Heading("Work and precision"),
             figs["work_precision.png"],
-            _cost_table(cmp),
+            _cost_table(cmp, figs["work_precision.png"].label),
             _reach_table(cmp),
             *_stability_blocks(cmp, figs),
             *_ride_blocks(cmp, figs),

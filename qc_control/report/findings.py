@@ -12,28 +12,36 @@ __all__ = ["findings", "coincidence_groups"]
 
 _KIND = {
     "confirmed": "confirmed by a run at that count",
-    "interpolated": "interpolated, not checked by a run",
-    "extrapolated": "extrapolated from its order, not checked by a run",
+    "interpolated": "an estimate, interpolated between the refinements, not checked by a run",
+    "extrapolated": "an estimate, extrapolated from its order, not checked by a run",
     "missed": "not reached by the runs from its estimate",
     "unreached": "not reached",
 }
 
 
+def _count(cmp, tol: float, method: str) -> str:
+    """A quoted cost: the confirmed count as it is, an estimate as "about" it."""
+    cost = fmt(int(cmp.cost.loc[tol, method]))
+    return cost if cmp.cost_kind.loc[tol, method] == "confirmed" else f"about {cost}"
+
+
 def _cheapest(cmp) -> list[str]:
+    """The cheapest method for each target, and the others' counts: the study's
+    numbers (confirmed, or estimates called so), as the summary and Table 7 quote them."""
     out = []
+    body = cmp.model.body_disp if getattr(cmp, "model", None) is not None else "xs"
     for tol in cmp.cost.index:
         costs = cmp.cost.loc[tol].dropna().sort_values()
         if costs.empty:
             continue
         best = costs.index[0]
-        others = ", ".join(f"{m} {fmt(int(v))}" for m, v in costs.iloc[1:].items())
         tied = [m for m, v in costs.items() if v == costs.iloc[0]]
-        who = " and ".join(tied) if len(tied) > 1 else best
+        others = ", ".join(f"{m} {_count(cmp, tol, m)}" for m in costs.index if m not in tied)
+        who = " and ".join(tied)
         kind = cmp.cost_kind.loc[tol, best]
         out.append(
-            f"Cheapest to reach {fmt(tol)} m (max |xs error|): {who}, "
-            + ("" if kind == "confirmed" else "about ")
-            + f"{fmt(int(costs.iloc[0]))} RHS evaluations ({_KIND[kind]})"
+            f"Cheapest to reach {fmt(tol)} m (max |{body} error|): {who}, "
+            f"{_count(cmp, tol, best)} RHS evaluations ({_KIND[kind]})"
             + (f"; the others need {others}." if others else ".")
         )
     return out
@@ -203,6 +211,9 @@ def _ride(cmp) -> list[str]:
 
 
 def _same_work(cmp) -> list[str]:
+    """Methods that make the same evaluations do the same work: whatever their times
+    say, within the spread of the timing rounds or beyond it, the difference is the
+    machine's (its load changed between the rounds), not the methods'."""
     out = []
     for pair in same_work(cmp.table):
         a, b = (f"{fmt(t * 1e3)} ms" for t in pair.times)
@@ -214,8 +225,9 @@ def _same_work(cmp) -> list[str]:
             head + "differ by less than the spread of the timing rounds: the difference is "
             "the machine's noise, not the methods'."
             if pair.noise
-            else head + "differ by more than the spread of the timing rounds: the work "
-            "besides the evaluations (each method's arithmetic) differs."
+            else head + "differ by more than the spread of the timing rounds, yet the same "
+            "evaluations are the same work: the difference is the machine's noise (its load "
+            "changed between the rounds), not the methods'. Compare them by their evaluations."
         )
     return out
 

@@ -88,8 +88,8 @@ def _cheapest(cmp, body: str, tol: float) -> list[str]:
         )
         kind = check.estimate_kind if check is not None else cmp.cost_kind.loc[tol, best]
         return [
-            f"{target} at h ≈ {fmt(h_est)} s, about {fmt(int(cost))} evaluations "
-            f"({_HOW.get(kind, kind)}). Not checked by a run: {why}."
+            f"{target} at h ≈ {fmt(h_est)} s, an estimate of about {fmt(int(cost))} "
+            f"evaluations ({_HOW.get(kind, kind)}). Not checked by a run: {why}."
         ]
     h = span / check.steps
     stated = f"{target} at h = {fmt(h)} s, {fmt(int(cost))} evaluations"
