@@ -229,6 +229,12 @@ def _one_count(cmp, folder, md: str) -> None:
                        _section(md, "Summary"))  # fmt: skip
     method, n = answer.group(1), int(answer.group(5))
     assert n == table[1e-3, method][0] == min(v for (t, _), (v, _) in table.items() if t == 1e-3)
+    # a method tied with it is named, as the findings name it
+    tied = sorted(m for (t, m), (v, _) in table.items() if t == 1e-3 and v == n and m != method)
+    (paragraph,) = [p for p in answer.string.split("\n\n") if p.startswith("To reach")]
+    if tied:
+        last = paragraph.rsplit(". ", 1)[-1]  # "heun needs the same count."
+        assert last.endswith("the same count.") and all(m in last for m in tied), paragraph
     if table[1e-3, method][1] == "c":  # a confirmed count states its step exactly
         stages = len(TABLEAUS[method][1])
         assert float(answer.group(3)) == pytest.approx(cmp.T[-1] / (n // stages), rel=5e-4)

@@ -69,12 +69,20 @@ def _check_of(cmp, method: str, tol: float):
 
 def _cheapest(cmp, body: str, tol: float) -> list[str]:
     """The cheapest method for ``tol``, with the run that confirmed its cost
-    (`qc_control.studies.confirm`); this only words the comparison's numbers."""
+    (`qc_control.studies.confirm`), and any method tied with it (as the findings
+    name them); this only words the comparison's numbers."""
     if tol not in cmp.cost.index:
         return []
     costs = cmp.cost.loc[tol].dropna().sort_values()
     if costs.empty:
         return [f"No method reaches {fmt(tol * 1e3)} mm in {body} at a step it can run."]
+    tied = [m for m in costs.index[1:] if costs[m] == costs.iloc[0]]
+    also = f" {' and '.join(tied)} {'needs' if len(tied) == 1 else 'need'} the same count."
+    return [_answer(cmp, body, tol, costs) + (also if tied else "")]
+
+
+def _answer(cmp, body: str, tol: float, costs) -> str:
+    """The cheapest method's step and count for ``tol``, and how it was found."""
     best, cost = costs.index[0], float(costs.iloc[0])
     span = float(cmp.T[-1] - cmp.T[0])
     target = f"To reach {fmt(tol * 1e3)} mm in {body} for the fewest RHS evaluations: {best}"
@@ -87,23 +95,23 @@ def _cheapest(cmp, body: str, tol: float) -> list[str]:
             else "a run that long is not made"
         )
         kind = check.estimate_kind if check is not None else cmp.cost_kind.loc[tol, best]
-        return [
+        return (
             f"{target} at h ≈ {fmt(h_est)} s, an estimate of about {fmt(int(cost))} "
             f"evaluations ({_HOW.get(kind, kind)}). Not checked by a run: {why}."
-        ]
+        )
     h = span / check.steps
     stated = f"{target} at h = {fmt(h)} s, {fmt(int(cost))} evaluations"
     if check.runs == 1:
-        return [
+        return (
             f"{stated} ({_HOW.get(check.estimate_kind, check.estimate_kind)}); a run at that "
             f"step confirms it: its error is {fmt(check.error * 1e3)} mm."
-        ]
-    return [
+        )
+    return (
         f"{stated}, confirmed by a run: its error is {fmt(check.error * 1e3)} mm. The estimate "
         f"{_HOW.get(check.estimate_kind, check.estimate_kind)}, about "
         f"{fmt(int(check.estimate))} evaluations, missed it: a run there gives "
         f"{fmt(check.estimate_error * 1e3)} mm."
-    ]
+    )
 
 
 def summary(cmp, tol: float = SUMMARY_TOLERANCE) -> list[str]:
