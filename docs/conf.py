@@ -146,7 +146,7 @@ def _add_architecture(app, docname, source):
 # literals; a docstring that writes ``|x|`` (or escapes the bars) needs no entry here.
 _BARS = {
     "qc_control.models.modal.Mode",
-    "qc_control.studies.compare.MethodComparison",
+    "qc_control.studies.compare.result.MethodComparison",
     "qc_control.ride.comfort.Transmissibility.to_frame",
     "qc_control.ride.comfort.ride_metrics_spectral",
 }

@@ -14,6 +14,7 @@ References, each independent of the code under test:
   studies layer's `Provenance` (a structural type: no import of the cli).
 """
 
+import dataclasses
 import math
 
 import numpy as np
@@ -21,6 +22,7 @@ import pandas as pd
 import pytest
 
 import qc_control as qc
+from qc_control.studies import columns as col
 from qc_control.studies.compare import (
     DEFAULT_X0,
     ComparisonProblem,
@@ -134,3 +136,24 @@ def test_the_scenario_states_its_run_by_the_studies_protocol():
     assert scenario.command().startswith("qc-control report")
     assert "[scenario]" in scenario.to_toml()
     assert not isinstance(object(), Provenance)
+
+
+def test_a_comparison_is_frozen_and_named_by_the_columns_module(both_paths):
+    """Every number is computed before the result is built: it cannot be assigned to
+    afterwards, and what a later step adds makes a new one (dataclasses.replace).
+    Its frames' columns are the names `qc_control.studies.columns` gives."""
+    lin, nl = both_paths
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        lin.ride_cost = None  # type: ignore[misc]
+    marked = dataclasses.replace(lin, input_description="a test")
+    assert marked.input_description == "a test" and lin.input_description == ""
+    assert marked.table is lin.table  # the same numbers, not recomputed
+    for cmp in (lin, nl):
+        assert list(cmp.convergence.columns[: len(col.CONVERGENCE)]) == list(col.CONVERGENCE)
+        assert cmp.table.index.name == col.METHOD and cmp.cost.index.name == col.TOLERANCE
+        named = [col.ORDER, col.STAGES, col.STEP, col.STEPS, col.RHS_EVALS, col.OBSERVED_ORDER]
+        named += [col.H_MAX, col.LIMITED_BY, col.STABLE, col.max_error("xs", "m")]
+        assert set(named) <= set(cmp.table.columns)
+    assert set(col.TIME_COLUMNS) <= set(lin.table.columns)
+    assert {col.OBSERVED_ORDER_EVENTS, col.OBSERVED_ORDER_NO_EVENTS} <= set(nl.table.columns)
+    assert ConvergencePoint._fields == col.CONVERGENCE

@@ -2,7 +2,6 @@
 number formats, the self-contained HTML, the PDF, numbering, and the figures."""
 
 import base64
-import copy
 import dataclasses
 import re
 import shutil
@@ -490,8 +489,7 @@ class _Scenario:
 @pytest.mark.slow
 @pytest.mark.usefixtures("placeholder_figures")
 def test_scenario_toml_beside_the_report_and_its_command(cmp, tmp_path):
-    with_scenario = copy.copy(cmp)
-    with_scenario.scenario = _Scenario()
+    with_scenario = dataclasses.replace(cmp, scenario=_Scenario())
     out = write_report(with_scenario, tmp_path / "rep", formats=("md",), command="ignored")
     assert (out / "scenario.toml").read_text(encoding="utf-8") == _Scenario().to_toml()
     reproduce = (out / "report.md").read_text(encoding="utf-8").split("## Reproduce")[1]
@@ -560,10 +558,9 @@ def test_midpoint_and_heun_are_shown_to_coincide(cmp):
 
 
 def test_wall_time_points_are_never_joined_out_of_order(cmp):
-    noisy = copy.copy(cmp)
     conv = cmp.convergence.copy()
     conv["time"] = conv["time"].to_numpy()[::-1]  # times that fall as work grows
-    noisy.convergence = conv
+    noisy = dataclasses.replace(cmp, convergence=conv)
     fig = figures.work_precision_figure(noisy)
     work, wall = fig.axes
     for line in work.lines:
@@ -630,9 +627,11 @@ def _shuffled(resp, order):
 
 def test_figures_look_outputs_up_by_label(cmp):
     order = ["body_acc", "tire_defl", "susp_travel", "xu", "xs"]
-    shuffled = copy.copy(cmp)
-    shuffled.reference = _shuffled(cmp.reference, order)
-    shuffled.responses = {m: _shuffled(r, order) for m, r in cmp.responses.items()}
+    shuffled = dataclasses.replace(
+        cmp,
+        reference=_shuffled(cmp.reference, order),
+        responses={m: _shuffled(r, order) for m, r in cmp.responses.items()},
+    )
     xs = cmp.responses["euler"].outputs[list(cmp.responses["euler"].output_labels).index("xs")]
     lines = {ln.get_label(): ln for ln in figures.method_figure(shuffled, "euler").axes[0].lines}
     np.testing.assert_array_equal(lines["suspension (sprung mass) xs"].get_ydata(), xs * 1e3)

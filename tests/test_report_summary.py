@@ -3,7 +3,9 @@ and its reference for what they are.
 
 The summary's stated step is checked against an independent run: RK4 on
 ``x' = Ax`` is the step ``x ← R(hA) x`` with ``R(z) = 1 + z + z²/2 + z³/6 +
-z⁴/24``, measured against the matrix exponential (scipy's ``expm``).
+z⁴/24``, measured against the matrix exponential (scipy's ``expm``). That the
+summary, the findings and the tables quote one count, for every method and
+target of four reports, is tests/test_report_consistency.py's.
 """
 
 import math
@@ -65,22 +67,6 @@ def test_the_seed_cars_answer_is_rk4_confirmed_by_a_run(seed):
     # 5 % of the least (131 steps, 524 evaluations: tests/test_exercises.py)
     assert rk4_error(round(10.0 / h)) <= 1e-3
     assert 524 <= evaluations <= 1.05 * 524
-
-
-def test_the_summary_findings_and_tables_quote_one_count(seed):
-    """Issue 38: the summary, the findings and the cost table quote the same
-    count for the same target, and it is the study's confirmed one."""
-    from qc_control.report.findings import findings
-
-    cost = int(seed.cost.loc[1e-3, "rk4"])
-    assert seed.cost_kind.loc[1e-3, "rk4"] == "confirmed"
-    assert f"{cost} evaluations" in summary(seed)[-1]
-    (line,) = [f for f in findings(seed) if f.startswith("Cheapest to reach 0.001 m")]
-    assert f"rk4, {cost} RHS evaluations (confirmed by a run at that count)" in line
-    (reach,) = [
-        b for b in build_blocks(seed) if "RHS evaluations to reach" in getattr(b, "caption", "")
-    ]
-    assert reach.frame.loc["rk4", "to 0.001 m"] == f"{cost} (c)"
 
 
 def test_a_method_past_its_limit_is_the_summarys_first_word():

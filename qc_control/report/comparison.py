@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import pandas as pd
 
-from ..studies.timing import TIME_COLUMNS
+from ..studies import columns as col
 from .document import Code, Heading, Image, Paragraph, Table, fmt
 from .figures import (
     convergence_figure,
@@ -434,38 +434,40 @@ def _accuracy_blocks(cmp, figs: dict[str, Image]) -> list:
 
 def _convergence_blocks(cmp, figs: dict[str, Image]) -> list:
     """The error at each refinement of h, and the order observed from it."""
-    conv = cmp.convergence.pivot(index="h", columns="method", values="error")
+    conv = cmp.convergence.pivot(index=col.H, columns=col.METHOD, values=col.ERROR)
     conv = conv.sort_index(ascending=False)[[t.name for t in cmp.methods]]
-    conv.index.name = "h [s]"
-    finest = 2 ** int(cmp.convergence["level"].max())
+    conv.index.name = col.STEP
+    finest = 2 ** int(cmp.convergence[col.LEVEL].max())
     return [
         Heading("Convergence"),
         figs["convergence.png"],
         Table(conv, f"Max |{_body(cmp)} error| [m] at h, h/2, …, h/{finest}"),
         Table(
-            cmp.table[["order", "observed order"]],
+            cmp.table[[col.ORDER, col.OBSERVED_ORDER]],
             "Observed order: least-squares slope of log error against log h over h, h/2 and h/4",
         ),
     ]
 
 
-_COST_COLUMNS = ["stages", "steps", "RHS evals", *TIME_COLUMNS]
+_COST_COLUMNS = [col.STAGES, col.STEPS, col.RHS_EVALS, *col.TIME_COLUMNS]
 
 
-def _cost_table(cmp) -> Table:
-    """What each method's run at h cost: evaluations and wall time."""
+def _cost_table(cmp, work_precision: str) -> Table:
+    """What each method's run at h cost: evaluations and wall time, timed with the runs
+    of the work-precision figure (labelled ``work_precision``): one measurement."""
     if getattr(cmp, "nonlinear", None) is not None:
         return Table(
             cmp.table[_COST_COLUMNS[:4]],
             f"Cost at h = {fmt(cmp.h)} s: wall time of one run through "
             "qc.input_output_response (depends on the machine; a nonlinear system has "
-            "no LTI engine); steps include those ending at events",
+            f"no LTI engine), the run at h of {work_precision}; steps include those ending "
+            "at events",
         )
     return Table(
         cmp.table[[c for c in _COST_COLUMNS if c in cmp.table.columns]],
         f"Cost at h = {fmt(cmp.h)} s (wall times depend on the machine): the step-by-step "
-        "loop, as the seed runs it, timed with every run of Figure 9 in interleaved rounds "
-        "(median, lowest and highest, and this process's CPU time); qc_control's LTI "
+        f"loop, as the seed runs it, timed with every run of {work_precision} in interleaved "
+        "rounds (median, lowest and highest, and this process's CPU time); qc_control's LTI "
         "engine, which computes the same trajectory; control's exact response took "
         f"{fmt(cmp.reference_time * 1e3)} ms",
     )
@@ -476,21 +478,27 @@ def _reach_table(cmp) -> Table:
     reach = cmp.cost.T.copy()
     reach.columns = [f"to {fmt(t)} m" for t in cmp.cost.index]
     kinds = cmp.cost_kind.T
-    for col, tol in zip(reach.columns, cmp.cost.index):
-        reach[col] = [f"{fmt(v)} ({k[0]})" for v, k in zip(reach[col], kinds[tol])]
-    reach.index.name = "method"
+    for column, tol in zip(reach.columns, cmp.cost.index):
+        reach[column] = [f"{fmt(v)} ({k[0]})" for v, k in zip(reach[column], kinds[tol])]
+    reach.index.name = col.METHOD
+    estimates = (
+        "; on a nonlinear car every cost is an estimate: there is no exact reference to "
+        "run it against"
+        if getattr(cmp, "nonlinear", None) is not None
+        else ""
+    )
     return Table(
         reach,
         f"RHS evaluations to reach each max |{_body(cmp)} error| "
         "(c: confirmed by a run at that count; estimates no run checked: i: interpolated "
         "between refinements, e: extrapolated with e = C·h^p, never beyond h_max; "
-        "m: missed by the runs from its estimate, u: unreached)",
+        f"m: missed by the runs from its estimate, u: unreached){estimates}",
     )
 
 
 def _stability_blocks(cmp, figs: dict[str, Image]) -> list:
     table = cmp.table
-    columns = ["h_max [s]", "limited by", "stable"] + [
+    columns = [col.H_MAX, col.LIMITED_BY, col.STABLE] + [
         c for c in table.columns if "freq err" in c or "zeta err" in c
     ]
     return [
@@ -549,7 +557,7 @@ def build_blocks(cmp, command: str | None = None) -> list:
             *_convergence_blocks(cmp, figs),
             Heading("Work and precision"),
             figs["work_precision.png"],
-            _cost_table(cmp),
+            _cost_table(cmp, figs["work_precision.png"].label),
             _reach_table(cmp),
             *_stability_blocks(cmp, figs),
             *_ride_blocks(cmp, figs),
@@ -563,13 +571,13 @@ def build_blocks(cmp, command: str | None = None) -> list:
 
 
 def _csv_tables(cmp) -> dict[str, pd.DataFrame]:
-    nm = pd.concat(cmp.numerical_modes, names=["method"])
+    nm = pd.concat(cmp.numerical_modes, names=[col.METHOD])
     cost = cmp.cost.copy()
     for name in cost.columns:
         cost[f"{name} kind"] = cmp.cost_kind[name]
     return {
         "methods.csv": cmp.table,
-        "convergence.csv": cmp.convergence.set_index("method"),
+        "convergence.csv": cmp.convergence.set_index(col.METHOD),
         "cost_to_reach.csv": cost,
         "modes.csv": cmp.modes.to_frame(),
         "numerical_modes.csv": nm,

@@ -29,6 +29,7 @@ from matplotlib.ticker import NullFormatter
 
 from ..models.registry import model_for_params, model_for_system
 from ..numerics.stability import stability_boundary
+from ..studies import columns as col
 from .findings import coincidence_groups
 from .plotting import output_signal, output_unit
 
@@ -329,11 +330,11 @@ def convergence_figure(cmp) -> Figure:
     fig = Figure(figsize=(7.5, 4.6), layout="constrained")
     ax = fig.subplots()
     for tab in cmp.methods:
-        rows = conv[conv["method"] == tab.name].sort_values("h", ascending=False)
-        ok = np.isfinite(rows["error"]) & (rows["error"] > 0)
+        rows = conv[conv[col.METHOD] == tab.name].sort_values(col.H, ascending=False)
+        ok = np.isfinite(rows[col.ERROR]) & (rows[col.ERROR] > 0)
         ax.loglog(
-            rows["h"][ok],
-            rows["error"][ok],
+            rows[col.H][ok],
+            rows[col.ERROR][ok],
             marker=_MARKERS[rank[tab.name] % len(_MARKERS)],
             mfc="none" if rank[tab.name] else colors[tab.name],
             color=colors[tab.name],
@@ -343,13 +344,13 @@ def convergence_figure(cmp) -> Figure:
         if ok.any() and rank[tab.name] == 0:  # one guide per group of coinciding methods
             _slope_guide(
                 ax,
-                rows["h"][ok].to_numpy(),
-                rows["error"][ok].iloc[0] * 3,
+                rows[col.H][ok].to_numpy(),
+                rows[col.ERROR][ok].iloc[0] * 3,
                 tab.order,
                 colors[tab.name],
             )
     title = "Convergence (dotted: slope of the method's order)"
-    convergence_axes(ax, conv["h"], body_wheel_road(cmp)[0], title)
+    convergence_axes(ax, conv[col.H], body_wheel_road(cmp)[0], title)
     _legend(fig, coincidence_note(cmp))
     return fig
 
@@ -382,8 +383,8 @@ def work_precision_figure(cmp) -> Figure:
     fig = Figure(figsize=(10, 4.2), layout="constrained")
     left, right = fig.subplots(1, 2, sharey=True)
     for tab in cmp.methods:
-        rows = conv[(conv["method"] == tab.name) & np.isfinite(conv["error"])]
-        rows = rows.sort_values("nfev", kind="stable")
+        rows = conv[(conv[col.METHOD] == tab.name) & np.isfinite(conv[col.ERROR])]
+        rows = rows.sort_values(col.NFEV, kind="stable")
         style = dict(
             color=colors[tab.name],
             marker=_MARKERS[rank[tab.name] % len(_MARKERS)],
@@ -391,9 +392,9 @@ def work_precision_figure(cmp) -> Figure:
             label=tab.name,
             **_style(cmp, tab.name, rank),
         )
-        left.loglog(rows["nfev"], rows["error"], **style)
+        left.loglog(rows[col.NFEV], rows[col.ERROR], **style)
         # measured times are noisy: points only, so no line ever runs back in time
-        right.loglog(rows["time"] * 1e3, rows["error"], **{**style, "ls": "none"})
+        right.loglog(rows[col.TIME] * 1e3, rows[col.ERROR], **{**style, "ls": "none"})
     left.set(
         xlabel="right-hand-side evaluations",
         ylabel=f"max |{body_wheel_road(cmp)[0]} error| [m]",

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from ..studies import columns as col
 from ..studies.timing import same_work
 from .document import fmt
 
@@ -11,28 +12,36 @@ __all__ = ["findings", "coincidence_groups"]
 
 _KIND = {
     "confirmed": "confirmed by a run at that count",
-    "interpolated": "interpolated, not checked by a run",
-    "extrapolated": "extrapolated from its order, not checked by a run",
+    "interpolated": "an estimate, interpolated between the refinements, not checked by a run",
+    "extrapolated": "an estimate, extrapolated from its order, not checked by a run",
     "missed": "not reached by the runs from its estimate",
     "unreached": "not reached",
 }
 
 
+def _count(cmp, tol: float, method: str) -> str:
+    """A quoted cost: the confirmed count as it is, an estimate as "about" it."""
+    cost = fmt(int(cmp.cost.loc[tol, method]))
+    return cost if cmp.cost_kind.loc[tol, method] == "confirmed" else f"about {cost}"
+
+
 def _cheapest(cmp) -> list[str]:
+    """The cheapest method for each target, and the others' counts: the study's
+    numbers (confirmed, or estimates called so), as the summary and Table 7 quote them."""
     out = []
+    body = cmp.model.body_disp if getattr(cmp, "model", None) is not None else "xs"
     for tol in cmp.cost.index:
         costs = cmp.cost.loc[tol].dropna().sort_values()
         if costs.empty:
             continue
         best = costs.index[0]
-        others = ", ".join(f"{m} {fmt(int(v))}" for m, v in costs.iloc[1:].items())
         tied = [m for m, v in costs.items() if v == costs.iloc[0]]
-        who = " and ".join(tied) if len(tied) > 1 else best
+        others = ", ".join(f"{m} {_count(cmp, tol, m)}" for m in costs.index if m not in tied)
+        who = " and ".join(tied)
         kind = cmp.cost_kind.loc[tol, best]
         out.append(
-            f"Cheapest to reach {fmt(tol)} m (max |xs error|): {who}, "
-            + ("" if kind == "confirmed" else "about ")
-            + f"{fmt(int(costs.iloc[0]))} RHS evaluations ({_KIND[kind]})"
+            f"Cheapest to reach {fmt(tol)} m (max |{body} error|): {who}, "
+            f"{_count(cmp, tol, best)} RHS evaluations ({_KIND[kind]})"
             + (f"; the others need {others}." if others else ".")
         )
     return out
@@ -43,21 +52,21 @@ def _step_limits(cmp) -> list[str]:
     out = []
     if "euler" in t.index:
         row = t.loc["euler"]
-        if row["h_max [s]"] > 0:
+        if row[col.H_MAX] > 0:
             out.append(
-                f"Euler's step limit is h = {fmt(row['h_max [s]'])} s, set by the "
-                f"{row['limited by']} mode (|1 + hλ| ≤ 1, i.e. h ≤ −2·Re λ/|λ|²); the chosen "
-                f"h = {fmt(cmp.h)} s is {fmt(100 * cmp.h / row['h_max [s]'])}% of it."
+                f"Euler's step limit is h = {fmt(row[col.H_MAX])} s, set by the "
+                f"{row[col.LIMITED_BY]} mode (|1 + hλ| ≤ 1, i.e. h ≤ −2·Re λ/|λ|²); the chosen "
+                f"h = {fmt(cmp.h)} s is {fmt(100 * cmp.h / row[col.H_MAX])}% of it."
             )
         else:  # Re λ = 0: the limit −2·Re λ/|λ|² is zero
             out.append(
-                f"Euler has no stable step: the {row['limited by']} mode is undamped "
+                f"Euler has no stable step: the {row[col.LIMITED_BY]} mode is undamped "
                 "(Re λ = 0), so |1 + hλ| > 1 for every h > 0 and its amplitude grows at any step."
             )
-    others = [f"{m} {fmt(r['h_max [s]'])} s" for m, r in t.iterrows() if m != "euler"]
+    others = [f"{m} {fmt(r[col.H_MAX])} s" for m, r in t.iterrows() if m != "euler"]
     if others:
         out.append("The other limits: " + ", ".join(others) + ".")
-    unstable = [m for m, r in t.iterrows() if not r["stable"]]
+    unstable = [m for m, r in t.iterrows() if not r[col.STABLE]]
     if unstable:
         out.append(
             f"At h = {fmt(cmp.h)} s {', '.join(unstable)} "
@@ -87,7 +96,7 @@ def coincidence_groups(cmp) -> list[list[str]]:
 
 def _coincidence(cmp) -> list[str]:
     out = []
-    orders = cmp.table["order"]
+    orders = cmp.table[col.ORDER]
     for group in coincidence_groups(cmp):
         gap = max(v for k, v in cmp.coincident.items() if set(k) <= set(group))
         names = ", ".join(group[:-1]) + " and " + group[-1]
@@ -150,12 +159,12 @@ def _damping(cmp) -> list[str]:
 
 def _orders(cmp) -> list[str]:
     t = cmp.table
-    parts = [f"{m} {fmt(r['observed order'])} (theory {r['order']})" for m, r in t.iterrows()]
+    parts = [f"{m} {fmt(r[col.OBSERVED_ORDER])} (theory {r[col.ORDER]})" for m, r in t.iterrows()]
     out = ["Observed orders from h, h/2, h/4: " + ", ".join(parts) + "."]
     off = [
         m
         for m, r in t.iterrows()
-        if math.isfinite(r["observed order"]) and abs(r["observed order"] - r["order"]) > 0.15
+        if math.isfinite(r[col.OBSERVED_ORDER]) and abs(r[col.OBSERVED_ORDER] - r[col.ORDER]) > 0.15
     ]
     if off:
         out.append(
@@ -202,6 +211,9 @@ def _ride(cmp) -> list[str]:
 
 
 def _same_work(cmp) -> list[str]:
+    """Methods that make the same evaluations do the same work: whatever their times
+    say, within the spread of the timing rounds or beyond it, the difference is the
+    machine's (its load changed between the rounds), not the methods'."""
     out = []
     for pair in same_work(cmp.table):
         a, b = (f"{fmt(t * 1e3)} ms" for t in pair.times)
@@ -213,8 +225,9 @@ def _same_work(cmp) -> list[str]:
             head + "differ by less than the spread of the timing rounds: the difference is "
             "the machine's noise, not the methods'."
             if pair.noise
-            else head + "differ by more than the spread of the timing rounds: the work "
-            "besides the evaluations (each method's arithmetic) differs."
+            else head + "differ by more than the spread of the timing rounds, yet the same "
+            "evaluations are the same work: the difference is the machine's noise (its load "
+            "changed between the rounds), not the methods'. Compare them by their evaluations."
         )
     return out
 

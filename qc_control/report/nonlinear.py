@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from ..studies import columns as col
 from .document import Heading, Image, Paragraph, Table, fmt
 from .figures import body_wheel_road, convergence_axes
 from .plotting import output_signal
@@ -68,14 +69,14 @@ def event_convergence_figure(cmp) -> Figure:
     colors = {t.name: f"C{i % 10}" for i, t in enumerate(cmp.methods)}
     for tab in cmp.methods:
         for events, style, marker in ((True, "-", "o"), (False, "--", "s")):
-            rows = conv[(conv["method"] == tab.name) & (conv["events"] == events)]
-            rows = rows.sort_values("h", ascending=False)
-            ok = np.isfinite(rows["error"]) & (rows["error"] > 0)
+            rows = conv[(conv[col.METHOD] == tab.name) & (conv[col.EVENTS] == events)]
+            rows = rows.sort_values(col.H, ascending=False)
+            ok = np.isfinite(rows[col.ERROR]) & (rows[col.ERROR] > 0)
             if not ok.any():
                 continue
             ax.loglog(
-                rows["h"][ok],
-                rows["error"][ok],
+                rows[col.H][ok],
+                rows[col.ERROR][ok],
                 ls=style,
                 marker=marker,
                 mfc=colors[tab.name] if events else "none",
@@ -89,7 +90,7 @@ def event_convergence_figure(cmp) -> Figure:
         ls=":",
         label="10x the reference's own error (not fitted below)",
     )
-    convergence_axes(ax, conv["h"], _body(cmp), "With and without events")
+    convergence_axes(ax, conv[col.H], _body(cmp), "With and without events")
     fig.legend(loc="outside right upper", fontsize="small")
     return fig
 
@@ -164,19 +165,19 @@ def reference_text(cmp) -> str:
 
 def _orders_table(cmp) -> pd.DataFrame:
     study = cmp.nonlinear
-    frame = pd.DataFrame({"order": [t.order for t in cmp.methods]}, index=study.orders.index)
+    frame = pd.DataFrame({col.ORDER: [t.order for t in cmp.methods]}, index=study.orders.index)
     return pd.concat([frame, study.orders], axis=1)
 
 
 def _errors_table(cmp) -> pd.DataFrame:
     conv = cmp.nonlinear.convergence
     names = [t.name for t in cmp.methods]
-    frame = conv.pivot_table(index="h", columns=["events", "method"], values="error")
+    frame = conv.pivot_table(index=col.H, columns=[col.EVENTS, col.METHOD], values=col.ERROR)
     frame = frame.sort_index(ascending=False)
     cols = [(ev, m) for ev in (True, False) for m in names if (ev, m) in frame.columns]
     frame = frame[cols]
     frame.columns = [f"{m} {'events' if ev else 'no events'}" for ev, m in cols]
-    frame.index.name = "h [s]"
+    frame.index.name = col.STEP
     return frame
 
 
@@ -243,7 +244,7 @@ def _order_blocks(cmp, study) -> list:
         )
     ]
     if study.switching_labels and "rk4" in orders.index:
-        with_ev, without = orders.loc["rk4", "with events"], orders.loc["rk4", "without events"]
+        with_ev, without = orders.loc["rk4", col.WITH_EVENTS], orders.loc["rk4", col.WITHOUT_EVENTS]
         blocks.append(
             Paragraph(
                 f"RK4's observed order is {fmt(with_ev)} with events and {fmt(without)} "
@@ -311,7 +312,7 @@ def nonlinear_tables(cmp) -> dict[str, pd.DataFrame]:
         }
     )
     return {
-        "nonlinear_convergence.csv": study.convergence.set_index("method"),
+        "nonlinear_convergence.csv": study.convergence.set_index(col.METHOD),
         "nonlinear_orders.csv": _orders_table(cmp),
         "events.csv": events,
     }

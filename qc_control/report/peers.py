@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from ..studies import columns as col
 from ..studies.scenarios import peak_table
 from .document import Heading, Image, Paragraph, Table, fmt
 
@@ -146,11 +147,11 @@ def _best_table(cmp) -> Table:
     frame = pd.DataFrame(
         {
             "kind": best["kind"],
-            "h [s]": best["h"],
+            col.STEP: best["h"],
             "rtol": best["rtol"],
             "atol": best["atol"],
-            "RHS evals": best["evaluations"],
-            "wall time [ms]": 1e3 * best["time"].astype(float),
+            col.RHS_EVALS: best["evaluations"],
+            col.WALL_TIME: 1e3 * best["time"].astype(float),
             "max |error| [m]": best["error"],
         }
     )
@@ -214,7 +215,8 @@ def ride_cost_blocks(cmp) -> list:
     if cost is None:
         return []
     best = cost.cheapest().assign(time=lambda b: 1e3 * b["time"].astype(float))
-    names = {"h": "h [s]", "evaluations": "RHS evals", "time": "wall time [ms]"}
+    # the comparison's table's names for the same quantities (studies.columns)
+    names = {"h": col.STEP, "evaluations": col.RHS_EVALS, "time": col.WALL_TIME}
     names["runs"] = "runs tried"
     columns = ["kind", "h", "rtol", "atol", "error [%]", "evaluations", "time", "reached", "runs"]
     frame = best[columns].rename(columns=names)

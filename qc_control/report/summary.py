@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 
 from ..numerics.methods import get_method
+from ..studies import columns as col
 from .document import fmt
 from .figures import body_wheel_road
 
@@ -24,7 +25,7 @@ SUMMARY_TOLERANCE = 1e-3
 
 def _limits(cmp) -> list[str]:
     t = cmp.table
-    beyond = [(m, r["h_max [s]"]) for m, r in t.iterrows() if not r["stable"]]
+    beyond = [(m, r[col.H_MAX]) for m, r in t.iterrows() if not r[col.STABLE]]
     if not beyond:
         return []
     named = ", ".join(
@@ -39,7 +40,7 @@ def _limits(cmp) -> list[str]:
 
 
 def _as_run(cmp, body: str) -> str:
-    column = f"max |{body} err| [m]"
+    column = col.max_error(body, "m")
     errors = cmp.table[column] if column in cmp.table else cmp.table.iloc[:, 0]
     listed = ", ".join(f"{m} {fmt(e)} m" for m, e in errors.items())
     return f"As run (h = {fmt(cmp.h)} s), the largest |{body} error| of each method: {listed}."
@@ -68,12 +69,20 @@ def _check_of(cmp, method: str, tol: float):
 
 def _cheapest(cmp, body: str, tol: float) -> list[str]:
     """The cheapest method for ``tol``, with the run that confirmed its cost
-    (`qc_control.studies.confirm`); this only words the comparison's numbers."""
+    (`qc_control.studies.confirm`), and any method tied with it (as the findings
+    name them); this only words the comparison's numbers."""
     if tol not in cmp.cost.index:
         return []
     costs = cmp.cost.loc[tol].dropna().sort_values()
     if costs.empty:
         return [f"No method reaches {fmt(tol * 1e3)} mm in {body} at a step it can run."]
+    tied = [m for m in costs.index[1:] if costs[m] == costs.iloc[0]]
+    also = f" {' and '.join(tied)} {'needs' if len(tied) == 1 else 'need'} the same count."
+    return [_answer(cmp, body, tol, costs) + (also if tied else "")]
+
+
+def _answer(cmp, body: str, tol: float, costs) -> str:
+    """The cheapest method's step and count for ``tol``, and how it was found."""
     best, cost = costs.index[0], float(costs.iloc[0])
     span = float(cmp.T[-1] - cmp.T[0])
     target = f"To reach {fmt(tol * 1e3)} mm in {body} for the fewest RHS evaluations: {best}"
@@ -86,23 +95,23 @@ def _cheapest(cmp, body: str, tol: float) -> list[str]:
             else "a run that long is not made"
         )
         kind = check.estimate_kind if check is not None else cmp.cost_kind.loc[tol, best]
-        return [
-            f"{target} at h ≈ {fmt(h_est)} s, about {fmt(int(cost))} evaluations "
-            f"({_HOW.get(kind, kind)}). Not checked by a run: {why}."
-        ]
+        return (
+            f"{target} at h ≈ {fmt(h_est)} s, an estimate of about {fmt(int(cost))} "
+            f"evaluations ({_HOW.get(kind, kind)}). Not checked by a run: {why}."
+        )
     h = span / check.steps
     stated = f"{target} at h = {fmt(h)} s, {fmt(int(cost))} evaluations"
     if check.runs == 1:
-        return [
+        return (
             f"{stated} ({_HOW.get(check.estimate_kind, check.estimate_kind)}); a run at that "
             f"step confirms it: its error is {fmt(check.error * 1e3)} mm."
-        ]
-    return [
+        )
+    return (
         f"{stated}, confirmed by a run: its error is {fmt(check.error * 1e3)} mm. The estimate "
         f"{_HOW.get(check.estimate_kind, check.estimate_kind)}, about "
         f"{fmt(int(check.estimate))} evaluations, missed it: a run there gives "
         f"{fmt(check.estimate_error * 1e3)} mm."
-    ]
+    )
 
 
 def summary(cmp, tol: float = SUMMARY_TOLERANCE) -> list[str]:

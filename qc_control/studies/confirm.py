@@ -96,13 +96,19 @@ def _input_on(T_data: np.ndarray, U: np.ndarray, T: np.ndarray) -> np.ndarray:
 
 def _carried(fine: int | None, steps: int) -> int:
     """``steps``, or the next count whose grid and the comparison's ``fine`` steps
-    fit in one uniform grid of at most `CONFIRM_MAX_STEPS` (only under an input)."""
+    fit in one uniform grid of at most `CONFIRM_MAX_STEPS` (only under an input).
+
+    None fits beyond that many steps: then the next multiple of ``fine`` (its
+    grid holds the comparison's), which the caller finds too long to run. (Falling
+    back to ``fine`` itself ran the comparison's own grid again and again and
+    called a target out of reach 'missed', e.g. Euler to 1e-6 m on a road step.)
+    """
     if fine is None:
         return steps
     for n in range(steps, steps + fine + 1):
         if math.lcm(fine, n) <= CONFIRM_MAX_STEPS:
             return n
-    return fine  # the comparison's own grid always fits
+    return math.ceil(steps / fine) * fine
 
 
 def _error_at(sys, T_data, X0, U, tab: ButcherTableau, steps: int, body: int) -> float:

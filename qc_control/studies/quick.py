@@ -29,7 +29,9 @@ from ..numerics.integrate import uniform_step
 from ..numerics.methods import get_method
 from ..numerics.reference import exact_response
 from ..numerics.stability import step_verdict
+from . import columns as col
 from .compare import Reference, error_table, max_error, method_responses, mode_errors
+from .compare.measures import padded_outputs
 
 __all__ = ["QuickComparison", "quick_comparison", "error_ladder", "ladder_steps"]
 
@@ -134,19 +136,19 @@ def quick_comparison(
     modes = modal_analysis(model)
     numerical, stability = mode_errors(tabs, h, sys, modes)
     ref = np.asarray(exact.outputs).reshape(sys.noutputs, -1)
-    outputs = {name: _padded(r, T.size) for name, r in responses.items()}
+    outputs = {name: padded_outputs(r, T.size) for name, r in responses.items()}
     with np.errstate(invalid="ignore", over="ignore"):  # an overflowed run's error is inf
         errors = {name: np.nan_to_num(np.abs(y - ref), nan=np.inf) for name, y in outputs.items()}
     cost = pd.DataFrame(
         {
-            "order": [t.order for t in tabs],
-            "RHS evals": [responses[t.name].nfev for t in tabs],
+            col.ORDER: [t.order for t in tabs],
+            col.RHS_EVALS: [responses[t.name].nfev for t in tabs],
         },
         index=[t.name for t in tabs],
     )
     table = pd.concat([cost, error_table(responses, reference, model), stability], axis=1)
-    table["verdict"] = [step_verdict(h, hm) for hm in table["h_max [s]"]]
-    table.index.name = "method"
+    table["verdict"] = [step_verdict(h, hm) for hm in table[col.H_MAX]]
+    table.index.name = col.METHOD
     return QuickComparison(
         h=h,
         T=T,
@@ -231,13 +233,7 @@ def error_ladder(
         for name, response in method_responses(sys, T, X0, U, tabs).items():
             y = np.asarray(response.outputs).reshape(len(response.output_labels), -1)[body]
             error = max_error(y, exact, T.size)  # a run that blew up: inf
-            rows.append({"method": name, "h": t_end / n, "nfev": response.nfev, "error": error})
+            rows.append(
+                {col.METHOD: name, col.H: t_end / n, col.NFEV: response.nfev, col.ERROR: error}
+            )
     return pd.DataFrame(rows)
-
-
-def _padded(response, samples: int) -> np.ndarray:
-    """Every output of a response on all ``samples``: ``inf`` after a run cut short
-    where it overflowed (its missing samples are infinitely wrong)."""
-    y = np.asarray(response.outputs).reshape(len(response.output_labels), -1)
-    missing = np.full((y.shape[0], samples - y.shape[1]), np.inf)
-    return np.concatenate([y, missing], axis=1) if missing.size else y

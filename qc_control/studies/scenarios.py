@@ -19,6 +19,7 @@ sampled road; an L-stable implicit method steps it at 5 ms.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -220,7 +221,8 @@ def stiff_car_comparison(
     )
     if ride_target is not None:
         shared = {k: options[k] for k in ("rtols", "progress") if k in options}
-        cmp.ride_cost = stiff_car_ride_cost(cmp, ride_target, **shared)
+        # the comparison is frozen: its ride cost makes a new one
+        cmp = dataclasses.replace(cmp, ride_cost=stiff_car_ride_cost(cmp, ride_target, **shared))
     return cmp
 
 

@@ -25,20 +25,12 @@ from dataclasses import dataclass
 from typing import TypeVar
 
 from ..numerics.threads import blas_single_thread
+from . import columns as col
+from .columns import TIME_COLUMNS  # handed on: its home before the columns had one
 
 __all__ = ["TIME_COLUMNS", "Timing", "interleaved_times", "SameWork", "same_work"]
 
 K = TypeVar("K", bound=Hashable)
-
-#: The wall-time columns of a linear comparison's table, named here once.
-TIME_COLUMNS = [
-    "wall time [ms]",
-    "wall min [ms]",
-    "wall max [ms]",
-    "CPU time [ms]",
-    "LTI engine [ms]",
-    "time / control",
-]
 
 
 @dataclass(frozen=True)
@@ -144,7 +136,7 @@ def same_work(table) -> list[SameWork]:
     whether their wall times differ by no more than the spread of the rounds
     (the columns ``wall time``, ``wall min`` and ``wall max [ms]``): a
     difference the machine makes, not the methods."""
-    needed = {"RHS evals", "wall time [ms]", "wall min [ms]", "wall max [ms]"}
+    needed = {col.RHS_EVALS, col.WALL_TIME, col.WALL_MIN, col.WALL_MAX}
     if not needed <= set(table.columns):
         return []
     rows = table.dropna(subset=sorted(needed))
@@ -152,12 +144,10 @@ def same_work(table) -> list[SameWork]:
     found = []
     for i, a in enumerate(names):
         for b in names[i + 1 :]:
-            if rows.at[a, "RHS evals"] != rows.at[b, "RHS evals"]:
+            if rows.at[a, col.RHS_EVALS] != rows.at[b, col.RHS_EVALS]:
                 continue
-            low, high, wall = (
-                rows[c] for c in ("wall min [ms]", "wall max [ms]", "wall time [ms]")
-            )
+            low, high, wall = (rows[c] for c in (col.WALL_MIN, col.WALL_MAX, col.WALL_TIME))
             noise = bool(low[a] <= high[b] and low[b] <= high[a])  # as `indistinguishable_from`
             times = (float(wall[a]) / 1e3, float(wall[b]) / 1e3)
-            found.append(SameWork(a, b, int(rows.at[a, "RHS evals"]), times, noise))
+            found.append(SameWork(a, b, int(rows.at[a, col.RHS_EVALS]), times, noise))
     return found
