@@ -193,7 +193,8 @@ def test_bad_arguments_name_the_value():
     # issue 39 item 4: accepted before, and fitted
     with pytest.raises(ValueError, match="'ms' is both free and fixed"):
         qc.identify(m, free=["ms", "ks"], fixed={"ms": 300.0})
-    every = {"ms": 300.0, "mu": 40.0, "ks": 2e4, "ku": 2e5, "cs": 1500.0}
+    # every parameter (cu is free by default since it may reach 0)
+    every = {"ms": 300.0, "mu": 40.0, "ks": 2e4, "ku": 2e5, "cs": 1500.0, "cu": 0.0}
     with pytest.raises(ValueError, match="nothing to fit"):
         qc.identify(m, fixed=every)
     with pytest.raises(ValueError, match="free parameter 'ks' is given twice"):

@@ -161,6 +161,10 @@ class ModelEntry:
     wheel_disp : str or None
         The output the report draws as the wheel's displacement beside the
         body's (None: the body alone).
+    identifiable : bool
+        Whether `qc_control.identify` fits it from measured records: its
+        parameters are the quarter car's ``ms, mu, ks, ku, cs, cu``, its
+        default vehicle the fit's start.
     """
 
     name: str
@@ -172,6 +176,7 @@ class ModelEntry:
     road_layout: RoadLayout = "single"
     road_function: bool = False
     wheel_disp: str | None = None
+    identifiable: bool = False
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.isidentifier():
@@ -377,6 +382,7 @@ for _entry in (
         ),
         defaults=DefaultRun(x0=SEED_X0),
         wheel_disp="xu",
+        identifiable=True,
     ),
     ModelEntry(
         "half",
