@@ -76,9 +76,9 @@ def add_measured_commands(sub, tools: CommandTools) -> None:
     ident.add_argument(
         "--free",
         metavar="NAME,...",
-        help=f"parameters fitted, of {','.join(PHYSICAL)} (default {','.join(DEFAULT_FREE)}: "
-        "the tire damping cu stays at its start, 0, unless freed; a rig's tire has some, "
-        "and a fit without it reports intervals marked unreliable)",
+        help=f"parameters fitted, of {','.join(PHYSICAL)} (default {','.join(DEFAULT_FREE)}, "
+        "less those --fix holds; the tire damping cu is bounded below by 0, so a car "
+        "without tire damping fits to cu = 0)",
     )
     ident.add_argument("--outputs", metavar="LABEL,...", help="outputs fitted (default all)")
     ident.add_argument(
