@@ -125,17 +125,25 @@ def test_road_only_accelerations_give_the_ratios_and_say_masses_are_undetermined
         assert ident.ratios.loc[ratio, "estimate"] == pytest.approx(value, rel=0.01), ratio
 
 
-def test_estimated_initial_state():
+X0_RELEASED = np.array([0.05, 0.0, 0.01, 0.0])  # [m/s, m, m, m]: a body released off rest
+
+
+def _released_record():
+    """The small car's xs and body_acc by python-control, started from `X0_RELEASED`."""
     car = CARS[0]
     t, zr, fa = _inputs(4.0, seed=5)
-    x0 = np.array([0.05, 0.0, 0.01, 0.0])
     A, B, C, D = quarter_car_abcd(
         car["ms"], car["mu"], car["ks"], car["ku"], car["cs"], road=True, actuator=True
     )
-    resp = control.forced_response(control.ss(A, B, C, D), t, np.vstack([zr, fa]), X0=x0)
-    m = qc.Measurement(t, zr=zr, fa=fa, xs=resp.outputs[0], body_acc=resp.outputs[4])
+    resp = control.forced_response(control.ss(A, B, C, D), t, np.vstack([zr, fa]), X0=X0_RELEASED)
+    return qc.Measurement(t, zr=zr, fa=fa, xs=resp.outputs[0], body_acc=resp.outputs[4])
+
+
+def test_estimated_initial_state():
+    car = CARS[0]
+    m = _released_record()
     ident = qc.identify(m, x0="estimate")
-    assert ident.x0 == pytest.approx(x0, abs=1e-4)  # 0.1 mm, mm/s against 1-5 cm
+    assert ident.x0 == pytest.approx(X0_RELEASED, abs=1e-4)  # 0.1 mm, mm/s against 1-5 cm
     assert ident.table.loc["ks", "estimate"] == pytest.approx(car["ks"], rel=0.01)
 
 
@@ -274,14 +282,7 @@ def test_a_runaway_parameter_is_flagged_not_a_success():
 def test_the_report_fit_table_is_the_fit_the_identification_reports(tmp_path):
     # issue 39 item 4: with x0='estimate' the report simulated from rest (65.6 % against
     # the 98.9 % printed); a record that starts away from rest makes the two differ
-    car = CARS[0]
-    t, zr, fa = _inputs(4.0, seed=5)
-    x0 = np.array([0.05, 0.0, 0.01, 0.0])
-    A, B, C, D = quarter_car_abcd(
-        car["ms"], car["mu"], car["ks"], car["ku"], car["cs"], road=True, actuator=True
-    )
-    resp = control.forced_response(control.ss(A, B, C, D), t, np.vstack([zr, fa]), X0=x0)
-    m = qc.Measurement(t, zr=zr, fa=fa, xs=resp.outputs[0], body_acc=resp.outputs[4])
+    m = _released_record()
     ident = qc.identify(m, x0="estimate")
     write_identification_report(ident, m, tmp_path / "r", formats=("csv",))
     fit = pd.read_csv(tmp_path / "r" / "fit.csv", index_col=0)["fit"]
@@ -313,3 +314,18 @@ def test_identify_finds_its_model_in_the_registry():
     m = qc.Measurement(t, zr=zr, body_acc=np.sin(t))
     with pytest.raises(ValueError, match="model must be 'quarter' .*got 'half'"):
         qc.identify(m, model="half")
+
+
+def test_messages_name_what_the_records_or_options_lack():
+    # issue 39 item 14: numpy's "Singular matrix" and scipy's "Residuals are not finite in
+    # the initial point" named none of the user's data
+    t, zr, fa = _inputs(60.0, seed=12)
+    car = CARS[0]
+    y = _records(car, t, zr, fa, ("body_acc",))
+    with pytest.raises(ValueError, match=r"input 'fa' is constant \(0 throughout\)"):
+        qc.identify(qc.Measurement(t, zr=zr, fa=0 * t, **y), domain="frequency")
+    with pytest.raises(ValueError, match="the inputs zr, fa move together"):
+        qc.identify(qc.Measurement(t, zr=zr, fa=zr, **y), domain="frequency", resolution=1.0)
+    m = qc.Measurement(t, zr=zr, fa=fa, **y)
+    with pytest.raises(ValueError, match=r"the start car \(ms=1e-300.*no finite response"):
+        qc.identify(m, fixed={"ms": 1e-300})

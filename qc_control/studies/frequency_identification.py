@@ -187,7 +187,14 @@ def transmissibility(
     q = len(inputs)
     Suu, Suy, Syy = S[:, :q, :q], S[:, :q, q:], S[:, q:, q:]
     # y = H u gives Suy[i, k] = E[conj(u_i) y_k] = Σ_j Suu[i, j] H[k, j]: Suu Hᵀ = Suy
-    Ht = np.linalg.solve(Suu, Suy)  # (F, q, p): Hᵀ
+    try:
+        Ht = np.linalg.solve(Suu, Suy)  # (F, q, p): Hᵀ
+    except np.linalg.LinAlgError:  # numpy's "Singular matrix" names none of the records
+        raise ValueError(
+            f"the inputs {', '.join(inputs)} move together (their cross-spectral matrix is "
+            "singular): the records cannot tell their effects apart; excite them "
+            "independently, or leave one out"
+        ) from None
     explained = np.einsum("fij,fij->fj", np.conj(Ht), Suy).real  # diag(H Suu Hᴴ)
     auto = np.real(np.diagonal(Syy, axis1=1, axis2=2))
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -414,6 +414,12 @@ def _setup(
         raise ValueError(
             f"the measurement has no output the model gives; expected one of {OUTPUT_LABELS}"
         )
+    for k in measurement.inputs:
+        if np.ptp(measurement[k]) == 0:  # a dead channel: S_uu singular, or no excitation
+            raise ValueError(
+                f"input {k!r} is constant ({float(measurement[k][0]):.6g} throughout): a dead "
+                f"channel? leave it out of the records (--map without {k})"
+            )
     for k in outs:
         x = measurement[k]
         if np.ptp(x) == 0:  # nothing to fit to, and a whiteness test of a constant
@@ -427,7 +433,26 @@ def _setup(
         base["cu"] = CU_START
     base.update(start_values)
     base.update(fixed_values)
+    _check_sampling(measurement, base)
     return base, free_names, gain_names, outs
+
+
+def _check_sampling(measurement: Measurement, base: Mapping[str, float]) -> None:
+    """Refuse records sampled below the start car's body mode (its lowest natural
+    frequency), naming the time column: a time column in ms read as seconds samples
+    a thousand times too slowly, and the fit then overflows with a message of scipy's
+    ("array must not contain infs or NaNs") that names nothing of the records."""
+    A, _, _, _ = _quarter_matrices(base)
+    body = float(np.min(np.abs(np.linalg.eigvals(A)))) / (2 * np.pi)
+    nyquist = 0.5 / measurement.dt
+    if nyquist < body:
+        column = getattr(measurement, "time_column", "t")
+        raise ValueError(
+            f"the records are sampled every {measurement.dt:.6g} s ({1 / measurement.dt:.3g} "
+            f"Hz): too slowly for a car whose body mode is near {body:.2g} Hz. Is the time "
+            f"column {column!r} in ms? Give its unit (units={{{column!r}: 'ms'}}, --units "
+            f"{column}=ms)"
+        )
 
 
 def _scale_free(base, free, gains, measurement) -> bool:
@@ -689,6 +714,16 @@ def _flag_runaway(problem: _Problem, values, table: pd.DataFrame, notes) -> bool
     """Mark the intervals unreliable and say so when a parameter ran away (`_runaway`);
     whether none did."""
     runaway = _runaway(problem, values)
+    try:
+        QuarterCarParams(**{n: values[n] for n in PHYSICAL})
+    except ValueError as exc:  # modes 1e7 apart, or an overflow: no car to report
+        found = f" ({'; '.join(runaway)})" if runaway else ""
+        raise ValueError(
+            f"the fit ran away{found} to a car the model cannot hold: {exc}. The records "
+            "do not determine it: check the records' units (a road in mm read as metres: "
+            "units={'zr': 'mm'}, --units zr=mm), fix a known mass (--fix ms=...) or fit "
+            "outputs that respond to every parameter"
+        ) from None
     if runaway:
         table["intervals"] = "unreliable"
         notes.append(
