@@ -221,3 +221,15 @@ def test_records_in_mm_read_as_metres_say_what_to_check(tmp_path, capsys):
     argv = [*RIG_RECIPE[:6], "--out", str(tmp_path / "r")]
     err = _one_line_error(argv, capsys)
     assert "the fit ran away" in err and "--units zr=mm" in err
+
+
+def test_iri_names_the_line_of_a_bad_cell_and_a_file_not_in_utf8(tmp_path, capsys):
+    # issue 39 item 14: the row was the sample's index ("profile is not finite at row 1"),
+    # and a Windows code page's byte gave "'utf-8' codec can't decode byte 0xff"
+    path = tmp_path / "p.csv"
+    path.write_text("x,z\n0,0\n\n# lost fix\n0.25,abc\n0.5,0\n", encoding="utf-8")
+    err = _one_line_error(["iri", str(path), "--x", "x", "--z", "z"], capsys)
+    assert "column 'z' is not a number at row 5 of" in err  # the file's fifth line
+    path.write_bytes(b"x,z\n0,0\n0.25,\xff\n")
+    err = _one_line_error(["iri", str(path), "--x", "x", "--z", "z"], capsys)
+    assert "is not UTF-8 text" in err and "save it as 'CSV UTF-8'" in err

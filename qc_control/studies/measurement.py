@@ -30,6 +30,8 @@ __all__ = [
     "TIME_FACTORS",
     "rig_record",
     "RIG_COLUMNS",
+    "read_csv",
+    "row_of",
 ]
 
 #: The labels a measurement may hold and their SI units: the quarter car's
@@ -65,8 +67,7 @@ def _where(row: int, first_row, t=None) -> str:
     """``row 12`` (and its time) in the numbering of the source (a file's lines):
     ``first_row`` is the first row's number, or every row's (a file whose blank and
     comment lines were skipped between rows)."""
-    line = first_row[row] if isinstance(first_row, np.ndarray) else row + first_row
-    at = f"row {line}"
+    at = f"row {row_of(first_row, row)}"
     return at if t is None else f"{at} (t = {t:.6g} s)"
 
 
@@ -269,18 +270,7 @@ class Measurement:
         Rows in messages are the file's line numbers. See `from_frame` for
         the arguments.
         """
-        path = Path(path)
-        try:
-            frame = pd.read_csv(path, comment="#")
-        except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
-            raise ValueError(f"cannot read {str(path)!r}: {exc}") from None
-        except UnicodeDecodeError as exc:  # a logger's export in a Windows code page
-            raise ValueError(
-                f"{str(path)!r} is not UTF-8 text (byte {exc.object[exc.start]:#04x} at "
-                f"position {exc.start}): save it as 'CSV UTF-8' and read it again"
-            ) from None
-        lines = _data_lines(path)
-        first_row: Any = lines if lines.size == len(frame) else 2 + _leading_comments(path)
+        frame, first_row = read_csv(path)
         return cls.from_frame(
             frame, time=time, columns=columns, scale=scale, units=units, first_row=first_row
         )
@@ -393,3 +383,38 @@ def _data_lines(path: Path) -> np.ndarray:
         next(kept, None)  # the header
         numbers = list(kept)
     return np.array(numbers, dtype=int)
+
+
+def read_csv(path) -> tuple[pd.DataFrame, Any]:
+    """A CSV file of records (a header line, then one row per sample; ``#`` lines are
+    comments) and the file's line number of each row, for messages.
+
+    Returns
+    -------
+    frame : pandas.DataFrame
+    lines : ndarray of int or int
+        Each row's line number in the file (1 for the first line); the first
+        row's number when the rows cannot be matched to lines one to one.
+
+    Raises
+    ------
+    ValueError
+        Naming the file, for one that cannot be read or is not UTF-8 text.
+    """
+    path = Path(path)
+    try:
+        frame = pd.read_csv(path, comment="#")
+    except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+        raise ValueError(f"cannot read {str(path)!r}: {exc}") from None
+    except UnicodeDecodeError as exc:  # a logger's export in a Windows code page
+        raise ValueError(
+            f"{str(path)!r} is not UTF-8 text (byte {exc.object[exc.start]:#04x} at "
+            f"position {exc.start}): save it as 'CSV UTF-8' and read it again"
+        ) from None
+    lines = _data_lines(path)
+    return frame, (lines if lines.size == len(frame) else 2 + _leading_comments(path))
+
+
+def row_of(lines, index: int) -> int:
+    """The file's line number of row ``index`` (`read_csv`'s ``lines``)."""
+    return int(lines[index]) if isinstance(lines, np.ndarray) else index + int(lines)
