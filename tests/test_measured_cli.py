@@ -233,3 +233,26 @@ def test_iri_names_the_line_of_a_bad_cell_and_a_file_not_in_utf8(tmp_path, capsy
     path.write_bytes(b"x,z\n0,0\n0.25,\xff\n")
     err = _one_line_error(["iri", str(path), "--x", "x", "--z", "z"], capsys)
     assert "is not UTF-8 text" in err and "save it as 'CSV UTF-8'" in err
+
+
+def test_x0_estimate_of_a_car_without_tire_damping_is_not_an_overflow(tmp_path, capsys):
+    # issue 39 item 7: cu free on records of a car without tire damping ran away as a
+    # logarithm, and --x0 estimate then died in the table with "OverflowError: math range
+    # error"; cu is now fitted as it is, bounded by 0. The records: python-control's
+    # response of the test's car (tests/test_identify.py), 5 % noise.
+    from test_identify import CARS, _inputs, _records
+
+    car = CARS[0]
+    t, zr, fa = _inputs(6.0, seed=1)
+    outputs = ("susp_travel", "body_acc", "tire_defl")
+    records = _records(car, t, zr, fa, outputs, noise=0.05)
+    path = tmp_path / "car.csv"
+    pd.DataFrame({"t": t, "zr": zr, "fa": fa, **records}).to_csv(path, index=False)
+    columns = ",".join(f"{k}={k}" for k in ("zr", "fa", *outputs))
+    argv = ["identify", str(path), "--map", columns, "--x0", "estimate"]
+    assert run([*argv, "--out", str(tmp_path / "r")]) == 0
+    table = pd.read_csv(tmp_path / "r" / "parameters.csv", index_col=0)
+    # the truth, cu = 0, inside an interval from the bound (5 % noise: a few N·s/m wide)
+    assert table.loc["cu", "ci_low"] == 0.0 < table.loc["cu", "ci_high"] < 50.0
+    for name in ("ms", "mu", "ks", "ku", "cs"):  # within 2 % at 5 % noise
+        assert table.loc[name, "estimate"] == pytest.approx(car[name], rel=0.02), name
