@@ -484,10 +484,13 @@ def identify(
     measurement : Measurement
         Inputs ``zr`` and/or ``fa``; outputs among `OUTPUT_LABELS`.
     model : {'quarter'}
-        The model fitted (the quarter car, with its tire damping ``cu``).
+        The model fitted: a registered model whose entry is ``identifiable``
+        (`qc_control.models.registry`), the quarter car with its tire
+        damping ``cu``.
     free : iterable of str, optional
-        Parameters to fit among ``ms, mu, ks, ku, cs, cu``; default all but
-        ``cu`` (which stays at its start, 0 unless given).
+        Parameters to fit among ``ms, mu, ks, ku, cs, cu``; default all
+        (less those ``fixed``). ``cu`` is fitted as it is, bounded by 0, and
+        starts at `CU_START` unless given; the rest as logarithms.
     fixed : mapping, optional
         ``{name: value}`` held at known values (a weighed mass).
     start : mapping, optional
@@ -517,8 +520,13 @@ def identify(
     Raises
     ------
     ValueError
-        For an unknown model, parameter, gain or output, a value <= 0, or
-        a measurement without inputs or fitted outputs.
+        For an unknown model, parameter, gain or output, a value <= 0, a
+        measurement without inputs or fitted outputs, a constant input or
+        output, records sampled below the car's body mode (a time column in
+        ms), a start with no finite response, or a fit that runs away to a
+        car the model cannot hold. A fit that runs away to a car it can hold
+        is returned with ``success`` False, its intervals marked unreliable
+        and a note.
     """
     entry = _identifiable(model)
     if x0 not in ("rest", "estimate"):
