@@ -329,3 +329,14 @@ def test_messages_name_what_the_records_or_options_lack():
     m = qc.Measurement(t, zr=zr, fa=fa, **y)
     with pytest.raises(ValueError, match=r"the start car \(ms=1e-300.*no finite response"):
         qc.identify(m, fixed={"ms": 1e-300})
+
+
+def test_a_fit_that_runs_away_to_a_car_the_model_cannot_hold_is_refused_in_words():
+    # the body's acceleration alone under the road, a tire damping started at 1e5 N·s/m:
+    # the wheel's stiffness runs to 1e-189 N/m; scipy's SVD said "array must not contain
+    # infs or NaNs" when a trial car's response was not finite
+    car = CARS[0]
+    t, zr, _ = _inputs(6.0, seed=4)
+    m = qc.Measurement(t, zr=zr, **_records(car, t, zr, None, ("body_acc",), noise=0.01))
+    with pytest.raises(ValueError, match=r"the fit ran away \(.*ku = .*--units zr=mm"):
+        qc.identify(m, fixed={"ms": 320.0}, start={"cu": 1e5})

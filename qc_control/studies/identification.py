@@ -97,7 +97,9 @@ Z95 = 1.959963984540054
 RANK_TOLERANCE = 1e-6
 #: Lags of the residuals' autocorrelation checked for whiteness.
 WHITENESS_LAGS = 25
-#: The misfit of a bin whose response overflowed (an absurd trial car).
+#: The misfit of a bin or sample whose response overflowed (an absurd trial car), and
+#: the largest one counted: a sound car's weighted misfits are of order 1, and a
+#: square beyond 1e308 would overflow the optimiser's cost.
 UNPHYSICAL_MISFIT = 1e12
 #: The frequency fit's bins should be at most this fraction of the body
 #: resonance's half-power width: the H1 estimate's leakage bias grows as the
@@ -273,13 +275,17 @@ class _Problem:
         )
 
     def residuals(self, theta: np.ndarray) -> np.ndarray:
+        # a trial car the model refuses (modes 1e7 apart) or whose response overflows: a
+        # huge finite misfit makes the trust region reject that step, where a NaN would
+        # end the fit in the SVD of a Jacobian ("array must not contain infs or NaNs")
         try:
-            y = self.simulate(theta)
-        except ValueError:  # a trial car the model refuses (modes 1e7 apart): the trust
-            # region shrinks its step on a non-finite misfit, as on an overflow
-            return np.full(self.weights.size * len(self.measurement), np.nan)
-        e = (y - self.measured()) * self.weights[:, None]
-        return e.ravel()
+            with np.errstate(over="ignore", invalid="ignore"):
+                e = (self.simulate(theta) - self.measured()) * self.weights[:, None]
+        except ValueError:
+            return np.full(self.weights.size * len(self.measurement), UNPHYSICAL_MISFIT)
+        return np.clip(
+            np.nan_to_num(e, nan=UNPHYSICAL_MISFIT), -UNPHYSICAL_MISFIT, UNPHYSICAL_MISFIT
+        ).ravel()
 
 
 @dataclass
@@ -545,7 +551,7 @@ def identify(
         measurement, (free, fixed, start, gains, outputs, entry), x0 == "estimate"
     )
     notes = list(measurement.notes)
-    _check_start(problem.residuals, theta0, problem)
+    _check_start(problem.simulate, theta0, problem)
     solution = problem.solve(problem.residuals, theta0)
     if not solution.success:
         notes.append(f"the optimiser stopped: {solution.message}")
@@ -580,13 +586,13 @@ def _problem(measurement, arguments, estimate_x0: bool) -> tuple[_Problem, np.nd
     return problem, theta0, pinned
 
 
-def _check_start(residuals, theta0: np.ndarray, problem: _Problem) -> None:
-    """Refuse a start whose response to the records is not finite, saying what to check
-    (the optimiser's own message, "Residuals are not finite in the initial point",
-    names none of the user's data)."""
+def _check_start(respond, theta0: np.ndarray, problem: _Problem) -> None:
+    """Refuse a start whose response to the records (``respond(theta0)``) is not finite,
+    saying what to check (the optimiser's own message, "Residuals are not finite in the
+    initial point", names none of the user's data)."""
     with np.errstate(all="ignore"):
         try:
-            finite = bool(np.all(np.isfinite(residuals(theta0))))
+            finite = bool(np.all(np.isfinite(respond(theta0))))
         except (ValueError, np.linalg.LinAlgError):  # a start car that cannot be built
             finite = False
     if not finite:
@@ -837,20 +843,26 @@ class _FrequencyFit:
     estimate: Transmissibility
     weights: np.ndarray  # (outputs, inputs, F): 1 / the SD of each bin's relative error
 
-    def residuals(self, theta: np.ndarray) -> np.ndarray:
+    def response(self, theta: np.ndarray) -> np.ndarray:
+        """The car's transmissibility at the estimate's bins, its gains applied."""
         values, gains, _ = self.problem.unpack(theta)
         est, dt = self.estimate, self.problem.measurement.dt
-        # a trial step to an absurd car (a mode far beyond the sampling rate) overflows
-        # exp(A dt); a huge finite misfit makes the trust region reject that step
         with np.errstate(over="ignore", invalid="ignore"):
-            try:
-                H = quarter_response(values, est.frequency, est.outputs, est.inputs, dt)
-            except ValueError:  # a trial car the model refuses (modes 1e7 apart)
-                return np.full(2 * est.response.size, UNPHYSICAL_MISFIT)
-        H = H * np.array([gains.get(k, 1.0) for k in est.inputs])[None, :, None]
-        e = (H - est.response) * self.weights
+            H = quarter_response(values, est.frequency, est.outputs, est.inputs, dt)
+        return H * np.array([gains.get(k, 1.0) for k in est.inputs])[None, :, None]
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        # a trial step to an absurd car (a mode far beyond the sampling rate) overflows
+        # exp(A dt), or the model refuses it (modes 1e7 apart): a huge finite misfit makes
+        # the trust region reject that step, where a NaN would end the fit in its SVD
+        try:
+            e = (self.response(theta) - self.estimate.response) * self.weights
+        except ValueError:
+            return np.full(2 * self.estimate.response.size, UNPHYSICAL_MISFIT)
         r = np.stack([e.real, e.imag], axis=2).ravel()
-        return np.where(np.isfinite(r), r, UNPHYSICAL_MISFIT)
+        return np.clip(
+            np.nan_to_num(r, nan=UNPHYSICAL_MISFIT), -UNPHYSICAL_MISFIT, UNPHYSICAL_MISFIT
+        )
 
 
 def _identify_frequency(measurement, arguments, resolution, band) -> Identification:
@@ -870,7 +882,7 @@ def _identify_frequency(measurement, arguments, resolution, band) -> Identificat
         f"bins from {estimate.averages} Welch averages, {lo_hi[0]:g}–{lo_hi[1]:g} Hz, "
         f"each bin weighted by its coherence and by each input's own share of it"
     )
-    _check_start(fit.residuals, theta0, problem)
+    _check_start(fit.response, theta0, problem)
     solution = problem.solve(fit.residuals, theta0)
     if not solution.success:
         notes.append(f"the optimiser stopped: {solution.message}")
