@@ -312,7 +312,7 @@ def test_identify_finds_its_model_in_the_registry():
     assert [name for name, entry in MODELS.items() if entry.identifiable] == ["quarter"]
     t, zr, _ = _inputs(2.0, seed=10)
     m = qc.Measurement(t, zr=zr, body_acc=np.sin(t))
-    with pytest.raises(ValueError, match="model must be 'quarter' .*got 'half'"):
+    with pytest.raises(qc.ParameterError, match="model must be 'quarter', got 'half'"):
         qc.identify(m, model="half")
 
 

@@ -142,14 +142,14 @@ def test_too_short_a_record_for_the_resolution_is_refused():
     # 0.1 Hz bins need 10 s segments: 20 s gives 3 averages, fewer than MIN_AVERAGES
     with pytest.raises(ValueError, match=r"record of 20\.01 s is too short for a resolution"):
         qc.identify(m, domain="frequency", resolution=0.1)
-    with pytest.raises(ValueError, match="resolution must be a frequency > 0 Hz"):
+    with pytest.raises(qc.ParameterError, match="resolution must be a finite number > 0 Hz"):
         transmissibility(m, resolution=-1.0)
 
 
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        (dict(domain="spectral"), "domain must be 'time' or 'frequency', got 'spectral'"),
+        (dict(domain="spectral"), "domain must be one of 'time', 'frequency', got 'spectral'"),
         (dict(domain="frequency", x0="estimate"), "x0='estimate' applies to the time domain"),
         (dict(resolution=0.5), "resolution and band apply to domain='frequency' only"),
         (dict(domain="frequency", band=(5.0, 2.0)), "band must be .f_low, f_high. in Hz"),
@@ -202,3 +202,14 @@ def test_a_band_holding_no_bin_is_refused():
     m = _record(CAR, 120.0, seed=1, outputs=("body_acc",))
     with pytest.raises(ValueError, match=r"band 1.01-1.02 Hz holds no bin of the 0.25 Hz"):
         qc.identify(m, domain="frequency", resolution=0.25, band=(1.01, 1.02))
+
+
+def test_a_numpy_integer_resolution_is_a_resolution():
+    # issue 39 item 14: resolution=np.int64(1) was refused as not a frequency; the
+    # reference is the same estimate at the plain int
+    m = _record(CAR, 60.0, seed=1, outputs=("body_acc",))
+    numpy_int = transmissibility(m, resolution=np.int64(1))
+    assert numpy_int.resolution == transmissibility(m, resolution=1).resolution == 1.0
+    for bad in (0, -1.0, float("nan"), "1"):
+        with pytest.raises(qc.ParameterError, match="resolution must be a finite number > 0 Hz"):
+            transmissibility(m, resolution=bad)

@@ -56,6 +56,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.signal
 
+from ..numerics.checks import positive
 from ..numerics.exact import exact_step_matrices
 from .measurement import Measurement
 
@@ -121,10 +122,8 @@ def _segment(measurement: Measurement, resolution: float | None) -> tuple[int, i
     if resolution is None:
         nperseg = 2 * n // (DEFAULT_AVERAGES + 1)
     else:
-        if not (isinstance(resolution, (int, float)) and math.isfinite(resolution)) or (
-            resolution <= 0
-        ):
-            raise ValueError(f"resolution must be a frequency > 0 Hz, got {resolution!r}")
+        # any real number, a NumPy one too (np.int64(1) was refused)
+        resolution = positive("resolution", resolution, "Hz")
         nperseg = int(math.ceil(fs / resolution))
     averages = (n - nperseg) // (nperseg // 2) + 1 if nperseg <= n and nperseg >= 2 else 0
     if averages < MIN_AVERAGES:

@@ -51,6 +51,7 @@ import scipy.stats
 from ..models.quarter import QuarterCarParams, quarter_car_abcd, quarter_car_model
 from ..models.registry import MODELS, ModelEntry
 from ..models.vehicle import VehicleModel
+from ..numerics.checks import ParameterError, choice
 from ..numerics.exact import exact_outputs
 from ..numerics.reference import rest_state
 from ..numerics.threads import one_blas_thread
@@ -535,10 +536,8 @@ def identify(
         and a note.
     """
     entry = _identifiable(model)
-    if x0 not in ("rest", "estimate"):
-        raise ValueError(f"x0 must be 'rest' or 'estimate', got {x0!r}")
-    if domain not in ("time", "frequency"):
-        raise ValueError(f"domain must be 'time' or 'frequency', got {domain!r}")
+    choice("x0", x0, ("rest", "estimate"))
+    choice("domain", domain, ("time", "frequency"))
     if domain == "frequency":
         if x0 != "rest":
             raise ValueError("x0='estimate' applies to the time domain only")
@@ -563,10 +562,7 @@ def _identifiable(model: str) -> ModelEntry:
     fits = [name for name, entry in MODELS.items() if entry.identifiable]
     entry = MODELS.get(model) if isinstance(model, str) else None
     if entry is None or not entry.identifiable:
-        raise ValueError(
-            f"model must be {' or '.join(map(repr, fits))} (the models identify can fit), "
-            f"got {model!r}"
-        )
+        raise ParameterError("model", model, " or ".join(map(repr, fits)))
     return entry
 
 
