@@ -191,7 +191,9 @@ def test_bad_arguments_name_the_value():
         qc.identify(m, free=["kx"])
     with pytest.raises(ValueError, match="gain 'fa'"):
         qc.identify(m, gains=["fa"])
-    with pytest.raises(ValueError, match="fixed value of 'ms'"):
+    with pytest.raises(
+        qc.ParameterError, match=r"ms \(fixed value\) must be a finite number > 0 kg"
+    ):
         qc.identify(m, fixed={"ms": -1.0})
     with pytest.raises(ValueError, match="x0 must be"):
         qc.identify(m, x0="guess")

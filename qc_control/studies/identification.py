@@ -51,7 +51,7 @@ import scipy.stats
 from ..models.quarter import QuarterCarParams, quarter_car_abcd, quarter_car_model
 from ..models.registry import MODELS, ModelEntry
 from ..models.vehicle import VehicleModel
-from ..numerics.checks import ParameterError, choice
+from ..numerics.checks import ParameterError, choice, nonnegative, positive
 from ..numerics.exact import exact_outputs
 from ..numerics.reference import rest_state
 from ..numerics.threads import one_blas_thread
@@ -383,14 +383,13 @@ def _as_names(values: Iterable[str] | None, what: str, allowed: Sequence[str]) -
 
 
 def _positive_values(values: Mapping[str, Any] | None, what: str) -> dict[str, float]:
+    """``values`` checked: known names, each a finite value > 0 in its unit (>= 0 for
+    the parameters fitted as they are, ``cu``)."""
     out = {}
     for name, value in (values or {}).items():
-        if name not in PHYSICAL:
-            raise ValueError(f"{what} parameter {name!r} is not one of {', '.join(PHYSICAL)}")
-        value = float(value)
-        if not math.isfinite(value) or value < 0 or (value == 0 and name != "cu"):
-            raise ValueError(f"{what} value of {name!r} must be > 0, got {value!r}")
-        out[name] = value
+        choice(f"{what} parameter", name, PHYSICAL)
+        check = nonnegative if name in LINEAR else positive
+        out[name] = check(name, value, _UNITS[name], description=f"{what} value")
     return out
 
 
