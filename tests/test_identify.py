@@ -260,6 +260,7 @@ def test_a_car_without_tire_damping_fits_to_cu_zero_with_cu_free_by_default(x0):
     # the truth, 0, inside an interval that starts at the bound and has a width: 1.96 SEs
     # of 5 % noise on 1201 samples is some N·s/m, far below a tire's few hundred
     assert row.ci_low == 0.0 <= row.estimate < row.ci_high < 50.0
+    assert any("cu is at its bound 0" in note for note in ident.notes)
     for name in ("ms", "mu", "ks", "ku", "cs"):  # 5 % noise: within 2 %
         assert ident.table.loc[name, "estimate"] == pytest.approx(car[name], rel=0.02), name
     assert ident.success and ident.undetermined == ()

@@ -81,7 +81,14 @@ def _blocks(ident: Identification, fitted, held, specs, command) -> list:
     n = 2 + (ident.ratios is not None)
     blocks += [
         Heading("Fit"),
-        Table(fit_table, "NRMSE fit [%] per output (100: perfect).", f"Table {n}"),
+        Table(
+            fit_table,
+            "NRMSE fit [%] per output (100: perfect); the identification record simulated "
+            "from the state its fit started from"
+            + (" (estimated)" if any(k.startswith("x0_") for k in ident.table.index) else "")
+            + (", the held-out record from rest." if held is not None else "."),
+            f"Table {n}",
+        ),
         Table(
             white,
             "Whiteness of the residuals: the fraction of autocorrelation lags 1-25 outside "

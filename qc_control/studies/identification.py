@@ -773,6 +773,18 @@ def _result(problem: _Problem, solution, pinned_for_scale, notes, covariance=Non
     fit, whiteness_table = _fit_and_whiteness(problem, theta)
     if settled:
         _intervals_trusted(table, whiteness_table, problem, notes)
+    # at the bound: the trust region stays strictly inside it, so "0" is a value a
+    # millionth of its own interval's width or less
+    bound = [
+        n
+        for n in problem.free
+        if n in LINEAR and table.loc[n, "estimate"] <= 1e-6 * table.loc[n, "ci_high"]
+    ]
+    if bound:
+        notes.append(
+            f"{', '.join(bound)} is at its bound 0: the records show no tire damping; its "
+            "interval is one-sided, from 0"
+        )
     undetermined_names = [n for n, u in zip(names, undetermined) if u]
     ratios = None
     if pinned_for_scale:
