@@ -775,11 +775,8 @@ def _result(problem: _Problem, solution, pinned_for_scale, notes, covariance=Non
         _intervals_trusted(table, whiteness_table, problem, notes)
     # at the bound: the trust region stays strictly inside it, so "0" is a value a
     # millionth of its own interval's width or less
-    bound = [
-        n
-        for n in problem.free
-        if n in LINEAR and table.loc[n, "estimate"] <= 1e-6 * table.loc[n, "ci_high"]
-    ]
+    at_zero = table["estimate"].to_numpy(float) <= 1e-6 * table["ci_high"].to_numpy(float)
+    bound = [n for n, z in zip(names, at_zero) if z and n in LINEAR and n in problem.free]
     if bound:
         notes.append(
             f"{', '.join(bound)} is at its bound 0: the records show no tire damping; its "
