@@ -306,7 +306,9 @@ class Identification:
         The initial state used (at rest, or estimated).
     table : pandas.DataFrame
         One row per fitted quantity: ``estimate``, ``std_error``,
-        ``ci_low``, ``ci_high`` (95 %), ``unit``, ``determined``.
+        ``ci_low``, ``ci_high`` (95 %; from 0 for ``cu``, bounded there),
+        ``unit``, ``determined``, and ``intervals``: ``'95 %'``, or
+        ``'unreliable'`` when a residual is not white or a parameter ran away.
     correlation : pandas.DataFrame
         The estimates' correlation matrix.
     fit : pandas.Series
@@ -324,7 +326,9 @@ class Identification:
         What the fit assumed or could not do, in words.
     outputs : tuple of str
     success : bool
+        The optimiser converged and no parameter ran away (see ``notes``).
     nfev : int
+        Residual evaluations the optimiser made.
     """
 
     params: QuarterCarParams
