@@ -122,7 +122,6 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from .numerics.methods import METHODS, TABLEAUS, ButcherTableau, get_method
     from .numerics.stability import max_stable_step, stability_function
     from .report import write_report
-    from .report.identification import MeasurementComparison, compare_to_measurement
     from .report.plotting import plot_outputs
     from .report.transaction import ReportError
     from .responses.timeresp import (
@@ -154,6 +153,7 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
     from .studies.control_study import ControlComparison, compare_controllers
     from .studies.damping import DampingOptimum, ParetoFront, optimal_damping, pareto_front
     from .studies.identification import Identification, identify
+    from .studies.measured_comparison import MeasurementComparison, compare_to_measurement
     from .studies.measurement import Measurement
     from .studies.nlsweep import BatchResponse, simulate_batch
     from .studies.scenario import Scenario
@@ -283,8 +283,8 @@ _LAZY: dict[str, str] = {
     "Measurement": "studies.measurement",
     "identify": "studies.identification",
     "Identification": "studies.identification",
-    "compare_to_measurement": "report.identification",
-    "MeasurementComparison": "report.identification",
+    "compare_to_measurement": "studies.measured_comparison",
+    "MeasurementComparison": "studies.measured_comparison",
 }
 
 

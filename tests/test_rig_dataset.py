@@ -3,12 +3,15 @@ from them: remade to the byte by their script, and the car found within 1 %."""
 
 from __future__ import annotations
 
+import re
+import shlex
 from pathlib import Path
 
 import pandas as pd
 import pytest
 from conftest import gallery_run
 
+from qc_control.cli.parser import run
 from qc_control.studies.measurement import rig_record
 
 ROOT = Path(__file__).parent.parent
@@ -50,3 +53,35 @@ def test_the_example_identifies_the_simulated_car(docs_build):
     fit = pd.read_csv(out_dir / "fit.csv", index_col=0)
     assert (fit["validation"] > 98.0).all()  # 1 % noise caps the fit near 99 %
     assert (out_dir / "report.html").exists() and (out_dir / "validation_psd.png").exists()
+
+
+def _guide_command() -> list[str]:
+    """The ``qc-control identify`` command of the guide's identification page, as words:
+    read from the page, so that the page and this test cannot drift apart."""
+    page = (ROOT / "docs" / "guide" / "identification.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```sh\n(.*?)```", page, flags=re.S)
+    commands = [b for b in blocks if b.lstrip().startswith("qc-control identify")]
+    assert len(commands) == 1, "the page shows one identify command"
+    return shlex.split(commands[0].replace("\\\n", " "))
+
+
+def test_the_guides_exact_command_recovers_every_parameter_within_its_interval(
+    tmp_path, monkeypatch
+):
+    # issue 39's "done when": the shipped records through the guide's command, word for
+    # word (its paths are relative to the repository's root, --out to a fresh folder)
+    words = _guide_command()
+    assert "..." not in " ".join(words)
+    monkeypatch.chdir(ROOT)
+    out = tmp_path / "id"
+    words[words.index("--out") + 1] = str(out)
+    assert run(words[1:]) == 0
+    table = pd.read_csv(out / "parameters.csv", index_col=0)
+    # the car examples/make_rig_dataset.py simulated (ms = 320 kg is fixed by the command)
+    truth = dict(mu=45.0, ks=22000.0, ku=190000.0, cs=1800.0, cu=150.0, gain_fa=-1.0)
+    assert set(truth) <= set(table.index)
+    for name, value in truth.items():
+        row = table.loc[name]
+        assert row.ci_low <= value <= row.ci_high, (name, row.ci_low, row.ci_high)
+    # white residuals: the intervals are the 95 % ones, not marked unreliable
+    assert (table["intervals"] == "95 %").all()

@@ -17,12 +17,13 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NamedTuple
 
+import numpy as np
 import pandas as pd
 
 from ..report.identification import write_identification_report
 from ..ride.roughness import IRISegments, iri
 from ..studies.identification import DEFAULT_FREE, PHYSICAL, identify
-from ..studies.measurement import Measurement
+from ..studies.measurement import Measurement, read_csv, row_of
 from .commands import COMMANDS
 
 __all__ = ["add_measured_commands", "CommandTools"]
@@ -76,9 +77,9 @@ def add_measured_commands(sub, tools: CommandTools) -> None:
     ident.add_argument(
         "--free",
         metavar="NAME,...",
-        help=f"parameters fitted, of {','.join(PHYSICAL)} (default {','.join(DEFAULT_FREE)}: "
-        "the tire damping cu stays at its start, 0, unless freed; a rig's tire has some, "
-        "and a fit without it reports intervals marked unreliable)",
+        help=f"parameters fitted, of {','.join(PHYSICAL)} (default {','.join(DEFAULT_FREE)}, "
+        "less those --fix holds; the tire damping cu is bounded below by 0, so a car "
+        "without tire damping fits to cu = 0)",
     )
     ident.add_argument("--outputs", metavar="LABEL,...", help="outputs fitted (default all)")
     ident.add_argument(
@@ -152,6 +153,24 @@ def _cmd_identify(args, tools: CommandTools) -> int:
     return 0
 
 
+def _profile(path: str, x_column: str, z_column: str) -> tuple[np.ndarray, np.ndarray]:
+    """The distance and elevation columns of a profile's CSV; a cell that is not a
+    number is named by its column and its line in the file."""
+    frame, lines = read_csv(Path(path))
+    found = []
+    for column in (x_column, z_column):
+        if column not in frame.columns:
+            raise ValueError(f"column {column!r} is not among {list(frame.columns)}")
+        values = pd.to_numeric(frame[column], errors="coerce").to_numpy(dtype=float)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raise ValueError(
+                f"column {column!r} is not a number at row {row_of(lines, int(bad[0]))} of {path!r}"
+            )
+        found.append(values)
+    return found[0], found[1]
+
+
 def _cmd_iri(args, tools: CommandTools) -> int:
     try:
         if not math.isfinite(args.z_scale) or args.z_scale == 0:
@@ -159,16 +178,8 @@ def _cmd_iri(args, tools: CommandTools) -> int:
                 f"--z-scale must be a finite factor to metres, not 0 (mm: 0.001), "
                 f"got {args.z_scale!r}"
             )
-        try:
-            frame = pd.read_csv(Path(args.profile), comment="#")
-        except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
-            raise ValueError(f"cannot read {args.profile!r}: {exc}") from None
-        for column in (args.x, args.z):
-            if column not in frame.columns:
-                raise ValueError(f"column {column!r} is not among {list(frame.columns)}")
-        x = pd.to_numeric(frame[args.x], errors="coerce").to_numpy(dtype=float)
-        z = args.z_scale * pd.to_numeric(frame[args.z], errors="coerce").to_numpy(dtype=float)
-        result = iri(x, z, segment=args.segment)
+        x, z = _profile(args.profile, args.x, args.z)
+        result = iri(x, args.z_scale * z, segment=args.segment)
     except ValueError as exc:
         raise tools.usage_error(str(exc)) from None
     if not isinstance(result, IRISegments):

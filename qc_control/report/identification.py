@@ -1,200 +1,42 @@
-"""A model against measurement, and the identification report (``qc-control identify``).
+"""The identification report (``qc-control identify``).
 
-`compare_to_measurement` simulates a car under a measurement's recorded
-inputs and gives the fit of each measured output (NRMSE, as MATLAB's
-``compare``) with three figures: the records overlaid, the residuals, and
-the power spectral densities overlaid. `write_identification_report` writes
-an `qc_control.identify` result as a report: the parameters with their 95 %
-intervals, what the records do not determine, the fit per output on the
-identification record and on a held-out one, the figures, and the command
-that redoes it.
+`write_identification_report` writes an `qc_control.identify` result as a
+report: the parameters with their 95 % intervals, what the records do not
+determine, the fit per output on the identification record and on a
+held-out one, the figures, and the command that redoes it. The numbers and
+the figures' data come from the studies
+(`qc_control.studies.measured_comparison`); this module formats them.
 
-matplotlib is imported inside the functions that draw.
+`compare_to_measurement` and `MeasurementComparison` lived here until they
+moved to `qc_control.studies.measured_comparison`: the old path still
+answers, with a `DeprecationWarning` naming the new one.
 """
 
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+import warnings
 
-import numpy as np
 import pandas as pd
-import scipy.signal
 
-from ..models.quarter import QuarterCarParams
-from ..models.vehicle import VehicleModel
-from ..numerics.reference import exact_response
-from ..studies.identification import OUTPUT_LABELS, Identification, nrmse_fit, simulate_quarter
-from ..studies.measurement import SIGNAL_UNITS, Measurement
+from ..studies import measured_comparison
+from ..studies.identification import Identification
+from ..studies.measurement import Measurement
 from .document import Code, Heading, Image, Paragraph, Table
 from .writer import FORMATS, FigureSpec, write_document
 
-if TYPE_CHECKING:
-    from matplotlib.figure import Figure
+__all__ = ["write_identification_report", "TITLE"]
 
-__all__ = [
-    "MeasurementComparison",
-    "compare_to_measurement",
-    "write_identification_report",
-    "TITLE",
-]
+#: The names that moved to `qc_control.studies.measured_comparison`.
+_MOVED = ("MeasurementComparison", "compare_to_measurement")
+# not under their own names: a module global would answer the old path without a warning
+_Comparison = measured_comparison.MeasurementComparison
+_compare = measured_comparison.compare_to_measurement
 
 TITLE = "Quarter car identified from measured records"
 
 
-@dataclass
-class MeasurementComparison:
-    """A model's outputs against a measurement's.
-
-    Attributes
-    ----------
-    t : ndarray
-        Time [s].
-    measured, simulated : dict
-        ``{label: samples}`` of each compared output.
-    fit : pandas.Series
-        NRMSE fit [%] of each output.
-    """
-
-    t: np.ndarray
-    measured: dict[str, np.ndarray]
-    simulated: dict[str, np.ndarray]
-    fit: pd.Series
-
-    @property
-    def residuals(self) -> dict[str, np.ndarray]:
-        """Measured minus simulated, per output."""
-        return {k: self.measured[k] - self.simulated[k] for k in self.measured}
-
-    def figure_records(self) -> Figure:
-        """The measured and simulated records overlaid, one panel per output."""
-        t, measured, simulated = self.t, self.measured, self.simulated
-        return _panels(self, lambda ax, k: _overlay(ax, t, measured[k], simulated[k]))
-
-    def figure_residuals(self) -> Figure:
-        """The residuals (measured − simulated), one panel per output."""
-        return _panels(self, lambda ax, k: ax.plot(self.t, self.residuals[k], lw=0.6))
-
-    def figure_psd(self) -> Figure:
-        """The PSDs of the measured and simulated outputs (Welch), one panel per output."""
-        fs = 1.0 / (self.t[1] - self.t[0])
-
-        def draw(ax, k):
-            for signal, style, name in (
-                (self.measured[k], "-", "measured"),
-                (self.simulated[k], "--", "simulated"),
-            ):
-                f, p = scipy.signal.welch(signal, fs=fs, nperseg=min(signal.size, 2048))
-                ax.loglog(f[1:], p[1:], style, lw=0.9, label=name)
-            ax.legend(fontsize="small")
-
-        return _panels(self, draw, xlabel="frequency [Hz]", psd=True)
-
-    @property
-    def figures(self) -> dict[str, Figure]:
-        """The three figures by name: ``records``, ``residuals``, ``psd``."""
-        return {
-            "records": self.figure_records(),
-            "residuals": self.figure_residuals(),
-            "psd": self.figure_psd(),
-        }
-
-
-def _overlay(ax, t, measured, simulated) -> None:
-    ax.plot(t, measured, lw=0.8, label="measured")
-    ax.plot(t, simulated, "--", lw=0.8, label="simulated")
-    ax.legend(fontsize="small", loc="upper right")
-
-
-def _panels(cmp: MeasurementComparison, draw, xlabel: str = "t [s]", psd: bool = False):
-    from matplotlib.figure import Figure  # heavy and optional: only when plotting
-
-    labels = list(cmp.measured)
-    fig = Figure(figsize=(8, 2.2 * len(labels) + 0.6), layout="constrained")
-    axes = fig.subplots(len(labels), 1, squeeze=False)[:, 0]
-    for ax, k in zip(axes, labels):
-        draw(ax, k)
-        unit = SIGNAL_UNITS.get(k, "")
-        ax.set_ylabel(f"{k} [({unit})²/Hz]" if psd else f"{k} [{unit}]")
-        ax.set_title(f"{k}: fit {cmp.fit[k]:.1f} %", fontsize="medium")
-    axes[-1].set_xlabel(xlabel)
-    return fig
-
-
-def _linear_outputs(model: VehicleModel, measurement: Measurement, outputs) -> np.ndarray:
-    """A linear `VehicleModel`'s outputs (python-control's exact response), at rest."""
-    sys = model.system
-    U = np.stack(
-        [
-            measurement[k] if k in measurement.signals else np.zeros(len(measurement))
-            for k in sys.input_labels
-        ]
-    )
-    response = exact_response(sys, measurement.t, U=U, at_rest=bool(U.size))
-    rows = [list(sys.output_labels).index(k) for k in outputs]
-    return np.atleast_2d(response.outputs)[rows]
-
-
-def compare_to_measurement(
-    model: Any, measurement: Measurement, outputs=None
-) -> MeasurementComparison:
-    """Simulate ``model`` under ``measurement``'s inputs and compare its outputs.
-
-    Parameters
-    ----------
-    model : Identification, QuarterCarParams, mapping or VehicleModel
-        An identification (its gains applied), a quarter car's parameters,
-        or a linear `VehicleModel` whose inputs are labelled as the
-        measurement's (``zr``, ``fa``; an absent one is zero).
-    measurement : Measurement
-    outputs : sequence of str, optional
-        The outputs compared; by default every measured output the model gives.
-
-    Returns
-    -------
-    MeasurementComparison
-        The fit per output and the figures (records, residuals, PSDs). The
-        record is taken to start at rest.
-    """
-    if not isinstance(measurement, Measurement):
-        raise TypeError(f"measurement must be a Measurement, got {type(measurement).__name__}")
-    if isinstance(model, VehicleModel):
-        given = set(model.system.output_labels)
-    else:
-        given = set(OUTPUT_LABELS)
-    wanted = [k for k in measurement.outputs if k in given] if outputs is None else list(outputs)
-    missing = [k for k in wanted if k not in given or k not in measurement.signals]
-    if missing or not wanted:
-        raise ValueError(
-            f"cannot compare output(s) {missing or '(none)'}: the model gives "
-            f"{sorted(given)}, the measurement has {list(measurement.outputs)}"
-        )
-    if isinstance(model, Identification):
-        y = model.simulate(measurement) if set(wanted) == set(model.outputs) else None
-        if y is None:
-            y = simulate_quarter(model.values, measurement, wanted, model.gains)
-        else:
-            y = y[[list(model.outputs).index(k) for k in wanted]]
-    elif isinstance(model, VehicleModel):
-        y = _linear_outputs(model, measurement, wanted)
-    elif isinstance(model, (QuarterCarParams, Mapping)):
-        p = model if isinstance(model, QuarterCarParams) else QuarterCarParams.from_mapping(model)
-        values = {n: float(getattr(p, n)) for n in ("ms", "mu", "ks", "ku", "cs", "cu")}
-        y = simulate_quarter(values, measurement, wanted)
-    else:
-        raise TypeError(
-            "model must be an Identification, QuarterCarParams, dict or VehicleModel, "
-            f"got {type(model).__name__}"
-        )
-    measured = {k: measurement[k] for k in wanted}
-    simulated = {k: y[i] for i, k in enumerate(wanted)}
-    fit = pd.Series({k: nrmse_fit(measured[k], simulated[k]) for k in wanted}, name="fit [%]")
-    return MeasurementComparison(measurement.t, measured, simulated, fit)
-
-
-def _figures(fitted: MeasurementComparison, held: MeasurementComparison | None):
+def _figures(fitted: _Comparison, held: _Comparison | None):
     specs: list[FigureSpec] = []
     runs = [("identification record", fitted, "fit")]
     if held is not None:
@@ -239,7 +81,14 @@ def _blocks(ident: Identification, fitted, held, specs, command) -> list:
     n = 2 + (ident.ratios is not None)
     blocks += [
         Heading("Fit"),
-        Table(fit_table, "NRMSE fit [%] per output (100: perfect).", f"Table {n}"),
+        Table(
+            fit_table,
+            "NRMSE fit [%] per output (100: perfect); the identification record simulated "
+            "from the state its fit started from"
+            + (" (estimated)" if any(k.startswith("x0_") for k in ident.table.index) else "")
+            + (", the held-out record from rest." if held is not None else "."),
+            f"Table {n}",
+        ),
         Table(
             white,
             "Whiteness of the residuals: the fraction of autocorrelation lags 1-25 outside "
@@ -271,8 +120,10 @@ def write_identification_report(
     determined), ``correlation.csv`` and ``fit.csv``.
     """
     formats = tuple(f for f in formats if f in FORMATS) or ("md",)
-    fitted = compare_to_measurement(ident, measurement, ident.outputs)
-    held = compare_to_measurement(ident, validation, ident.outputs) if validation else None
+    # the identification record from the state its fit started from (at rest, or the
+    # estimated x0), so that this table is the fit the identification reports
+    fitted = _compare(ident, measurement, ident.outputs, X0=ident.x0)
+    held = _compare(ident, validation, ident.outputs) if validation else None
     specs = _figures(fitted, held)
 
     def tables() -> dict[str, pd.DataFrame]:
@@ -297,3 +148,17 @@ def write_identification_report(
         command=command,
         overwrite=overwrite,
     )
+
+
+def __getattr__(name: str):
+    """`compare_to_measurement` and `MeasurementComparison` moved to the studies (they
+    simulate): the old path still answers, with a `DeprecationWarning`."""
+    if name in _MOVED:
+        warnings.warn(
+            f"qc_control.report.identification.{name} moved to "
+            f"qc_control.studies.measured_comparison.{name}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return getattr(measured_comparison, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

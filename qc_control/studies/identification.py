@@ -6,8 +6,11 @@ simulated exactly (`qc_control.numerics.exact`) under the measured inputs
 misfit of the measured outputs, each output's residual divided by that
 output's RMS so that a displacement and an acceleration weigh alike.
 Physical parameters are fitted as logarithms (they stay positive, and their
-steps are relative); input gains, which may be negative (a force channel
-of the opposite sign), are fitted as they are.
+steps are relative), except the tire damping ``cu``, fitted as it is with a
+bound at 0: a tire without damping is a car the fit must reach, and a
+logarithm reaches 0 only by running away to minus infinity (its interval
+then of zero width, or an overflow). Input gains, which may be negative (a
+force channel of the opposite sign), are fitted as they are.
 
 What the records can determine is stated, not guessed. Scaling every mass,
 stiffness and damping by one factor leaves the response to the road
@@ -46,7 +49,9 @@ import scipy.optimize
 import scipy.stats
 
 from ..models.quarter import QuarterCarParams, quarter_car_abcd, quarter_car_model
+from ..models.registry import MODELS, ModelEntry
 from ..models.vehicle import VehicleModel
+from ..numerics.checks import ParameterError, choice, nonnegative, positive
 from ..numerics.exact import exact_outputs
 from ..numerics.reference import rest_state
 from ..numerics.threads import one_blas_thread
@@ -71,8 +76,14 @@ __all__ = [
 
 #: The quarter car's physical parameters that identification can fit.
 PHYSICAL = ("ms", "mu", "ks", "ku", "cs", "cu")
-#: What a fit leaves free by default: all but the tire damping (a seed car).
-DEFAULT_FREE = ("ms", "mu", "ks", "ku", "cs")
+#: What a fit leaves free by default: every physical parameter. The tire damping is
+#: bounded below by 0, so a car without it is fitted as well as one with it.
+DEFAULT_FREE = PHYSICAL
+#: Parameters fitted as they are, bounded below by 0 (the rest as logarithms).
+LINEAR = ("cu",)
+#: An estimate more than this factor from its start has run away: the records hold
+#: nothing that pins it (e.g. a stiffness whose spring the outputs never see).
+RUNAWAY_FACTOR = 1e3
 #: The outputs the identified quarter car can be compared on.
 OUTPUT_LABELS = ("xs", "xu", "susp_travel", "tire_defl", "body_acc", "wheel_acc")
 #: A tire damping's start [N·s/m] when it is free and no start is given: a
@@ -87,7 +98,9 @@ Z95 = 1.959963984540054
 RANK_TOLERANCE = 1e-6
 #: Lags of the residuals' autocorrelation checked for whiteness.
 WHITENESS_LAGS = 25
-#: The misfit of a bin whose response overflowed (an absurd trial car).
+#: The misfit of a bin or sample whose response overflowed (an absurd trial car), and
+#: the largest one counted: a sound car's weighted misfits are of order 1, and a
+#: square beyond 1e308 would overflow the optimiser's cost.
 UNPHYSICAL_MISFIT = 1e12
 #: The frequency fit's bins should be at most this fraction of the body
 #: resonance's half-power width: the H1 estimate's leakage bias grows as the
@@ -202,6 +215,15 @@ def simulate_quarter(
     return y
 
 
+def _decode(name: str, theta: float) -> float:
+    """A physical value from its fitted coordinate (module note: ``cu`` as it is)."""
+    return float(theta) if name in LINEAR else float(np.exp(theta))
+
+
+def _encode(name: str, value: float) -> float:
+    return float(value) if name in LINEAR else math.log(value)
+
+
 @dataclass
 class _Problem:
     """What the optimiser varies and how the values of the car follow from it."""
@@ -221,7 +243,8 @@ class _Problem:
     def unpack(self, theta: np.ndarray):
         values = dict(self.base)
         k = len(self.free)
-        values.update(zip(self.free, np.exp(theta[:k])))
+        with np.errstate(over="ignore"):  # a runaway trial step: an inf car, flagged later
+            values.update((n, _decode(n, v)) for n, v in zip(self.free, theta[:k]))
         gains = dict(zip(self.gains, theta[k : k + len(self.gains)]))
         x0 = theta[k + len(self.gains) :] if self.estimate_x0 else None
         return values, gains, x0
@@ -233,9 +256,37 @@ class _Problem:
     def measured(self) -> np.ndarray:
         return np.stack([self.measurement[k] for k in self.outputs])
 
+    def lower_bounds(self) -> np.ndarray:
+        """0 for a parameter fitted as it is (``cu``), none for the rest."""
+        low = np.full(len(self.names()), -np.inf)
+        low[[i for i, n in enumerate(self.free) if n in LINEAR]] = 0.0
+        return low
+
+    def solve(self, residuals, theta0: np.ndarray):
+        """`scipy.optimize.least_squares` of ``residuals`` from ``theta0`` (trust region,
+        the bounds of `lower_bounds`)."""
+        return scipy.optimize.least_squares(
+            residuals,
+            theta0,
+            bounds=(self.lower_bounds(), np.inf),
+            method="trf",
+            x_scale="jac",
+            xtol=1e-12,
+            ftol=1e-12,
+        )
+
     def residuals(self, theta: np.ndarray) -> np.ndarray:
-        e = (self.simulate(theta) - self.measured()) * self.weights[:, None]
-        return e.ravel()
+        # a trial car the model refuses (modes 1e7 apart) or whose response overflows: a
+        # huge finite misfit makes the trust region reject that step, where a NaN would
+        # end the fit in the SVD of a Jacobian ("array must not contain infs or NaNs")
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):
+                e = (self.simulate(theta) - self.measured()) * self.weights[:, None]
+        except ValueError:
+            return np.full(self.weights.size * len(self.measurement), UNPHYSICAL_MISFIT)
+        return np.clip(
+            np.nan_to_num(e, nan=UNPHYSICAL_MISFIT), -UNPHYSICAL_MISFIT, UNPHYSICAL_MISFIT
+        ).ravel()
 
 
 @dataclass
@@ -255,7 +306,9 @@ class Identification:
         The initial state used (at rest, or estimated).
     table : pandas.DataFrame
         One row per fitted quantity: ``estimate``, ``std_error``,
-        ``ci_low``, ``ci_high`` (95 %), ``unit``, ``determined``.
+        ``ci_low``, ``ci_high`` (95 %; from 0 for ``cu``, bounded there),
+        ``unit``, ``determined``, and ``intervals``: ``'95 %'``, or
+        ``'unreliable'`` when a residual is not white or a parameter ran away.
     correlation : pandas.DataFrame
         The estimates' correlation matrix.
     fit : pandas.Series
@@ -273,7 +326,9 @@ class Identification:
         What the fit assumed or could not do, in words.
     outputs : tuple of str
     success : bool
+        The optimiser converged and no parameter ran away (see ``notes``).
     nfev : int
+        Residual evaluations the optimiser made.
     """
 
     params: QuarterCarParams
@@ -332,18 +387,19 @@ def _as_names(values: Iterable[str] | None, what: str, allowed: Sequence[str]) -
 
 
 def _positive_values(values: Mapping[str, Any] | None, what: str) -> dict[str, float]:
+    """``values`` checked: known names, each a finite value > 0 in its unit (>= 0 for
+    the parameters fitted as they are, ``cu``)."""
     out = {}
     for name, value in (values or {}).items():
-        if name not in PHYSICAL:
-            raise ValueError(f"{what} parameter {name!r} is not one of {', '.join(PHYSICAL)}")
-        value = float(value)
-        if not math.isfinite(value) or value < 0 or (value == 0 and name != "cu"):
-            raise ValueError(f"{what} value of {name!r} must be > 0, got {value!r}")
-        out[name] = value
+        choice(f"{what} parameter", name, PHYSICAL)
+        check = nonnegative if name in LINEAR else positive
+        out[name] = check(name, value, _UNITS[name], description=f"{what} value")
     return out
 
 
-def _setup(measurement, free, fixed, start, gains, outputs) -> tuple[dict, tuple, tuple, tuple]:
+def _setup(
+    measurement, free, fixed, start, gains, outputs, entry
+) -> tuple[dict, tuple, tuple, tuple]:
     """Checked arguments: the start values, free parameters, gains and outputs."""
     if not isinstance(measurement, Measurement):
         raise TypeError(f"measurement must be a Measurement, got {type(measurement).__name__}")
@@ -368,6 +424,12 @@ def _setup(measurement, free, fixed, start, gains, outputs) -> tuple[dict, tuple
         raise ValueError(
             f"the measurement has no output the model gives; expected one of {OUTPUT_LABELS}"
         )
+    for k in measurement.inputs:
+        if np.ptp(measurement[k]) == 0:  # a dead channel: S_uu singular, or no excitation
+            raise ValueError(
+                f"input {k!r} is constant ({float(measurement[k][0]):.6g} throughout): a dead "
+                f"channel? leave it out of the records (--map without {k})"
+            )
     for k in outs:
         x = measurement[k]
         if np.ptp(x) == 0:  # nothing to fit to, and a whiteness test of a constant
@@ -375,15 +437,32 @@ def _setup(measurement, free, fixed, start, gains, outputs) -> tuple[dict, tuple
                 f"output {k!r} is constant ({float(x[0]):.6g} throughout): a dead sensor? "
                 "leave it out (outputs=[...], --outputs)"
             )
-    seed = QuarterCarParams()
+    seed = entry.params()
     base = {n: float(getattr(seed, n)) for n in PHYSICAL}
     if "cu" in free_names:
         base["cu"] = CU_START
     base.update(start_values)
     base.update(fixed_values)
-    if "cu" in free_names and base["cu"] == 0:
-        raise ValueError("a free cu needs a start > 0 (it is fitted as a logarithm)")
+    _check_sampling(measurement, base)
     return base, free_names, gain_names, outs
+
+
+def _check_sampling(measurement: Measurement, base: Mapping[str, float]) -> None:
+    """Refuse records sampled below the start car's body mode (its lowest natural
+    frequency), naming the time column: a time column in ms read as seconds samples
+    a thousand times too slowly, and the fit then overflows with a message of scipy's
+    ("array must not contain infs or NaNs") that names nothing of the records."""
+    A, _, _, _ = _quarter_matrices(base)
+    body = float(np.min(np.abs(np.linalg.eigvals(A)))) / (2 * np.pi)
+    nyquist = 0.5 / measurement.dt
+    if nyquist < body:
+        column = getattr(measurement, "time_column", "t")
+        raise ValueError(
+            f"the records are sampled every {measurement.dt:.6g} s ({1 / measurement.dt:.3g} "
+            f"Hz): too slowly for a car whose body mode is near {body:.2g} Hz. Is the time "
+            f"column {column!r} in ms? Give its unit (units={{{column!r}: 'ms'}}, --units "
+            f"{column}=ms)"
+        )
 
 
 def _scale_free(base, free, gains, measurement) -> bool:
@@ -415,10 +494,13 @@ def identify(
     measurement : Measurement
         Inputs ``zr`` and/or ``fa``; outputs among `OUTPUT_LABELS`.
     model : {'quarter'}
-        The model fitted (the quarter car, with its tire damping ``cu``).
+        The model fitted: a registered model whose entry names ``fit_parameters``
+        (`qc_control.models.registry`), the quarter car with its tire
+        damping ``cu``.
     free : iterable of str, optional
-        Parameters to fit among ``ms, mu, ks, ku, cs, cu``; default all but
-        ``cu`` (which stays at its start, 0 unless given).
+        Parameters to fit among ``ms, mu, ks, ku, cs, cu``; default all
+        (less those ``fixed``). ``cu`` is fitted as it is, bounded by 0, and
+        starts at `CU_START` unless given; the rest as logarithms.
     fixed : mapping, optional
         ``{name: value}`` held at known values (a weighed mass).
     start : mapping, optional
@@ -448,44 +530,79 @@ def identify(
     Raises
     ------
     ValueError
-        For an unknown model, parameter, gain or output, a value <= 0, or
-        a measurement without inputs or fitted outputs.
+        For an unknown model, parameter, gain or output, a value <= 0, a
+        measurement without inputs or fitted outputs, a constant input or
+        output, records sampled below the car's body mode (a time column in
+        ms), a start with no finite response, or a fit that runs away to a
+        car the model cannot hold. A fit that runs away to a car it can hold
+        is returned with ``success`` False, its intervals marked unreliable
+        and a note.
     """
-    if model != "quarter":
-        raise ValueError(f"identify fits the quarter car: model must be 'quarter', got {model!r}")
-    if x0 not in ("rest", "estimate"):
-        raise ValueError(f"x0 must be 'rest' or 'estimate', got {x0!r}")
-    if domain not in ("time", "frequency"):
-        raise ValueError(f"domain must be 'time' or 'frequency', got {domain!r}")
+    entry = _identifiable(model)
+    choice("x0", x0, ("rest", "estimate"))
+    choice("domain", domain, ("time", "frequency"))
     if domain == "frequency":
         if x0 != "rest":
             raise ValueError("x0='estimate' applies to the time domain only")
         return _identify_frequency(
-            measurement, (free, fixed, start, gains, outputs), resolution, band
+            measurement, (free, fixed, start, gains, outputs, entry), resolution, band
         )
     if resolution is not None or band is not None:
         raise ValueError("resolution and band apply to domain='frequency' only")
-    base, free_names, gain_names, outs = _setup(measurement, free, fixed, start, gains, outputs)
+    problem, theta0, pinned_for_scale = _problem(
+        measurement, (free, fixed, start, gains, outputs, entry), x0 == "estimate"
+    )
     notes = list(measurement.notes)
-    pinned_for_scale = _scale_free(base, free_names, gain_names, measurement) and (
-        "ms" in free_names
-    )
-    fitted = tuple(n for n in free_names if not (pinned_for_scale and n == "ms"))
-    rms = np.array([np.sqrt(np.mean(measurement[k] ** 2)) for k in outs])
-    if np.any(rms == 0):
-        raise ValueError(f"output {outs[int(np.argmin(rms))]!r} is zero throughout")
-    problem = _Problem(measurement, outs, base, fitted, gain_names, x0 == "estimate", 1.0 / rms)
-    theta0 = np.concatenate(
-        [np.log([base[n] for n in fitted]), np.ones(len(gain_names)), np.zeros(4 * (x0 != "rest"))]
-    )
-    if x0 == "estimate":  # start from rest in equilibrium with the first inputs
-        theta0[len(fitted) + len(gain_names) :] = _rest_state(problem, theta0)
-    solution = scipy.optimize.least_squares(
-        problem.residuals, theta0, method="trf", x_scale="jac", xtol=1e-12, ftol=1e-12
-    )
+    _check_start(problem.simulate, theta0, problem)
+    solution = problem.solve(problem.residuals, theta0)
     if not solution.success:
         notes.append(f"the optimiser stopped: {solution.message}")
     return _result(problem, solution, pinned_for_scale, notes)
+
+
+def _identifiable(model: str) -> ModelEntry:
+    """The registry's entry of ``model``, if `identify` can fit it (it names
+    ``fit_parameters``)."""
+    fits = [name for name, entry in MODELS.items() if entry.fit_parameters]
+    entry = MODELS.get(model) if isinstance(model, str) else None
+    if entry is None or not entry.fit_parameters:
+        raise ParameterError("model", model, " or ".join(map(repr, fits)))
+    return entry
+
+
+def _problem(measurement, arguments, estimate_x0: bool) -> tuple[_Problem, np.ndarray, bool]:
+    """The problem of `identify`'s ``arguments`` (``free, fixed, start, gains, outputs,
+    entry``), its start, and whether ``ms`` is held for the scale (module note)."""
+    base, free_names, gain_names, outs = _setup(measurement, *arguments)
+    pinned = _scale_free(base, free_names, gain_names, measurement) and "ms" in free_names
+    fitted = tuple(n for n in free_names if not (pinned and n == "ms"))
+    rms = np.array([np.sqrt(np.mean(measurement[k] ** 2)) for k in outs])
+    problem = _Problem(measurement, outs, base, fitted, gain_names, estimate_x0, 1.0 / rms)
+    theta0 = np.concatenate(
+        [[_encode(n, base[n]) for n in fitted], np.ones(len(gain_names)), np.zeros(4 * estimate_x0)]
+    )
+    if estimate_x0:  # start from rest in equilibrium with the first inputs
+        theta0[len(fitted) + len(gain_names) :] = _rest_state(problem, theta0)
+    return problem, theta0, pinned
+
+
+def _check_start(respond, theta0: np.ndarray, problem: _Problem) -> None:
+    """Refuse a start whose response to the records (``respond(theta0)``) is not finite,
+    saying what to check (the optimiser's own message, "Residuals are not finite in the
+    initial point", names none of the user's data)."""
+    with np.errstate(all="ignore"):
+        try:
+            finite = bool(np.all(np.isfinite(respond(theta0))))
+        except (ValueError, np.linalg.LinAlgError):  # a start car that cannot be built
+            finite = False
+    if not finite:
+        values, _, _ = problem.unpack(theta0)
+        start = ", ".join(f"{n}={values[n]:.6g}" for n in PHYSICAL)
+        raise ValueError(
+            f"the start car ({start}) gives no finite response to the records' inputs "
+            f"{', '.join(problem.measurement.inputs)}: check their units and magnitudes "
+            "(a road in mm read as metres), or give start values near the car (start=, --start)"
+        )
 
 
 def _rest_state(problem: _Problem, theta: np.ndarray) -> np.ndarray:
@@ -517,13 +634,18 @@ def _covariance(n_out: int, J: np.ndarray, residual: np.ndarray):
     return cov, undetermined
 
 
-def _table(names, theta, cov, undetermined, n_log) -> pd.DataFrame:
+def _table(names, theta, cov, undetermined, n_physical) -> pd.DataFrame:
     se = np.sqrt(np.clip(np.diag(cov), 0, None))
     rows = []
     for i, name in enumerate(names):
-        if i < n_log:  # fitted as a logarithm: the interval is exp of a symmetric one
-            value = math.exp(theta[i])
-            low, high = math.exp(theta[i] - Z95 * se[i]), math.exp(theta[i] + Z95 * se[i])
+        if i < n_physical and name in LINEAR:  # as it is, bounded by 0: so is its interval
+            value, std = float(theta[i]), float(se[i])
+            low, high = max(value - Z95 * std, 0.0), value + Z95 * std
+            unit = _UNITS[name]
+        elif i < n_physical:  # fitted as a logarithm: the interval is exp of a symmetric one
+            # a runaway's logarithm may overflow exp: inf, flagged by _runaway
+            with np.errstate(over="ignore"):
+                value, low, high = np.exp(theta[i] + np.array([0.0, -Z95, Z95]) * se[i]).tolist()
             std = value * se[i]
             unit = _UNITS[name]
         else:
@@ -571,6 +693,73 @@ def _intervals_trusted(table: pd.DataFrame, white: pd.DataFrame, problem: _Probl
     )
 
 
+def _runaway(problem: _Problem, values: Mapping[str, float]) -> list[str]:
+    """The fitted parameters that ran away, each in words (empty: none).
+
+    A parameter the records do not pin drifts where the optimiser's steps take it:
+    a logarithm more than `RUNAWAY_FACTOR` from its start, or a tire damping above
+    the wheel's critical damping on its tire ``2 √(ku mu)`` (a tire's damping ratio
+    is a few per cent; Wong, *Theory of Ground Vehicles*, §1.6). Its interval is
+    then of no use (zero width, or an overflow), and the car it implies is not one
+    the rig holds. A value that is not finite cannot be reported at all.
+    """
+    found = []
+    for name in problem.free:
+        value, start = values[name], problem.base[name]
+        if not math.isfinite(value):
+            raise ValueError(
+                f"the fit of {name} ran away to {value}: the records do not determine it; "
+                f"fix it at a known value (fixed={{'{name}': ...}}, --fix {name}=...) or "
+                "fit outputs that respond to it"
+            )
+        if name in LINEAR:
+            critical = 2.0 * math.sqrt(values["ku"] * values["mu"])
+            if value > critical:
+                found.append(
+                    f"{name} = {value:.4g} {_UNITS[name]}, above the wheel's critical damping "
+                    f"on its tire (2√(ku mu) = {critical:.4g} {_UNITS[name]})"
+                )
+        elif not 1.0 / RUNAWAY_FACTOR <= value / start <= RUNAWAY_FACTOR:
+            found.append(f"{name} = {value:.4g} {_UNITS[name]}, from a start of {start:.4g}")
+    return found
+
+
+def _flag_runaway(problem: _Problem, values, table: pd.DataFrame, notes) -> bool:
+    """Mark the intervals unreliable and say so when a parameter ran away (`_runaway`);
+    whether none did."""
+    runaway = _runaway(problem, values)
+    try:
+        QuarterCarParams(**{n: values[n] for n in PHYSICAL})
+    except ValueError as exc:  # modes 1e7 apart, or an overflow: no car to report
+        found = f" ({'; '.join(runaway)})" if runaway else ""
+        raise ValueError(
+            f"the fit ran away{found} to a car the model cannot hold: {exc}. The records "
+            "do not determine it: check the records' units (a road in mm read as metres: "
+            "units={'zr': 'mm'}, --units zr=mm), fix a known mass (--fix ms=...) or fit "
+            "outputs that respond to every parameter"
+        ) from None
+    if runaway:
+        table["intervals"] = "unreliable"
+        notes.append(
+            f"the fit ran away: {'; '.join(runaway)}. The records do not pin "
+            f"{'it' if len(runaway) == 1 else 'them'}, so the result is not a car the records "
+            "determine: fix such a parameter at a known value (fixed=, --fix; a tire "
+            "without damping: cu=0), or fit outputs that respond to it"
+        )
+    return not runaway
+
+
+def _fit_and_whiteness(problem: _Problem, theta: np.ndarray) -> tuple[pd.Series, pd.DataFrame]:
+    """The NRMSE fit [%] of each output and its residual's whiteness."""
+    y = problem.simulate(theta)
+    measured = problem.measured()
+    fit = pd.Series(
+        {k: nrmse_fit(measured[i], y[i]) for i, k in enumerate(problem.outputs)}, name="fit [%]"
+    )
+    white = [whiteness(measured[i] - y[i]) for i in range(len(problem.outputs))]
+    return fit, pd.DataFrame(white, index=list(problem.outputs), columns=["lags_outside", "white"])
+
+
 def _result(problem: _Problem, solution, pinned_for_scale, notes, covariance=None):
     """The `Identification` of a solved problem; ``covariance`` is ``(cov,
     undetermined)`` when the fit was not this problem's (the frequency domain)."""
@@ -583,18 +772,21 @@ def _result(problem: _Problem, solution, pinned_for_scale, notes, covariance=Non
     sd = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
     correlation = pd.DataFrame(cov / np.outer(sd, sd), index=names, columns=names)
     values, gains, x0 = problem.unpack(theta)
+    settled = _flag_runaway(problem, values, table, notes)
     if x0 is None:
         x0 = _rest_state(problem, theta)
-    y = problem.simulate(theta)
-    measured = problem.measured()
-    fit = pd.Series(
-        {k: nrmse_fit(measured[i], y[i]) for i, k in enumerate(problem.outputs)}, name="fit [%]"
-    )
-    white = [whiteness(measured[i] - y[i]) for i in range(len(problem.outputs))]
-    whiteness_table = pd.DataFrame(
-        white, index=list(problem.outputs), columns=["lags_outside", "white"]
-    )
-    _intervals_trusted(table, whiteness_table, problem, notes)
+    fit, whiteness_table = _fit_and_whiteness(problem, theta)
+    if settled:
+        _intervals_trusted(table, whiteness_table, problem, notes)
+    # at the bound: the trust region stays strictly inside it, so "0" is a value a
+    # millionth of its own interval's width or less
+    at_zero = table["estimate"].to_numpy(float) <= 1e-6 * table["ci_high"].to_numpy(float)
+    bound = [n for n, z in zip(names, at_zero) if z and n in LINEAR and n in problem.free]
+    if bound:
+        notes.append(
+            f"{', '.join(bound)} is at its bound 0: the records show no tire damping; its "
+            "interval is one-sided, from 0"
+        )
     undetermined_names = [n for n, u in zip(names, undetermined) if u]
     ratios = None
     if pinned_for_scale:
@@ -625,7 +817,7 @@ def _result(problem: _Problem, solution, pinned_for_scale, notes, covariance=Non
         ratios=ratios,
         notes=notes,
         outputs=problem.outputs,
-        success=bool(solution.success),
+        success=bool(solution.success) and settled,
         nfev=int(solution.nfev),
         values=values,
     )
@@ -660,45 +852,47 @@ class _FrequencyFit:
     estimate: Transmissibility
     weights: np.ndarray  # (outputs, inputs, F): 1 / the SD of each bin's relative error
 
-    def residuals(self, theta: np.ndarray) -> np.ndarray:
+    def response(self, theta: np.ndarray) -> np.ndarray:
+        """The car's transmissibility at the estimate's bins, its gains applied."""
         values, gains, _ = self.problem.unpack(theta)
         est, dt = self.estimate, self.problem.measurement.dt
-        # a trial step to an absurd car (a mode far beyond the sampling rate) overflows
-        # exp(A dt); a huge finite misfit makes the trust region reject that step
         with np.errstate(over="ignore", invalid="ignore"):
             H = quarter_response(values, est.frequency, est.outputs, est.inputs, dt)
-        H = H * np.array([gains.get(k, 1.0) for k in est.inputs])[None, :, None]
-        e = (H - est.response) * self.weights
+        return H * np.array([gains.get(k, 1.0) for k in est.inputs])[None, :, None]
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        # a trial step to an absurd car (a mode far beyond the sampling rate) overflows
+        # exp(A dt), or the model refuses it (modes 1e7 apart): a huge finite misfit makes
+        # the trust region reject that step, where a NaN would end the fit in its SVD
+        try:
+            e = (self.response(theta) - self.estimate.response) * self.weights
+        except ValueError:
+            return np.full(2 * self.estimate.response.size, UNPHYSICAL_MISFIT)
         r = np.stack([e.real, e.imag], axis=2).ravel()
-        return np.where(np.isfinite(r), r, UNPHYSICAL_MISFIT)
+        return np.clip(
+            np.nan_to_num(r, nan=UNPHYSICAL_MISFIT), -UNPHYSICAL_MISFIT, UNPHYSICAL_MISFIT
+        )
 
 
 def _identify_frequency(measurement, arguments, resolution, band) -> Identification:
     """`identify` with ``domain='frequency'``: the car's exact response fitted to the
     records' multi-input H1 transmissibility, each bin weighted by its coherence
     (`qc_control.studies.frequency_identification`); ``arguments`` are `identify`'s
-    ``free, fixed, start, gains, outputs``."""
-    base, free_names, gain_names, outs = _setup(measurement, *arguments)
+    ``free, fixed, start, gains, outputs, entry``."""
+    problem, theta0, pinned = _problem(measurement, arguments, False)
+    outs = problem.outputs
     lo_hi = check_band(band, measurement)
     estimate = transmissibility(measurement, measurement.inputs, outs, resolution=resolution)
+    fit = _FrequencyFit(problem, estimate, bin_weights(estimate, lo_hi))
     notes = list(measurement.notes)
     notes.append(
         f"fitted in the frequency domain: the multi-input H1 transmissibility of "
         f"{', '.join(measurement.inputs)} to {', '.join(outs)}, {estimate.resolution:.4g} Hz "
         f"bins from {estimate.averages} Welch averages, {lo_hi[0]:g}–{lo_hi[1]:g} Hz, "
-        f"each bin weighted by its coherence"
+        f"each bin weighted by its coherence and by each input's own share of it"
     )
-    pinned = _scale_free(base, free_names, gain_names, measurement) and "ms" in free_names
-    fitted = tuple(n for n in free_names if not (pinned and n == "ms"))
-    rms = np.array([np.sqrt(np.mean(measurement[k] ** 2)) for k in outs])
-    if np.any(rms == 0):
-        raise ValueError(f"output {outs[int(np.argmin(rms))]!r} is zero throughout")
-    problem = _Problem(measurement, outs, base, fitted, gain_names, False, 1.0 / rms)
-    fit = _FrequencyFit(problem, estimate, bin_weights(estimate, lo_hi))
-    theta0 = np.concatenate([np.log([base[n] for n in fitted]), np.ones(len(gain_names))])
-    solution = scipy.optimize.least_squares(
-        fit.residuals, theta0, method="trf", x_scale="jac", xtol=1e-12, ftol=1e-12
-    )
+    _check_start(fit.response, theta0, problem)
+    solution = problem.solve(fit.residuals, theta0)
     if not solution.success:
         notes.append(f"the optimiser stopped: {solution.message}")
     covariance = _covariance(len(outs), np.asarray(solution.jac), solution.fun)

@@ -27,8 +27,11 @@ __all__ = [
     "SIGNAL_UNITS",
     "INPUT_LABELS",
     "UNIT_FACTORS",
+    "TIME_FACTORS",
     "rig_record",
     "RIG_COLUMNS",
+    "read_csv",
+    "row_of",
 ]
 
 #: The labels a measurement may hold and their SI units: the quarter car's
@@ -50,6 +53,8 @@ UNIT_FACTORS = {
     "m/s^2": 1.0,
     "g": 9.80665,  # standard gravity, ISO 80000-3
 }
+#: Factors from the units a time column may be in to seconds (``units={'time_ms': 'ms'}``).
+TIME_FACTORS = {"s": 1.0, "ms": 1e-3}
 #: A sample interval more than this times the median one is a gap (a lost
 #: stretch of record), not jitter: refused, since no resampling restores it.
 GAP_FACTOR = 1.5
@@ -58,13 +63,15 @@ GAP_FACTOR = 1.5
 JITTER = 1e-6
 
 
-def _where(row: int, first_row: int, t=None) -> str:
-    """``row 12`` (and its time) in the numbering of the source (a file's lines)."""
-    at = f"row {row + first_row}"
+def _where(row: int, first_row, t=None) -> str:
+    """``row 12`` (and its time) in the numbering of the source (a file's lines):
+    ``first_row`` is the first row's number, or every row's (a file whose blank and
+    comment lines were skipped between rows)."""
+    at = f"row {row_of(first_row, row)}"
     return at if t is None else f"{at} (t = {t:.6g} s)"
 
 
-def _check_time(t: np.ndarray, column: str, first_row: int) -> None:
+def _check_time(t: np.ndarray, column: str, first_row) -> None:
     if t.ndim != 1 or t.size < 3:
         raise ValueError(f"time column {column!r} must be 1-D with at least 3 samples")
     bad = np.flatnonzero(~np.isfinite(t))
@@ -89,7 +96,7 @@ def _check_time(t: np.ndarray, column: str, first_row: int) -> None:
         )
 
 
-def _check_signal(label: str, values, n: int, column: str, first_row: int, t) -> np.ndarray:
+def _check_signal(label: str, values, n: int, column: str, first_row, t) -> np.ndarray:
     if label not in SIGNAL_UNITS:
         known = ", ".join(sorted(SIGNAL_UNITS))
         raise ValueError(f"unknown label {label!r} for column {column!r}; expected one of {known}")
@@ -165,9 +172,18 @@ class Measurement:
     def __init__(self, t, units: Mapping[str, Any] | None = None, **signals):
         self._build(t, signals, units or {}, {k: k for k in signals}, "t", 0)
 
-    def _build(self, t, signals, units, columns, time_column: str, first_row: int) -> None:
+    def _build(self, t, signals, units, columns, time_column: str, first_row) -> None:
+        units = dict(units)
         t = np.asarray(t, dtype=float)
         _check_time(t, time_column, first_row)
+        if time_column in units and time_column not in signals:
+            unit = units.pop(time_column)
+            if unit not in TIME_FACTORS:
+                raise ValueError(
+                    f"unit {unit!r} of the time column {time_column!r} is not known; expected "
+                    f"one of {', '.join(TIME_FACTORS)}"
+                )
+            t = t * TIME_FACTORS[unit]
         if not signals:
             raise ValueError("a measurement needs at least one signal")
         for label in units:
@@ -192,6 +208,8 @@ class Measurement:
         self.signals = data
         self.columns = dict(columns)
         self.notes = tuple(notes)
+        #: The time column's name in the source (``t`` for arrays), for messages.
+        self.time_column = time_column
 
     @classmethod
     def from_frame(
@@ -218,9 +236,11 @@ class Measurement:
             ``{label: factor}`` applied after reading (a sign or a
             calibration), on top of ``units``.
         units : mapping, optional
-            As in `Measurement`.
-        first_row : int, default 0
-            The number the messages give the first row (a file's line).
+            As in `Measurement`; the time column's unit may be given too, by
+            its name (``{'time_ms': 'ms'}``, `TIME_FACTORS`).
+        first_row : int or array of int, default 0
+            The number the messages give the first row (a file's line), or
+            every row's.
         """
         names = list(map(str, frame.columns))
         if time not in names:
@@ -250,20 +270,9 @@ class Measurement:
         Rows in messages are the file's line numbers. See `from_frame` for
         the arguments.
         """
-        path = Path(path)
-        try:
-            frame = pd.read_csv(path, comment="#")
-        except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
-            raise ValueError(f"cannot read {str(path)!r}: {exc}") from None
-        except UnicodeDecodeError as exc:  # a logger's export in a Windows code page
-            raise ValueError(
-                f"{str(path)!r} is not UTF-8 text (byte {exc.object[exc.start]:#04x} at "
-                f"position {exc.start}): save it as 'CSV UTF-8' and read it again"
-            ) from None
-        # the header is line 1 (comment lines are counted only before it)
-        skipped = _leading_comments(path)
+        frame, first_row = read_csv(path)
         return cls.from_frame(
-            frame, time=time, columns=columns, scale=scale, units=units, first_row=2 + skipped
+            frame, time=time, columns=columns, scale=scale, units=units, first_row=first_row
         )
 
     @property
@@ -303,6 +312,7 @@ class Measurement:
         other.t = self.t[keep]
         other.signals = {k: v[keep] for k, v in self.signals.items()}
         other.columns, other.notes = dict(self.columns), self.notes
+        other.time_column = self.time_column
         return other
 
     def frame(self) -> pd.DataFrame:
@@ -361,3 +371,50 @@ def _leading_comments(path: Path) -> int:
                 break
             count += 1
     return count
+
+
+def _data_lines(path: Path) -> np.ndarray:
+    """The file's line number (1 for the first) of each data row, as ``pandas.read_csv(...,
+    comment='#')`` reads them: blank lines and ``#`` lines are skipped before the header
+    and between rows, so a row's number is not its index plus a constant."""
+    numbers = []
+    with path.open(encoding="utf-8", errors="replace") as f:
+        kept = (n for n, line in enumerate(f, start=1) if line.strip()[:1] not in ("", "#"))
+        next(kept, None)  # the header
+        numbers = list(kept)
+    return np.array(numbers, dtype=int)
+
+
+def read_csv(path) -> tuple[pd.DataFrame, Any]:
+    """A CSV file of records (a header line, then one row per sample; ``#`` lines are
+    comments) and the file's line number of each row, for messages.
+
+    Returns
+    -------
+    frame : pandas.DataFrame
+    lines : ndarray of int or int
+        Each row's line number in the file (1 for the first line); the first
+        row's number when the rows cannot be matched to lines one to one.
+
+    Raises
+    ------
+    ValueError
+        Naming the file, for one that cannot be read or is not UTF-8 text.
+    """
+    path = Path(path)
+    try:
+        frame = pd.read_csv(path, comment="#")
+    except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+        raise ValueError(f"cannot read {str(path)!r}: {exc}") from None
+    except UnicodeDecodeError as exc:  # a logger's export in a Windows code page
+        raise ValueError(
+            f"{str(path)!r} is not UTF-8 text (byte {exc.object[exc.start]:#04x} at "
+            f"position {exc.start}): save it as 'CSV UTF-8' and read it again"
+        ) from None
+    lines = _data_lines(path)
+    return frame, (lines if lines.size == len(frame) else 2 + _leading_comments(path))
+
+
+def row_of(lines, index: int) -> int:
+    """The file's line number of row ``index`` (`read_csv`'s ``lines``)."""
+    return int(lines[index]) if isinstance(lines, np.ndarray) else index + int(lines)
