@@ -37,6 +37,7 @@ from qc_control.studies.sweeps import DEFAULT_METRICS, design_grid, sweep
 # the sections kept in modules of their own, beside this script (run as a script or by
 # runpy, which puts no folder on the path)
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from explore_redraw import browser_redraw_benchmark  # noqa: E402
 from mpc_solvers import mpc_solvers_benchmark  # noqa: E402
 from shared import g, other_cores_busy, table  # noqa: E402
 
@@ -820,8 +821,8 @@ def explore_benchmark(quick: bool) -> tuple[list[str], list[list[str]]]:
     1 ms, four methods and the exact response), h moved between 1 and 0.99 ms: the
     library's part (`quick_comparison`), the convergence ladder (redone when the
     vehicle or the start changes) and the whole callback with the figures' and tables'
-    updates (Panel's models, without the browser; tests/test_explore.py times the
-    browser's part, from the key to the painted figures)."""
+    updates (Panel's models, without the browser; `browser_redraw_benchmark` times
+    the browser's part, from the key to the painted figures)."""
     from qc_control.cli.explore import explorer
     from qc_control.cli.scenario import Scenario
     from qc_control.studies.quick import error_ladder, ladder_steps, quick_comparison
@@ -989,7 +990,11 @@ def main(argv=None) -> int:
         "mpc": lambda: "\n".join(mpc_benchmark(quick)[0] + mpc_solvers_benchmark(quick)[0]),
         "identify": lambda: table(*identification_benchmark(quick)[1:3]),
         "peers": lambda: table(*work_precision_benchmark(quick)[1:]),
-        "explore": lambda: table(*explore_benchmark(quick)),
+        "explore": lambda: (
+            table(*explore_benchmark(quick))
+            + "\n\n"
+            + "\n".join(browser_redraw_benchmark(quick)[0])
+        ),
         "busy": lambda: table(*busy_benchmark(quick)[1:3]),
     }
     if args.only is not None:
@@ -1333,6 +1338,15 @@ def main(argv=None) -> int:
     md += lines
     say("\n" + table(head, rows))
     missed += late
+
+    lines, head, rows = browser_redraw_benchmark(quick)
+    md += lines
+    say("\n" + "\n".join(lines))
+    missed += [
+        f"the explorer's median redraw in the browser, {row[2]} ms {row[0]}, is over 300 ms"
+        for row in rows
+        if not quick and row[0] == "quiet" and float(row[2]) > 300
+    ]
 
     lines, head, rows, late = identification_benchmark(quick)
     md += lines

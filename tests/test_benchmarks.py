@@ -174,3 +174,14 @@ def test_the_mpc_solvers_plan_the_exact_qp_solution_on_both_cases(results):
         assert math.isfinite(float(row["solve median [ms]"]))
     share = {r["case"].split(":")[0]: float(r["ticks with the limit active"][:-1]) for r in rows}
     assert share["binding"] > share["not binding"]
+
+
+def test_the_explorers_redraw_is_timed_by_the_benchmark_or_skipped_in_one_line(results):
+    """The redraw's time left the suite (tests/test_explore.py checks what it shows):
+    the benchmark either times it in the browser (positive numbers) or says in one
+    line why it could not."""
+    section = results.split("### The explorer's redraw in the browser", 1)[1]
+    if section.lstrip().startswith("Skipped: "):
+        return
+    rows = _table(section, "median [ms]")
+    assert rows and all(float(row["median [ms]"]) > 0 for row in rows)
