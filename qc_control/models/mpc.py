@@ -71,6 +71,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import control
+import daqp  # type: ignore[import-not-found]  # a compiled module without type hints
 import numpy as np
 import osqp
 import scipy.linalg
@@ -477,8 +478,6 @@ class _DAQPSolver:
     """
 
     def __init__(self, P, rows, lo, hi, N):
-        import daqp  # type: ignore[import-not-found]
-
         self._model = daqp.Model()
         n = P.shape[0]
         self._model.setup(P, np.zeros(n), np.ascontiguousarray(rows), hi, lo)
