@@ -177,8 +177,8 @@ def test_the_measured_problem_matches_python_control_and_an_independent_solve(ca
     """Never above solve_optimal_trajectory's cost (1e-9 relative allows for
     rounding only: SLSQP started from the BVLS optimum ends within 1e-15 of it),
     and equal to the bounded least squares optimum to 1e-6 relative (lsq_linear's
-    BVLS is an exact active-set method; OSQP's polished solution lands on the same
-    set)."""
+    BVLS is an exact active-set method, and so is DAQP, the default solver: both
+    end on the same active set's equations)."""
     mpc = qc.mpc_controller(car, DT, N, Q=Q, R=R, limits={"fa": LIMIT})
     sol = mpc.solve(x0)
     assert sol.status == "solved"
@@ -190,8 +190,8 @@ def test_the_measured_problem_matches_python_control_and_an_independent_solve(ca
     assert sol.cost <= pc.cost * (1 + 1e-9)
     ref_cost = float(np.sum((A @ ref.x - b) ** 2))
     assert sol.cost == pytest.approx(ref_cost, rel=1e-6)
-    # the plan itself to 1e-6 N (issue 40; measured 3e-12 to 1.2e-11 N: OSQP's
-    # polished solution solves the same active set's equations)
+    # the plan itself to 1e-6 N (issue 40; measured 3e-12 to 1.2e-11 N: the
+    # solver solves the same active set's equations)
     np.testing.assert_allclose(sol.moves, ref.x, rtol=0, atol=1e-6)
 
 
