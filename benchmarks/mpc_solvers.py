@@ -47,7 +47,7 @@ def _osqp_before():
 #: label -> (solver, whether OSQP has its earlier settings)
 SOLVERS = {
     "OSQP, as before (ρ 0.1 adaptive, 20,000 iterations)": ("osqp", True),
-    "OSQP, tuned (ρ 1 fixed, shifted warm start)": ("osqp", False),
+    "OSQP, tuned (ρ from 1, shifted warm start)": ("osqp", False),
     "DAQP (dual active set)": ("daqp", False),
 }
 

@@ -245,16 +245,21 @@ def _run(car, zr, T, **kwargs):
     return mpc, loop, qc.input_output_response(loop.system, T, zr)
 
 
-def test_the_force_limit_holds_on_every_tick_and_the_travel_penalty_is_logged(car):
+@pytest.mark.parametrize("solver", SOLVERS)
+@pytest.mark.parametrize("penalty", [None, (1e6, 0.0)])
+def test_the_force_limit_holds_on_every_tick_and_the_travel_penalty_is_logged(car, solver, penalty):
     """A 5 cm bump with |fa| <= 500 N and a 1 cm travel limit the car cannot
     keep: every move within the limit, and the ticks whose plan needed the
     travel slack are in the log. Elsewhere the car rides the limit: between the
     ticks (where the plan has no constraint) it passes it by at most 1 µm
     (measured 6e-8 m), and by more only within 0.02 s (two ticks: the
-    plan's prediction of the next tick) of a logged tick."""
+    plan's prediction of the next tick) of a logged tick. With each solver, and a
+    penalty linear only (no quadratic term: a singular Hessian in the slacks),
+    every tick's QP is solved (an OSQP with a fixed ρ failed on some)."""
     T = np.arange(0, 301) * 0.005
     zr = qc.road.bump(T, height=0.05)
-    mpc, loop, r = _run(car, zr, T, limits={"fa": LIMIT, "susp_travel": 0.01})
+    extra = {"solver": solver} if penalty is None else {"solver": solver, "travel_penalty": penalty}
+    mpc, loop, r = _run(car, zr, T, limits={"fa": LIMIT, "susp_travel": 0.01}, **extra)
     assert np.max(np.abs(r.moves)) <= LIMIT
     assert mpc.log.penalty_ticks and not mpc.log.failures
     travel = np.abs(r.outputs[r.output_labels.index("susp_travel")])

@@ -102,19 +102,18 @@ TRAVEL_PENALTY = (1e6, 1e8)
 #: already the forces in units of the limit (so a tolerance of 1e-5 is 3 mN at
 #: 300 N, and the force is good to far better once polishing has solved the
 #: active set's equations: measured 3e-12 N against an exact QP solution).
-#: A fixed ρ = 1 suits a QP whose every constraint is a bound of order 1: on
-#: the binding case (benchmarks/run.py) it converges in 25 iterations on every
-#: tick, where the default adaptive ρ = 0.1 took 25-75, and it never
-#: refactors the KKT matrix inside a solve. Ruiz scaling stays on: it is done
-#: once at setup. 4,000 iterations bound a solve that would not converge.
+#: ρ starts at 1, the size of a bound in these units, not OSQP's 0.1: on the
+#: binding case (benchmarks/run.py) every tick then converges in 25 iterations
+#: (one termination check), where ρ 0.1 took 25-75. ρ stays adaptive: fixed,
+#: the soft travel rows (another scale) failed to converge in 4,000 iterations
+#: on some ticks of a bump. Ruiz scaling stays on: it is done once, at setup.
 _OSQP_SETTINGS = dict(
     eps_abs=1e-5,
     eps_rel=1e-5,
     rho=1.0,
-    adaptive_rho=False,
     polishing=True,
     polish_refine_iter=3,
-    max_iter=4000,
+    max_iter=20000,
     verbose=False,
 )
 #: The QP solvers `mpc_controller` offers, the default first.
@@ -497,7 +496,7 @@ class _OSQPSolver:
     dense condensed QP (`_OSQP_SETTINGS`).
 
     Set up once with the constant ``P`` and constraint matrix, its KKT
-    matrix factored once (a fixed ρ: no refactoring within a solve). Each QP
+    matrix factored once (again only when OSQP adapts ρ). Each QP
     tick starts from the last plan and its multipliers shifted by one tick
     (``u_1 … u_{N-1}, u_{N-1}``: the plan the last tick expected to apply
     now), the standard warm start of MPC; a tick whose unconstrained plan
