@@ -18,6 +18,7 @@ fewer constraints), and a tick where it does not is counted apart.
 from __future__ import annotations
 
 import contextlib
+import os
 
 import numpy as np
 import scipy.linalg
@@ -161,6 +162,7 @@ def mpc_solvers_benchmark(quick: bool):
                             "busy" if busy else "quiet",
                             label,
                             g(float(np.median(ms))),
+                            g(float(np.percentile(ms, 99))),
                             g(float(ms.max())),
                             g(loops[label].wall),
                             f"{active:.0%}",
@@ -180,6 +182,7 @@ def mpc_solvers_benchmark(quick: bool):
         "machine",
         "solver",
         "solve median [ms]",
+        "solve 99th percentile [ms]",
         "solve worst [ms]",
         f"{t_end:g} s loop [s]",
         "ticks with the limit active",
@@ -224,4 +227,19 @@ def _section(head, rows, notes, t_end: float, rounds: int) -> list[str]:
         "",
         *[f"{note}." for note in notes],
         *([""] if notes else []),
+        *_load_line(),
+    ]
+
+
+def _load_line() -> list[str]:
+    """The machine's load average when the section ended (POSIX), so that a reader can
+    tell a quiet machine from a shared one: a worst solve is one tick preempted."""
+    if not hasattr(os, "getloadavg"):
+        return []
+    one, five, _ = os.getloadavg()
+    return [
+        f"Load average at the end of this section: {one:.1f} (1 min), {five:.1f} (5 min) "
+        f"on {os.cpu_count()} cores; 'quiet' is quiet only for this benchmark's own "
+        "processes.",
+        "",
     ]

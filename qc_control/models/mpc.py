@@ -42,11 +42,13 @@ splitting solver for quadratic programs", Math. Prog. Comp. 12, 2020), tuned
 for this QP. Either is set up once with the constant ``H`` and constraint
 matrix; each tick updates the linear term and the bounds and starts from the
 last tick (DAQP from its active set, OSQP from its plan and multipliers
-shifted by one tick). Both end on the exact solution of the optimal active
-set's equations, so the plans agree with an exact QP solution to rounding
-(tests/test_mpc.py: to 1e-6 N against bounded least squares); DAQP is the
-faster where the limit binds (benchmarks/RESULTS.md, the solvers side by
-side). A tick whose
+shifted by one tick). DAQP ends on the exact solution of the optimal active
+set's equations, so its plans agree with an exact QP solution to rounding
+(tests/test_mpc.py: to 1e-6 N against bounded least squares); OSQP's do when
+its polishing succeeds, which it did on every tick of a binding force limit
+but not on every tick with the soft travel limit (plans up to 0.5 N off:
+benchmarks/RESULTS.md, the solvers side by side, where DAQP is also the
+faster). A tick whose
 unconstrained plan already keeps every limit needs no QP: that plan is the
 convex QP's optimum (with no slack), exactly.
 
@@ -101,7 +103,9 @@ TRAVEL_PENALTY = (1e6, 1e8)
 #: OSQP tuned for the condensed QP (``solver='osqp'``), whose variables are
 #: already the forces in units of the limit (so a tolerance of 1e-5 is 3 mN at
 #: 300 N, and the force is good to far better once polishing has solved the
-#: active set's equations: measured 3e-12 N against an exact QP solution).
+#: active set's equations: measured 3e-12 N against an exact QP solution with a
+#: force limit alone; with the soft travel limit polishing does not always
+#: succeed, and plans were up to 0.5 N off).
 #: ρ starts at 1, the size of a bound in these units, not OSQP's 0.1: on the
 #: binding case (benchmarks/run.py) every tick then converges in 25 iterations
 #: (one termination check), where ρ 0.1 took 25-75. ρ stays adaptive: fixed,
@@ -647,8 +651,9 @@ def mpc_controller(
     solver : {'daqp', 'osqp'}
         The QP solver used when there are limits: DAQP, a dual active-set
         method made for MPC (the default: on the benchmark's binding case a
-        median solve of 0.02 ms against OSQP's 0.16 ms, the same plans to
-        1e-11 N), or OSQP tuned for this QP (`_OSQP_SETTINGS`).
+        median tick of 0.06 ms against OSQP's 0.25-0.37 ms, and plans equal
+        to an exact QP solution to 1e-11 N), or OSQP tuned for this QP
+        (`_OSQP_SETTINGS`).
     name : str
 
     Returns
