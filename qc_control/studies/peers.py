@@ -21,7 +21,8 @@ costs and how far it lands from the reference:
 - **wall time**: the median over ``repeats`` interleaved rounds, every run of
   the study timed once per round in turn (`qc_control.studies.timing`, the
   one timing method of the studies and reports), with the rounds' lowest and
-  highest beside it (``time min``, ``time max``) and the CPU time.
+  highest beside it (``time_low``, ``time_high``) and the CPU time
+  (``cpu_time``), the columns of the comparison's convergence study.
 
 ``"control"`` is ``control.input_output_response`` at its defaults (RK45,
 rtol 1e-3, atol 1e-6), the call a python-control user makes, run once. An
@@ -256,11 +257,12 @@ def timed_in_rounds(
 
 
 def _time_columns(timing: Timing) -> dict:
+    """The time columns, named as the comparison's convergence study names them."""
     return {
         "time": timing.wall,
-        "time min": timing.low,
-        "time max": timing.high,
-        "CPU time": timing.cpu,
+        "time_low": timing.low,
+        "time_high": timing.high,
+        "cpu_time": timing.cpu,
     }
 
 
