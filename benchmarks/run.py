@@ -19,7 +19,6 @@ import datetime as dt
 import os
 import platform
 import statistics
-import subprocess
 import sys
 import time
 import tracemalloc
@@ -34,6 +33,13 @@ import qc_control as qc
 from qc_control.numerics import threads
 from qc_control.studies.compare import best_time
 from qc_control.studies.sweeps import DEFAULT_METRICS, design_grid, sweep
+
+# the sections kept in modules of their own, beside this script (run as a script or by
+# runpy, which puts no folder on the path)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from explore_redraw import browser_redraw_benchmark  # noqa: E402
+from mpc_solvers import mpc_solvers_benchmark  # noqa: E402
+from shared import g, other_cores_busy, table  # noqa: E402
 
 X0 = np.array([0.0, 0.0, 0.05, 0.0])
 
@@ -453,20 +459,6 @@ def loop_comparison(f, T, repeats: int):
     return head, rows, text
 
 
-def table(headers, rows) -> str:
-    """A Markdown table; a '|' inside a cell is escaped."""
-
-    def line(cells):
-        return "| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |"
-
-    out = [line(headers), "|" + "|".join("---" for _ in headers) + "|"]
-    return "\n".join(out + [line(r) for r in rows])
-
-
-def g(x, digits=3):
-    return f"{x:.{digits}g}"
-
-
 def car_with_skyhook():
     """The seed car (StateSpace, body and wheel velocities as extra outputs) under a
     clipped skyhook (Karnopp 1974, ``control.nlsys``), joined by ``control.interconnect``."""
@@ -639,7 +631,7 @@ def mpc_benchmark(quick: bool) -> tuple[list[str], list[str], list[list[str]]]:
 
     The measured problem: the seed car with the force as input, ZOH at 10 ms,
     horizon 20, Q = diag(1, 1, 1e4, 1e4), R = 1e-6, |fa| <= 500 N, from a few
-    initial states; ``qc.mpc_controller(...).solve`` (condensed QP, OSQP)
+    initial states; ``qc.mpc_controller(...).solve`` (condensed QP, DAQP)
     against ``control.optimal.solve_optimal_trajectory`` (SLSQP) on the same
     discrete system (``control.c2d``), wall times side by side, and both
     optimal costs. Quick mode: horizon 5 (python-control's solve takes
@@ -696,7 +688,7 @@ def mpc_benchmark(quick: bool) -> tuple[list[str], list[str], list[list[str]]]:
         "### Model predictive control (issue 25)",
         "",
         f"One control step of the measured problem (horizon {horizon}, ZOH 10 ms, "
-        "Q = diag(1, 1, 1e4, 1e4), R = 1e-6, |fa| ≤ 500 N): qc's condensed QP (OSQP, "
+        "Q = diag(1, 1, 1e4, 1e4), R = 1e-6, |fa| ≤ 500 N): qc's condensed QP (DAQP, "
         "median wall time of 20 warm solves) against python-control's "
         "solve_optimal_trajectory (one call), and both optimal costs.",
         "",
@@ -709,32 +701,7 @@ def mpc_benchmark(quick: bool) -> tuple[list[str], list[str], list[list[str]]]:
         "",
     ]
     rows.append(["closed loop, preview 0.5 s", g(t_loop * 1e3), "", "", "", ""])
-    md += _binding_mpc(T, t_end)
     return md, head, rows
-
-
-def _binding_mpc(T, t_end: float) -> list[str]:
-    """Issue 40: the loop above with MATLAB's qcar car and |fa| <= 300 N, where the
-    limit binds on many ticks: its time, solve times and the share of ticks at the limit."""
-    params = qc.QuarterCarParams(ms=300.0, mu=60.0, ks=16000.0, cs=1000.0, ku=190000.0)
-    car = qc.quarter_car_model(params, road=True, actuator=True)
-    zr = qc.road.iso8608(T, "C", speed=20.0, seed=0)
-    law = qc.mpc_controller(car, 0.01, 50, limits={"fa": 300.0}, preview=0.5)
-    loop = qc.closed_loop(car, law)
-    start = time.perf_counter()
-    r = qc.input_output_response(loop.system, T, zr)
-    t_loop = time.perf_counter() - start
-    solves = np.asarray(law.log.solve_times) * 1e3
-    fa = np.asarray(r.outputs)[list(r.output_labels).index("fa")]
-    share = float(np.mean(np.abs(fa) >= 300.0 * (1 - 1e-9)))
-    return [
-        f"Where the limit binds: MATLAB's qcar car (ms 300, mu 60, ks 16,000, cs 1,000, "
-        f"ku 190,000), |fa| ≤ 300 N, the same road and preview: the {t_end:g} s loop "
-        f"{g(t_loop)} s (target < 1 s), the force at its limit on {share:.0%} of the "
-        f"samples; solve per tick median {g(float(np.median(solves)))} ms, worst "
-        f"{g(float(solves.max()))} ms (target < 5 ms).",
-        "",
-    ]
 
 
 def identification_benchmark(quick: bool):
@@ -854,8 +821,8 @@ def explore_benchmark(quick: bool) -> tuple[list[str], list[list[str]]]:
     1 ms, four methods and the exact response), h moved between 1 and 0.99 ms: the
     library's part (`quick_comparison`), the convergence ladder (redone when the
     vehicle or the start changes) and the whole callback with the figures' and tables'
-    updates (Panel's models, without the browser; tests/test_explore.py times the
-    browser's part, from the key to the painted figures)."""
+    updates (Panel's models, without the browser; `browser_redraw_benchmark` times
+    the browser's part, from the key to the painted figures)."""
     from qc_control.cli.explore import explorer
     from qc_control.cli.scenario import Scenario
     from qc_control.studies.quick import error_ladder, ladder_steps, quick_comparison
@@ -885,23 +852,6 @@ def explore_benchmark(quick: bool) -> tuple[list[str], list[list[str]]]:
         for name, fn in parts.items()
     ]
     return head, rows
-
-
-@contextlib.contextmanager
-def other_cores_busy(busy: bool):
-    """One CPU-bound process on each core but this one (at least one), as a
-    laptop with a browser and a build open; nothing when ``busy`` is false."""
-    hogs = []
-    if busy:
-        spin = [sys.executable, "-c", "while True: pass"]
-        hogs = [subprocess.Popen(spin) for _ in range(max(1, (os.cpu_count() or 2) - 1))]
-        time.sleep(0.3)  # every hog running before the first timed call
-    try:
-        yield
-    finally:
-        for hog in hogs:
-            hog.kill()
-            hog.wait()
 
 
 @contextlib.contextmanager
@@ -1037,10 +987,14 @@ def main(argv=None) -> int:
     WARMUP = not quick
     alone = {
         "interconnect": lambda: table(*interconnect_benchmark(quick)[1:]),
-        "mpc": lambda: "\n".join(mpc_benchmark(quick)[0]),
+        "mpc": lambda: "\n".join(mpc_benchmark(quick)[0] + mpc_solvers_benchmark(quick)[0]),
         "identify": lambda: table(*identification_benchmark(quick)[1:3]),
         "peers": lambda: table(*work_precision_benchmark(quick)[1:]),
-        "explore": lambda: table(*explore_benchmark(quick)),
+        "explore": lambda: (
+            table(*explore_benchmark(quick))
+            + "\n\n"
+            + "\n".join(browser_redraw_benchmark(quick)[0])
+        ),
         "busy": lambda: table(*busy_benchmark(quick)[1:3]),
     }
     if args.only is not None:
@@ -1375,11 +1329,24 @@ def main(argv=None) -> int:
         for row in rows[:-1]
         if not quick and float(row[3]) < 1000
     ]
+    lines, head, rows, late = mpc_solvers_benchmark(quick)
+    md += lines
+    say("\n" + table(head, rows))
+    missed += late
 
     lines, head, rows, late = busy_benchmark(quick)
     md += lines
     say("\n" + table(head, rows))
     missed += late
+
+    lines, head, rows = browser_redraw_benchmark(quick)
+    md += lines
+    say("\n" + "\n".join(lines))
+    missed += [
+        f"the explorer's median redraw in the browser, {row[2]} ms {row[0]}, is over 300 ms"
+        for row in rows
+        if not quick and row[0] == "quiet" and float(row[2]) > 300
+    ]
 
     lines, head, rows, late = identification_benchmark(quick)
     md += lines

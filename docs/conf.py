@@ -118,6 +118,18 @@ os.environ["PYTHONWARNINGS"] = ",".join(
     filter(None, [os.environ.get("PYTHONWARNINGS"), "ignore:IProgress not found"])
 )
 
+# The kernels that run the pages talk to the build over IPC (Unix sockets in the
+# user's Jupyter runtime folder) rather than TCP on 127.0.0.1: ipykernel 7 logs
+# "Kernel is running over TCP without encryption" once per kernel started (14 in a
+# build), and names IPC as the remedy. The kernel and the build are one user's
+# processes on one machine, which IPC keeps to that user; no warning is filtered, so
+# any other the kernels log still shows. ZeroMQ has no IPC transport on Windows:
+# there the kernels stay on TCP, and the message with them.
+if os.name == "posix":
+    from jupyter_client.manager import KernelManager
+
+    KernelManager.transport.default_value = "ipc"  # the trait's default, read per kernel
+
 # The guide's pages are MyST notebooks too: every code cell runs in the build, so a
 # page that drifts from the code fails it (nb_execution_raise_on_error).
 nb_execution_mode = "force"

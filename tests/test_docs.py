@@ -9,8 +9,11 @@ the other in one kernel, each with a fresh namespace and folder
 (conftest's ``guide_in_one_kernel``), where ``make docs`` gives each page a
 kernel of its own; the build renders the outputs of that run."""
 
+import os
 import pkgutil
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -123,6 +126,37 @@ def test_the_shared_kernel_gives_each_page_a_fresh_namespace_and_folder(tmp_path
         if record.uri.endswith(("d.md", "e.md")):
             (cell,) = db.get_cache_bundle(record.pk).nb.cells
             assert "UserWarning: from a module" in str(cell.outputs), (record.uri, cell.outputs)
+
+
+#: docs/conf.py, then a kernel started as myst-nb starts one (nbclient), running a
+#: cell that warns: what the kernel logged to the build's stderr, and the cell's output.
+_KERNEL_UNDER_CONF = """
+import runpy, sys, nbformat
+from nbclient import NotebookClient
+runpy.run_path(sys.argv[1])
+nb = nbformat.v4.new_notebook()
+nb.cells.append(nbformat.v4.new_code_cell("import warnings; warnings.warn('a cell warns')"))
+NotebookClient(nb, timeout=120).execute()
+print(nb.cells[0].outputs[0]["text"])
+"""
+
+
+@pytest.mark.slow  # docs/conf.py imported and one kernel started: about 3 s
+@pytest.mark.skipif(os.name != "posix", reason="ZeroMQ has no IPC transport on Windows")
+def test_the_builds_kernels_log_no_tcp_warning_and_keep_every_other(tmp_path):
+    """Issue 39 item 12: each kernel of the build logged "Kernel is running over TCP
+    without encryption" (14 in a build). Under docs/conf.py a kernel talks over IPC
+    and logs nothing of the kind, and a warning raised in a cell still shows."""
+    run = subprocess.run(
+        [sys.executable, "-c", _KERNEL_UNDER_CONF, str(DOCS / "conf.py")],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=300,
+        check=True,
+    )
+    assert "without encryption" not in run.stderr, run.stderr
+    assert "UserWarning: a cell warns" in run.stdout
 
 
 #: Pages with formulas: a guide page with display and inline math ($$ and $),

@@ -18,7 +18,11 @@ costs and how far it lands from the reference:
   side itself, so it also holds the few columns scipy's ``num_jac``
   evaluates again with a larger increment (a Jacobian can cost a little
   more than ``n``); it is never below ``nfev + njev · n``, which is checked;
-- **wall time**: the best of ``repeats`` runs.
+- **wall time**: the median over ``repeats`` interleaved rounds, every run of
+  the study timed once per round in turn (`qc_control.studies.timing`, the
+  one timing method of the studies and reports), with the rounds' lowest and
+  highest beside it (``time_low``, ``time_high``) and the CPU time
+  (``cpu_time``), the columns of the comparison's convergence study.
 
 ``"control"`` is ``control.input_output_response`` at its defaults (RK45,
 rtol 1e-3, atol 1e-6), the call a python-control user makes, run once. An
@@ -46,6 +50,7 @@ from ..numerics.lti import is_nonlinear_system
 from ..numerics.methods import ButcherTableau
 from ..numerics.sampled import linear_input
 from ..responses.timeresp import forced_response, initial_response
+from .timing import Timing, interleaved_times
 
 __all__ = [
     "SOLVERS",
@@ -227,6 +232,40 @@ class _Problem:
     scale: np.ndarray  # max |x_i| of the reference per state, for atol
 
 
+def timed_in_rounds(
+    runs: dict, repeats: int, progress: Callable[[str], None] | None = None
+) -> tuple[dict, dict[Any, Timing]]:
+    """Each run's result and its `Timing` over ``repeats`` interleaved rounds
+    (`interleaved_times`: every run once per round, in turns, so a drift of the
+    machine's load reaches all alike). The timed calls give the results (no
+    extra untimed call: a peer's run can take seconds); ``progress`` hears of
+    each run's first call, keyed by its key's words."""
+    results: dict = {}
+
+    def keeping(key, run):
+        def call():
+            if progress and key not in results:
+                progress(key if isinstance(key, str) else ": ".join(map(str, key)))
+            results[key] = run()
+
+        return call
+
+    timings = interleaved_times(
+        {key: keeping(key, run) for key, run in runs.items()}, max(repeats, 1), warmup=False
+    )
+    return results, timings
+
+
+def _time_columns(timing: Timing) -> dict:
+    """The time columns, named as the comparison's convergence study names them."""
+    return {
+        "time": timing.wall,
+        "time_low": timing.low,
+        "time_high": timing.high,
+        "cpu_time": timing.cpu,
+    }
+
+
 def best_of(run: Callable[[], Any], repeats: int) -> tuple[Any, float]:
     """The run's result and its best wall time [s] over ``repeats`` runs."""
     best, result = math.inf, None
@@ -255,42 +294,47 @@ def solver_runs(
     where it did not finish).
     """
     f = peer_derivative(problem.sys, problem.T, problem.U)
-    rows: list[dict] = []
-    loosest: dict[str, np.ndarray | None] = {}
-    run: Callable[[], tuple]
+    runs: dict[tuple[str, str], Callable[[], tuple]] = {}
+    atols: dict[tuple[str, str], np.ndarray] = {}
     for solver in check_solvers(solvers):
         ladder = [CONTROL_DEFAULTS[0]] if solver == "control" else list(check_rtols(rtols))
         for rtol in ladder:
-            if progress:
-                progress(f"{solver}: rtol {rtol:g}")
+            key = (solver, f"rtol {rtol!r}")
             if solver == "control":
-                atol = np.full(problem.X0.size, CONTROL_DEFAULTS[1])
-                run = lambda: control_run(problem.sys, f, problem.T, problem.X0, budget)  # noqa: E731
-            else:
-                atol = _atol(rtol, problem.scale)
-                run = functools.partial(
-                    ivp_run, solver, f, problem.T, problem.X0, rtol, atol, budget
+                atols[key] = np.full(problem.X0.size, CONTROL_DEFAULTS[1])
+                runs[key] = functools.partial(
+                    control_run, problem.sys, f, problem.T, problem.X0, budget
                 )
-            (x, evaluations, nfev, njev, message, ok), seconds = best_of(run, repeats)
-            y = outputs_of(problem.sys, x, problem.T, problem.U)
-            loosest.setdefault(solver, y)
-            rows.append(
-                {
-                    "kind": "solver",
-                    "name": solver,
-                    "rtol": rtol,
-                    "atol": float(np.max(atol)),
-                    "h": math.nan,
-                    "error": _error(None if y is None else y[problem.body], problem.reference),
-                    "evaluations": evaluations,
-                    "nfev": nfev,
-                    "njev": njev,
-                    "time": seconds,
-                    "success": ok,
-                    "message": str(message),
-                    "default": solver == "control",
-                }
-            )
+            else:
+                atols[key] = _atol(rtol, problem.scale)
+                runs[key] = functools.partial(
+                    ivp_run, solver, f, problem.T, problem.X0, rtol, atols[key], budget
+                )
+    results, timings = timed_in_rounds(runs, repeats, progress)
+    rows: list[dict] = []
+    loosest: dict[str, np.ndarray | None] = {}
+    for key in runs:
+        solver, rtol = key[0], float(key[1].split()[1])  # the rtol's repr, exactly
+        x, evaluations, nfev, njev, message, ok = results[key]
+        y = outputs_of(problem.sys, x, problem.T, problem.U)
+        loosest.setdefault(solver, y)
+        rows.append(
+            {
+                "kind": "solver",
+                "name": solver,
+                "rtol": CONTROL_DEFAULTS[0] if solver == "control" else rtol,
+                "atol": float(np.max(atols[key])),
+                "h": math.nan,
+                "error": _error(None if y is None else y[problem.body], problem.reference),
+                "evaluations": evaluations,
+                "nfev": nfev,
+                "njev": njev,
+                **_time_columns(timings[key]),
+                "success": ok,
+                "message": str(message),
+                "default": solver == "control",
+            }
+        )
     return pd.DataFrame(rows), loosest
 
 
@@ -310,40 +354,42 @@ def adaptive_runs(
     the fixed-step ladder.
     """
     sys, T, X0, U = problem.sys, problem.T, problem.X0, problem.U
-    rows = []
+    runs, atols = {}, {}
     for tab in methods:
         if not getattr(tab, "embedded", False):
             continue
         for rtol in check_rtols(rtols):
-            if progress:
-                progress(f"{tab.name}: rtol {rtol:g} (step-size control)")
-            atol = _atol(rtol, problem.scale)
+            key = (tab.name, f"rtol {rtol!r} (step-size control)")
+            atols[key] = atol = _atol(rtol, problem.scale)
 
             def run(tab=tab, rtol=rtol, atol=atol):
                 if U is None:
                     return initial_response(sys, T, X0, method=tab, rtol=rtol, atol=atol)
                 return forced_response(sys, T, U, X0, method=tab, rtol=rtol, atol=atol)
 
-            resp, seconds = best_of(run, repeats)
-            y = np.asarray(resp.outputs).reshape(sys.noutputs, -1)[problem.body]
-            rows.append(
-                {
-                    "kind": "adaptive",
-                    "name": tab.name,
-                    "rtol": rtol,
-                    "atol": float(np.max(atol)),
-                    "h": math.nan,
-                    "error": _error(y if y.size == T.size else None, problem.reference),
-                    "evaluations": int(resp.nfev),
-                    "nfev": int(resp.nfev),
-                    "njev": 0,
-                    "time": seconds,
-                    "success": bool(getattr(resp, "success", True)),
-                    "message": f"{getattr(resp, 'n_accepted', '?')} steps accepted, "
-                    f"{getattr(resp, 'n_rejected', '?')} rejected",
-                    "default": False,
-                }
-            )
+            runs[key] = run
+    results, timings = timed_in_rounds(runs, repeats, progress)
+    rows = []
+    for key, resp in results.items():
+        y = np.asarray(resp.outputs).reshape(sys.noutputs, -1)[problem.body]
+        rows.append(
+            {
+                "kind": "adaptive",
+                "name": key[0],
+                "rtol": float(key[1].split()[1]),  # the rtol's repr, exactly
+                "atol": float(np.max(atols[key])),
+                "h": math.nan,
+                "error": _error(y if y.size == T.size else None, problem.reference),
+                "evaluations": int(resp.nfev),
+                "nfev": int(resp.nfev),
+                "njev": 0,
+                **_time_columns(timings[key]),
+                "success": bool(getattr(resp, "success", True)),
+                "message": f"{getattr(resp, 'n_accepted', '?')} steps accepted, "
+                f"{getattr(resp, 'n_rejected', '?')} rejected",
+                "default": False,
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -468,7 +514,7 @@ def work_precision(
     rtols : sequence of float
         The tolerance ladder, default 1e-3 ... 1e-10.
     repeats : int
-        Each peer's time is the best of this many runs.
+        The interleaved rounds each peer's run is timed in (its time the median).
     """
     T = np.asarray(T, dtype=float)
     scale = state_scale(np.asarray(reference.states, dtype=float).reshape(np.size(X0), -1))
