@@ -50,20 +50,25 @@ class ParameterError(ValueError):
         What the value must be (``"a finite number > 0 N/m"``).
     """
 
-    def __init__(self, name: str, value: Any, expected: str, *, description: str = ""):
+    def __init__(
+        self, name: str, value: Any, expected: str, *, description: str = "", message: str = ""
+    ):
         self.name = name
         self.value = value
         self.expected = expected
         self.description = description
         what = f"{name} ({description})" if description else name
-        super().__init__(f"{what} must be {expected}, got {value!r}")
+        # ``message`` words a refusal in its domain's terms ("unknown method
+        # 'rk5'; known methods are ..."); it still names the value and what
+        # was expected, and ``.name``/``.value`` say the same to a program
+        super().__init__(message or f"{what} must be {expected}, got {value!r}")
 
     def __reduce__(self):  # errors cross process boundaries in sweeps
-        return (_rebuild, (self.name, self.value, self.expected, self.description))
+        return (_rebuild, (self.name, self.value, self.expected, self.description, str(self)))
 
 
-def _rebuild(name, value, expected, description) -> ParameterError:
-    return ParameterError(name, value, expected, description=description)
+def _rebuild(name, value, expected, description, message="") -> ParameterError:
+    return ParameterError(name, value, expected, description=description, message=message)
 
 
 def _real(value) -> bool:

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .adaptive import SCIPY_CONTROLLER, StepController, adaptive_solve, check_embedded
+from .checks import ParameterError
 from .limits import check_memory
 from .messages import show
 from .methods import ButcherTableau, get_method
@@ -354,9 +355,9 @@ def check_run_steps(intervals: int, substeps: int) -> None:
 
 
 def check_substeps(substeps) -> int:
-    """``substeps`` as an int >= 1, or a ValueError naming it."""
+    """``substeps`` as an int >= 1, or a `ParameterError` naming it."""
     if isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
-        raise ValueError(f"substeps must be a positive integer, got {substeps!r}")
+        raise ParameterError("substeps", substeps, "a positive integer")
     return int(substeps)
 
 

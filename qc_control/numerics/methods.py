@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from .checks import ParameterError
 from .messages import show
 from .order_conditions import MAX_ORDER, check_order
 
@@ -407,8 +408,8 @@ def get_method(method) -> ButcherTableau:
 
     Raises
     ------
-    ValueError
-        For an unknown name; the message lists the known ones.
+    qc_control.ParameterError
+        For an unknown name (a ValueError); the message lists the known ones.
     TypeError
         For anything that is neither a string nor a `ButcherTableau`.
     """
@@ -418,9 +419,13 @@ def get_method(method) -> ButcherTableau:
         try:
             return TABLEAUS[method.lower()]
         except KeyError:
-            raise ValueError(
-                f"unknown method {method!r}; known methods are "
-                f"{', '.join(TABLEAUS)} (or pass a ButcherTableau)"
+            known = ", ".join(TABLEAUS)
+            raise ParameterError(
+                "method",
+                method,
+                f"one of {known} or a ButcherTableau",
+                message=f"unknown method {method!r}; known methods are {known} "
+                "(or pass a ButcherTableau)",
             ) from None
     raise TypeError(
         f"method must be a name in METHODS or TABLEAUS ({', '.join(TABLEAUS)}) or a "

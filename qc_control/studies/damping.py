@@ -429,8 +429,11 @@ def pareto_front(
     q = road_intensity(road, stacklevel=2)  # read once: every design sees the same number
     objectives = list(objectives)
     if len(objectives) < 2 or any(o not in OBJECTIVES for o in objectives):
-        raise ValueError(
-            f"objectives must be two or more of {sorted(OBJECTIVES)}, got {objectives!r}"
+        raise ParameterError(
+            "objectives",
+            objectives,
+            f"two or more of {sorted(OBJECTIVES)}",
+            message=f"objectives must be two or more of {sorted(OBJECTIVES)}, got {objectives!r}",
         )
     if vary is None:
         critical = 2 * math.sqrt(p.ks * p.ms)

@@ -376,13 +376,23 @@ class Identification:
         return "\n".join(lines)
 
 
-def _as_names(values: Iterable[str] | None, what: str, allowed: Sequence[str]) -> tuple[str, ...]:
+def _as_names(
+    values: Iterable[str] | None, what: str, allowed: Sequence[str], argument: str
+) -> tuple[str, ...]:
+    """``values`` as names among ``allowed``, each once; a refusal names ``argument``."""
     names = tuple(values or ())
     for i, name in enumerate(names):
         if name not in allowed:
-            raise ValueError(f"{what} {name!r} is not one of {', '.join(allowed)}")
+            raise ParameterError(
+                argument,
+                name,
+                f"one of {', '.join(allowed)}",
+                message=f"{what} {name!r} is not one of {', '.join(allowed)}",
+            )
         if name in names[:i]:
-            raise ValueError(f"{what} {name!r} is given twice")
+            raise ParameterError(
+                argument, name, "each name once", message=f"{what} {name!r} is given twice"
+            )
     return names
 
 
@@ -407,18 +417,21 @@ def _setup(
         raise ValueError("the measurement has no input: record the road zr or the force fa")
     fixed_values = _positive_values(fixed, "fixed")
     start_values = _positive_values(start, "start")
-    free_names = _as_names(DEFAULT_FREE if free is None else free, "free parameter", PHYSICAL)
+    free_names = _as_names(
+        DEFAULT_FREE if free is None else free, "free parameter", PHYSICAL, "free"
+    )
     both = [n for n in free_names if n in fixed_values] if free is not None else []
     if both:
         raise ValueError(f"{both[0]!r} is both free and fixed: give it in one of them")
     free_names = tuple(n for n in free_names if n not in fixed_values)
-    gain_names = _as_names(gains, "gain", measurement.inputs)
+    gain_names = _as_names(gains, "gain", measurement.inputs, "gains")
     if not free_names and not gain_names:
         raise ValueError("nothing to fit: every parameter is fixed and no gain is free")
     outs = _as_names(
         [k for k in measurement.outputs if k in OUTPUT_LABELS] if outputs is None else outputs,
         "output",
         [k for k in measurement.outputs if k in OUTPUT_LABELS],
+        "outputs",
     )
     if not outs:
         raise ValueError(

@@ -28,6 +28,7 @@ import pandas as pd
 
 from ..models.quarter import quarter_car_model
 from ..models.vehicle import VehicleModel
+from ..numerics import checks
 from ..numerics import methods as catalogue
 from ..numerics.methods import METHODS
 from ..ride import road as roads
@@ -141,9 +142,8 @@ STIFF_CAR = StiffCar()
 
 def pothole_road(T, depth: float = 0.05, length: float = 0.3, speed: float = 20.0, t0: float = 1.0):
     """The pothole's road height [m] on ``T`` [s]: a 1 − cos bump of height ``-depth``."""
-    if not (isinstance(depth, (int, float)) and not isinstance(depth, bool) and depth > 0):
-        raise ValueError(f"depth must be a number > 0 m, got {depth!r}")
-    return roads.bump(T, height=-float(depth), length=length, speed=speed, t0=t0)
+    depth = checks.positive("depth", depth, "m", description="the pothole's depth")
+    return roads.bump(T, height=-depth, length=length, speed=speed, t0=t0)
 
 
 def pothole_comparison(

@@ -20,6 +20,7 @@ import numpy as np
 from ...models.quarter import SEED_X0, as_params
 from ...models.registry import MODELS, model_for_params, model_for_system
 from ...models.vehicle import VehicleModel
+from ...numerics import checks
 from ...numerics.integrate import (
     check_time_grid,
     uniform_step,
@@ -105,11 +106,16 @@ def _grid(T: np.ndarray, h: float | None) -> tuple[float, int]:
         raise ValueError("T must be uniformly spaced for a method comparison")
     if h is None:
         return dt, 1
-    if not (isinstance(h, (int, float)) and math.isfinite(h) and h > 0):
-        raise ValueError(f"h must be a finite step > 0 s, got {h!r}")
+    if isinstance(h, bool) or not isinstance(h, (int, float)) or not (math.isfinite(h) and h > 0):
+        raise checks.ParameterError("h", h, "a finite step > 0 s")
     k = round(dt / h)
     if k < 1 or abs(k * h - dt) > 1e-9 * dt:
-        raise ValueError(f"h = {h!r} s must divide the grid spacing {dt!r} s of T")
+        raise checks.ParameterError(
+            "h",
+            h,
+            f"a step dividing the grid spacing {dt!r} s of T",
+            message=f"h = {h!r} s must divide the grid spacing {dt!r} s of T",
+        )
     return dt / k, int(k)
 
 
@@ -198,8 +204,7 @@ def checked_problem(
     T = check_time_grid(default_grid() if T is None else T, "T")
     h, substeps = _grid(T, h)
     tabs = _tableaus(methods)
-    if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
-        raise ValueError(f"repeats must be a positive integer, got {repeats!r}")
+    checks.integer("repeats", repeats, minimum=1)
     X0 = check_initial_state(X0, sys.nstates)
     if U is not None:
         U = check_input_samples(U, sys.ninputs, T.size)
