@@ -16,6 +16,7 @@ import qc_control as qc
 from qc_control.cli.console import main
 from qc_control.report.comparison import build_blocks
 from qc_control.report.document import Heading, Paragraph, Table
+from qc_control.ride.iso2631_spectral import spectral_axis_rms
 from qc_control.studies.scenario import Scenario
 from qc_control.studies.scenarios import POTHOLE, pothole_road
 
@@ -201,3 +202,36 @@ def test_the_command_reports_the_pothole_leading_with_mtvv_and_vdv(tmp_path):
     assert _number(section, "z", 5) == pytest.approx(expected["z"].vdv, rel=5e-4)
     verdict = next(x for x in section.splitlines() if x.startswith("The exact reference"))
     assert verdict.index("the assessment is MTVV and VDV") < verdict.index("vibration total")
+
+
+def test_the_roads_guide_says_what_its_cells_compute(tmp_path, monkeypatch):
+    """docs/guide/roads.md's comfort section: the figures its text quotes, read from
+    its cells' values, and its RK4 pothole against python-control's exact one."""
+    import re
+    from pathlib import Path
+
+    page = Path(__file__).parent.parent / "docs" / "guide" / "roads.md"
+    cells = re.findall(
+        r"^```\{code-cell\}[^\n]*\n(.*?)^```", page.read_text(encoding="utf-8"), re.S | re.M
+    )
+    monkeypatch.chdir(tmp_path)
+    ns: dict = {}
+    for cell in cells:
+        exec(compile(cell, page.name, "exec"), ns)
+    rough, shock, car, road = ns["rough"], ns["shock"], ns["car"], ns["rough_road"]
+    # the text's numbers, as printed (3 significant digits, or 2 where it says so)
+    assert (round(shock["z"].mtvv_ratio, 2), round(shock["z"].vdv_ratio, 1)) == (1.69, 2.1)
+    assert (round(rough["x"].mtvv_ratio, 2), round(rough["ry"].mtvv_ratio, 2)) == (1.61, 1.52)
+    assert max(a.crest_factor for a in rough.axes.values()) < 4
+    assert rough.comfort == ("fairly uncomfortable",) and shock.comfort == ("not uncomfortable",)
+    assert rough.health.rms_verdict == "below"
+    assert shock.verdict[0].startswith("MTVV/a_w 1.69 > 1.5 on z")
+    spectral = spectral_axis_rms(car, road.intensity, seat=0.5)
+    assert abs(spectral["z"] / rough["z"].a_w - 1) < 0.04
+    assert round(spectral["ry"] / rough["ry"].a_w, 1) == 1.7
+    assert round(spectral["x"] / rough["x"].a_w, 1) == 1.4
+    # RK4 at 1 ms on the pothole against the exact response on 0-3 s (the page stops a
+    # sample earlier, long after the shock): 1e-4 (measured 9e-8)
+    exact = _pothole_exact()
+    assert shock["z"].vdv == pytest.approx(exact["z"].vdv, rel=1e-4)
+    assert shock["z"].mtvv == pytest.approx(exact["z"].mtvv, rel=1e-4)
