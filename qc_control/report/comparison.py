@@ -581,7 +581,7 @@ def _comfort_blocks(cmp) -> list:
         Heading("Ride comfort (ISO 2631-1:1997)"),
         Paragraph(
             "The exact reference's ride, assessed as ISO 2631-1:1997 does: "
-            + " ".join(f"{sentence}." for sentence in comfort.verdict)
+            + " ".join(f"{sentence[:1].upper()}{sentence[1:]}." for sentence in comfort.verdict)
         ),
         Table(
             axes,
