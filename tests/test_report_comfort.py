@@ -235,3 +235,26 @@ def test_the_roads_guide_says_what_its_cells_compute(tmp_path, monkeypatch):
     exact = _pothole_exact()
     assert shock["z"].vdv == pytest.approx(exact["z"].vdv, rel=1e-4)
     assert shock["z"].mtvv == pytest.approx(exact["z"].mtvv, rel=1e-4)
+
+
+def test_the_nonlinear_car_reading_its_road_itself_is_assessed():
+    """The nonlinear car takes its lift-off bump as a function of time (no ``U``):
+    the study still assesses its reference, held against `qc.ride_assessment` of
+    python-control's own DOP853 solve (rtol 1e-10, steps of at most 1 ms): two
+    tight solves agree to 1e-7 (measured 1e-9)."""
+    sc = Scenario(model="nonlinear", comfort=True, t_end=2.0)
+    vehicle, T, U, description = sc.problem()
+    assert U is None and description  # the car reads its road itself
+    cmp = qc.compare_methods(
+        vehicle, T, np.asarray(sc.x0), input_description=description, methods=("rk4",),
+        timing=False, comfort=True,
+    )  # fmt: skip
+    tight = {"rtol": 1e-10, "atol": 1e-13, "max_step": 1e-3}
+    solve = control.input_output_response(
+        vehicle.system, T, np.zeros((vehicle.system.ninputs, T.size)), X0=np.asarray(sc.x0),
+        solve_ivp_method="DOP853", solve_ivp_kwargs=tight,
+    )  # fmt: skip
+    exact = qc.ride_assessment(solve, model=vehicle)
+    for name in ("a_w", "mtvv", "vdv"):
+        assert getattr(cmp.comfort["z"], name) == pytest.approx(getattr(exact["z"], name), rel=1e-7)
+    assert cmp.comfort.comfort == exact.comfort

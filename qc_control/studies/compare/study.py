@@ -272,7 +272,7 @@ def compare_methods(
         sys, U, input_description = road_problem(sys, road, T, params)
     sys, model, params = as_model(sys, U, params)
     problem = checked_problem(sys, model, params, T, X0, U, methods, h, repeats)
-    assess = _comfort_request(problem, comfort)
+    assess = _comfort_request(problem, comfort, input_description)
     peers = check_solvers(solvers)
     if is_sampled(sys):
         if events is not None or levels is not None or peers:
@@ -302,9 +302,11 @@ def compare_methods(
 _COMFORT_KEYS = ("seat", "duration")
 
 
-def _comfort_request(problem: ComparisonProblem, comfort) -> dict | None:
+def _comfort_request(problem: ComparisonProblem, comfort, input_description: str) -> dict | None:
     """``comfort`` checked before any work: None (no assessment) or the keyword
-    arguments of `ride_assessment`; an assessment needs a road under the car."""
+    arguments of `ride_assessment`. An assessment needs a road under the car: its
+    samples (``U`` on the road inputs), or a car that reads its road itself as a
+    function of time (the nonlinear car: no ``U``, the road in ``input_description``)."""
     if comfort is False or comfort is None:
         return None
     if comfort is True:
@@ -313,7 +315,7 @@ def _comfort_request(problem: ComparisonProblem, comfort) -> dict | None:
         raise ParameterError(
             "comfort", comfort, f"True, or a mapping of {' and '.join(_COMFORT_KEYS)}"
         )
-    if not on_road(problem):
+    if not (on_road(problem) or (problem.U is None and input_description)):
         raise ParameterError(
             "comfort", True, "a road under the car: ISO 2631-1 assesses a ride (give road=)"
         )
