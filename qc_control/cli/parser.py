@@ -347,6 +347,26 @@ def _add_report(sub, shown: str) -> None:
         "with a stiff damper top mount on an ISO 8608 road",
     )
     sc.add_argument(
+        "--comfort",
+        action="store_const",
+        const=True,
+        help="assess the exact ride to ISO 2631-1 in the report (per axis a_w, crest factor, "
+        "MTVV, VDV; a_v, MSDV, Annex C's comfort words); needs a road",
+    )
+    sc.add_argument(
+        "--seat-height",
+        type=float,
+        metavar="M",
+        help="with --comfort, half/full car: the seat above the pitch and roll axes [m] "
+        "(gives the fore-aft and lateral axes)",
+    )
+    sc.add_argument(
+        "--exposure",
+        type=float,
+        metavar="H",
+        help="with --comfort: daily exposure [h] for Annex B's health guidance (10 min-24 h)",
+    )
+    sc.add_argument(
         "--max-steps",
         type=int,
         metavar="N",

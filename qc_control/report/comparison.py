@@ -512,25 +512,110 @@ def _stability_blocks(cmp, figs: dict[str, Image]) -> list:
     ]
 
 
+#: The per-axis columns of the comfort table: (heading, attribute, clause key), the
+#: RMS first; a shock's table leads with MTVV and VDV instead (`_axis_columns`).
+_RMS_COLUMNS = (("a_w", "a_w", "a_w"), ("crest factor [-]", "crest_factor", "crest_factor"))
+_SHOCK_COLUMNS = (
+    ("MTVV", "mtvv", "mtvv"),
+    ("VDV [unit·s^¼]", "vdv", "vdv"),
+    ("MTVV/a_w [-]", "mtvv_ratio", None),
+    ("VDV/(a_w T^¼) [-]", "vdv_ratio", None),
+)
+
+
+def _axis_columns(comfort) -> tuple:
+    """The MTVV and VDV first where the additional methods are the assessment."""
+    if comfort.additional_methods:
+        return _SHOCK_COLUMNS + _RMS_COLUMNS
+    return _RMS_COLUMNS + _SHOCK_COLUMNS
+
+
+def _comfort_value(value) -> str:
+    """A whole-ride value as text: a zone as its two ends, a missing one as a dash."""
+    if value is None:
+        return "–"
+    if isinstance(value, tuple):
+        return "–".join(fmt(v) for v in value)
+    return fmt(value)
+
+
+def _comfort_blocks(cmp) -> list:
+    """The exact reference's ride assessed to ISO 2631-1:1997 (``cmp.comfort``): the
+    verdict in words, a table per axis with units and the whole-ride numbers, each
+    beside its clause. A shock (the additional methods are the assessment) leads
+    with MTVV and VDV, in the verdict and in the table."""
+    comfort = getattr(cmp, "comfort", None)
+    if comfort is None:
+        return []
+    columns = _axis_columns(comfort)
+    axes = pd.DataFrame(
+        {
+            "weighting": [a.weighting for a in comfort.axes.values()],
+            "k": [a.k for a in comfort.axes.values()],
+            "unit": [a.unit for a in comfort.axes.values()],
+            **{
+                head: [getattr(a, name) for a in comfort.axes.values()] for head, name, _ in columns
+            },
+        },
+        index=pd.Index(list(comfort.axes), name="axis"),
+    )
+    first = next(iter(comfort.axes.values()))
+    cited = "; ".join(
+        f"{head.split(' [')[0]}: {first.clauses[key]}" for head, _, key in columns if key
+    )
+    summary = comfort.summary()
+    whole = pd.DataFrame(
+        {
+            "value": [_comfort_value(v) for v in summary["value"]],
+            "unit": summary["unit"],
+            "clause": summary["clause"],
+        },
+        index=summary.index,
+    )
+    lead = (
+        "MTVV and VDV first, the additional methods being the assessment (§6.2.1, §6.3.3): each"
+        if comfort.additional_methods
+        else "Each"
+    )
+    return [
+        Heading("Ride comfort (ISO 2631-1:1997)"),
+        Paragraph(
+            "The exact reference's ride, assessed as ISO 2631-1:1997 does: "
+            + " ".join(f"{sentence[:1].upper()}{sentence[1:]}." for sentence in comfort.verdict)
+        ),
+        Table(
+            axes,
+            f"{lead} seat axis, weighted by its Annex A curve, in its unit (m/s² for a "
+            f"translation, rad/s² for a rotation; VDV in unit·s^¼) ({cited})",
+        ),
+        Table(whole, "The whole ride, each number beside the clause it follows"),
+    ]
+
+
 def _ride_blocks(cmp, figs: dict[str, Image]) -> list:
-    """Under a road input: the transmissibility and the ride metrics."""
+    """Under a road input: the comfort assessment (when the study made one), the
+    transmissibility and the ride metrics."""
     if cmp.ride is None:
         return []
     blocks: list = [Heading("Road and ride")]
     if "transmissibility.png" in figs:
         blocks.append(figs["transmissibility.png"])
-    return blocks + [
-        Table(
-            _by_measure(cmp.ride, "metric"),
-            "Ride metrics of each method and of the exact reference "
-            "(ISO 2631-1 Wk weighting; tire load over the static "
-            "wheel load (ms + mu)·g)",
-        ),
-        Table(
-            _by_measure(cmp.ride_error, "metric"),
-            "Each method's ride metrics against the reference [%]",
-        ),
-    ]
+    return (
+        _comfort_blocks(cmp)
+        + blocks
+        + [
+            Table(
+                _by_measure(cmp.ride, "metric"),
+                "Ride metrics of each method and of the exact reference "
+                "(ISO 2631-1 Wk weighting; tire load over the static "
+                "wheel load (ms + mu)·g)",
+            ),
+            Table(
+                _by_measure(cmp.ride_error, "metric"),
+                "Each method's ride metrics against the reference [%]",
+            ),
+        ]
+    )
 
 
 def _reproduce_blocks(cmp, command: str | None) -> list:

@@ -296,25 +296,31 @@ class RideAssessment:
 
     @property
     def verdict(self) -> tuple[str, ...]:
-        """The findings in the standard's words, one sentence each, with clauses."""
+        """The findings in the standard's words, one sentence each, with clauses.
+
+        Where the additional methods are the assessment (§6.2.1, §6.3.3: a
+        shock), the sentence giving MTVV and VDV comes first, the RMS-based
+        a_v and comfort words after it; otherwise a_v leads."""
         c = self.clauses
-        out = [
+        rms = (
             f"vibration total value a_v = {self.a_v:.3g} m/s² ({c['a_v']}): "
             f"{' / '.join(self.comfort)} ({c['comfort']})"
-        ]
+        )
         if self.additional_methods:
             worst = max(self.axes.values(), key=lambda a: a.crest_factor)
-            out.append(
+            out = [
                 f"{'; '.join(self.triggers)}: the RMS underestimates the shocks, and the "
                 f"assessment is MTVV and VDV ({worst.axis}: MTVV = {worst.mtvv:.3g} "
                 f"{worst.unit}, VDV = {worst.vdv:.3g} {worst.unit}·s^¼) "
-                f"({c['additional_methods']})"
-            )
+                f"({c['additional_methods']})",
+                rms,
+            ]
         else:
-            out.append(
+            out = [
+                rms,
                 f"crest factor {self.crest_factor:.3g} <= 9 and the ratios of §6.3.3 within "
-                f"their limits: the basic (RMS) method suffices ({c['additional_methods']})"
-            )
+                f"their limits: the basic (RMS) method suffices ({c['additional_methods']})",
+            ]
         if self.msdv is not None:
             out.append(
                 f"MSDV_z = {self.msdv:.3g} m/s^1.5 ({c['msdv']}): about "

@@ -31,9 +31,12 @@ import numpy as np
 import scipy.linalg
 
 from ..models.vehicle import VehicleModel
+from ..numerics import checks
 from ..numerics.checks import ParameterError, positive
 from ..numerics.threads import one_blas_thread
-from .iso2631 import wk_filter
+from .assessment import AXES
+from .guidance import AXIS_RULES, POSTURES
+from .iso2631 import weighting, wk_filter
 from .metrics import metric_columns
 from .road import ISO8608_BAND, ISO8608Road, iso8608_intensity
 
@@ -49,6 +52,8 @@ __all__ = [
     "iso8608_spelling",
     "DEFAULT_ROAD",
     "spectral_metrics",
+    "spectral_axis_rms",
+    "spectral_a_v",
     "SPECTRAL_METRICS",
     "SPECTRAL_CAPABLE",
 ]
@@ -436,11 +441,116 @@ def road_intensity(road=None, *, stacklevel: int = 2) -> float:
     return positive("road", road, "m²/s", description="white road-velocity intensity q")
 
 
+@functools.lru_cache(maxsize=8)
+def _weighting_matrices(name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    sys = control.ss(weighting(name))
+    A, B, C, D = (np.asarray(getattr(sys, k), dtype=float) for k in "ABCD")
+    return A, B[:, 0], C[0], float(D[0, 0])
+
+
+def _axis_rows(model: VehicleModel, C: np.ndarray, seat) -> dict[str, np.ndarray]:
+    """Each ISO axis's acceleration as rows ``(..., n)`` of the car's ``C``."""
+    labels = list(model.system.output_labels)
+    rows = {"z": C[..., labels.index(model.body_acc), :]}
+    if "pitch_acc" in labels:  # ISO ry is nose down; the cars count pitch nose up
+        rows["ry"] = -C[..., labels.index("pitch_acc"), :]
+    if "roll_acc" in labels:
+        rows["rx"] = C[..., labels.index("roll_acc"), :]
+    if seat is not None:
+        h = checks.finite("seat", seat, "m", description="seat height above the pitch/roll axes")
+        if "ry" in rows:
+            rows["x"] = h * rows["ry"]
+        if "rx" in rows:
+            rows["y"] = -h * rows["rx"]
+    return rows
+
+
+def _weighted_variance(A, Bw, c, name: str, q: float):
+    """``q c_c P c_cᵀ`` of the car's row ``c`` in series with weighting ``name``."""
+    Aw, bw, cw, dw = _weighting_matrices(name)
+    n, nw = A.shape[-1], Aw.shape[0]
+    batch = A.shape[:-2]
+    Ac = np.zeros(batch + (n + nw, n + nw))
+    Ac[..., :n, :n] = A
+    Ac[..., n:, :n] = bw[:, None] * c[..., None, :]
+    Ac[..., n:, n:] = Aw
+    Bc = np.zeros(batch + (n + nw, Bw.shape[-1]))
+    Bc[..., :n, :] = Bw
+    Cc = np.zeros(batch + (1, n + nw))
+    Cc[..., 0, :n] = dw * c
+    Cc[..., 0, n:] = cw
+    return q * lyapunov_variances(Ac, Bc, Cc)[..., 0]
+
+
+def spectral_axis_rms(
+    model: VehicleModel,
+    intensity: float,
+    *,
+    seat: float | None = None,
+    posture: str = "seated",
+    batch=None,
+) -> dict:
+    """Exact stationary ISO 2631-1 weighted RMS ``a_w`` of each axis on white road velocity.
+
+    Parameters
+    ----------
+    model : VehicleModel
+        A linear car with road inputs (``road=True``).
+    intensity : float
+        ``q`` [m²/s], e.g. ``ISO8608Road('C', speed=20).intensity``.
+    seat : float, optional
+        Seat height above the pitch and roll axes [m]: adds ``x`` and ``y``
+        (as `qc_control.ride.assessment.axis_signals` derives them).
+    posture : {'seated', 'standing'}
+        The weighting of each axis (`qc_control.ride.guidance.AXIS_RULES`).
+    batch : BatchedModel, optional
+        Many designs: each value is then an array ``(m,)``.
+
+    Returns
+    -------
+    dict[str, float or ndarray]
+        ``a_w`` by axis, in ISO order: m/s² for x, y, z; rad/s² for rx, ry.
+
+    Examples
+    --------
+    >>> from qc_control.models.quarter import quarter_car_model
+    >>> from qc_control.ride.road import ISO8608Road
+    >>> q = ISO8608Road("C", speed=20.0).intensity
+    >>> round(spectral_axis_rms(quarter_car_model(road=True), q)["z"], 3)
+    0.665
+    """
+    q = checks.positive("intensity", intensity, "m²/s")
+    posture = checks.choice("posture", posture, POSTURES)
+    A, Bw, C, gain = white_velocity_system(model, batch)
+    rules = AXIS_RULES[posture]
+    rows = _axis_rows(model, C, seat)
+    out: dict = {}
+    for axis in (a for a in AXES if a in rows and a in rules):
+        var = _weighted_variance(A, Bw, rows[axis], rules[axis].weighting, q)
+        out[axis] = float(np.sqrt(var)) if np.ndim(var) == 0 else np.sqrt(var)
+    if not out:
+        raise ParameterError("posture", posture, f"a posture with the axes of {model.name!r}")
+    return out
+
+
+def spectral_a_v(per_axis, posture: str = "seated"):
+    """The vibration total value ``(Σ k² a_w²)^½`` (ISO 2631-1:1997 §6.5, k of
+    §8.2.3) of `spectral_axis_rms`' values [m/s²]."""
+    rules = AXIS_RULES[checks.choice("posture", posture, POSTURES)]
+    return np.sqrt(sum((rules[a].k_comfort * v) ** 2 for a, v in per_axis.items()))
+
+
 #: The metrics a spectral sweep computes unless told otherwise (the
 #: Wk-weighted one costs a 12-state Lyapunov equation per design; ask for it).
+#: The ISO 2631-1 metrics of `qc_control.ride.metrics` with an exact stationary value:
+#: the body's axes as `spectral_axis_rms` weights them, no seat height (as the metrics).
+ISO2631_SPECTRAL = ("a_w_z", "a_w_rx", "a_w_ry", "a_v")
 SPECTRAL_METRICS = ("rms_body_acc", "rms_susp_travel", "rms_tire_load / static")
 #: Every metric with an exact stationary value under white road velocity.
-SPECTRAL_CAPABLE = ("rms_body_acc", "rms_body_acc_wk", "rms_susp_travel", "rms_tire_load / static")
+SPECTRAL_CAPABLE = (
+    "rms_body_acc", "rms_body_acc_wk", "rms_susp_travel", "rms_tire_load / static",
+    *ISO2631_SPECTRAL,
+)  # fmt: skip
 
 
 @one_blas_thread
@@ -453,7 +563,11 @@ def spectral_metrics(
     ``rms_tire_load / static`` (``kt σ(tire_defl) / static load``), under the
     column names of `qc_control.ride.metrics` (per corner for a wheel's metric),
     from `white_velocity_variances` and `white_velocity_wk_variance`: the
-    Lyapunov values over the unbounded band.
+    Lyapunov values over the unbounded band. ISO 2631-1's ``a_w_z``,
+    ``a_w_rx``, ``a_w_ry`` (the body's vertical, roll and pitch, each with
+    its Annex A weighting) and ``a_v = (Σ k² a_w²)^½`` over them (§6.5, k of
+    §8.2.3) come from `spectral_axis_rms` without a seat height, as the
+    time-domain metrics define them; a rotation the car does not have is 0.
 
     Parameters
     ----------
@@ -488,9 +602,16 @@ def spectral_metrics(
     )
     load = batch.static_load if batch is not None else [c.static_load for c in roles.corners]
     out: dict = {}
+    axes = (
+        spectral_axis_rms(model, intensity, batch=batch)
+        if any(metric.name in ISO2631_SPECTRAL for _, metric, _ in items)
+        else {}
+    )
     for column, metric, i in items:
         corner = roles.corners[i]
-        if metric.name == "rms_body_acc":
+        if metric.name in ISO2631_SPECTRAL:
+            out[column] = _iso2631_value(metric.name, axes)
+        elif metric.name == "rms_body_acc":
             out[column] = np.sqrt(var[roles.body_acc])
         elif metric.name == "rms_body_acc_wk":
             out[column] = np.sqrt(
@@ -501,3 +622,12 @@ def spectral_metrics(
         else:
             out[column] = stiffness[i] * np.sqrt(var[corner.tire_defl]) / load[i]
     return {k: (float(v) if np.ndim(v) == 0 else v) for k, v in out.items()}
+
+
+def _iso2631_value(name: str, axes: dict):
+    """A metric of `ISO2631_SPECTRAL` from `spectral_axis_rms`' ``axes``; a rotation
+    the car's body does not have (a quarter car's pitch) is 0, as in the time domain."""
+    if name == "a_v":
+        return spectral_a_v(axes)
+    axis = name.removeprefix("a_w_")
+    return axes[axis] if axis in axes else 0.0 * axes["z"]

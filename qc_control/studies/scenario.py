@@ -86,6 +86,9 @@ __all__ = [
 ]
 
 
+#: Annex B's Figure B.1 covers daily exposures of 10 min to 24 h [h].
+EXPOSURE_HOURS = (10.0 / 60.0, 24.0)
+
 #: The largest magnitude of an x0 entry: its square (RMS errors, energies) stays far
 #: inside the range of a float.
 MAX_STATE = 1e150
@@ -330,6 +333,17 @@ class Scenario:
         the quarter car with a 1e7 N/m damper top mount on 60 s of an ISO
         8608 class C road at 20 m/s, h = 5 ms, with the L-stable tableaus
         known by name. Both run every peer.
+    comfort : bool, default False
+        Assess the exact reference's ride to ISO 2631-1:1997 into the
+        comparison's ``comfort`` (`compare_methods`' ``comfort``); it needs
+        a road.
+    seat_height : float, optional
+        With ``comfort``: the seat's height above a half or full car's
+        pitch and roll axes [m], which gives the seat's fore-aft and
+        lateral motion (default: those axes are not assessed).
+    exposure : float, optional
+        With ``comfort``: the daily exposure [h] of Annex B's health
+        guidance, from 10 min to 24 h (default: no health zone).
 
     Examples
     --------
@@ -358,6 +372,9 @@ class Scenario:
     model_options: Any = None  # resolved: a tuple of (name, value) pairs, hashable
     solvers: tuple[str, ...] = None  # type: ignore[assignment]  # resolved: () without peers
     kind: str | None = None
+    comfort: bool = False
+    seat_height: float | None = None
+    exposure: float | None = None
 
     def __post_init__(self):
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
@@ -406,6 +423,48 @@ class Scenario:
             put("solvers", check_solvers(self.solvers))
         except (TypeError, ValueError) as exc:
             raise ScenarioError(f"solvers: {exc}", "scenario", "solvers") from None
+        self._comfort()
+
+    def _comfort(self) -> None:
+        """Check the ride assessment's choice: a road under the car, a finite seat
+        height, an exposure within Annex B's Figure B.1 (10 min to 24 h)."""
+        put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
+        if not isinstance(self.comfort, bool):
+            raise ScenarioError(
+                f"comfort must be true or false, got {self.comfort!r}", "scenario", "comfort"
+            )
+        for key in ("seat_height", "exposure"):
+            if getattr(self, key) is not None and not self.comfort:
+                raise ScenarioError(
+                    f"{key} applies to the ride assessment only: set comfort = true (--comfort)",
+                    "scenario",
+                    key,
+                )
+        if self.comfort and isinstance(self.road, NoRoad):
+            raise ScenarioError(
+                "comfort needs a road: ISO 2631-1 assesses a ride, and this run has none "
+                "(give a road, e.g. --road iso8608, or --scenario pothole)",
+                "scenario",
+                "comfort",
+            )
+        if self.seat_height is not None:
+            put("seat_height", _checked(checks.finite, "seat_height", self.seat_height, "m"))
+        if self.exposure is not None:
+            low, high = EXPOSURE_HOURS
+            put(
+                "exposure",
+                _checked(checks.number, "exposure", self.exposure, "h", low=low, high=high),
+            )
+
+    def comfort_request(self) -> dict[str, float] | bool:
+        """`compare_methods`' ``comfort`` for this scenario: False, or the
+        ride assessment's ``seat`` [m] and ``duration`` [s] that are given."""
+        if not self.comfort:
+            return False
+        request = {"seat": self.seat_height}
+        if self.exposure is not None:
+            request["duration"] = self.exposure * 3600.0
+        return {k: v for k, v in request.items() if v is not None}
 
     def _kind(self) -> None:
         """Fill what a scenario kind (`KINDS`) sets and the scenario does not give."""
@@ -720,6 +779,7 @@ class Scenario:
             progress=progress,
             input_description=description,
             solvers=self.solvers or None,
+            comfort=self.comfort_request(),
             **self.option_arguments("compare"),
         )
         if self.kind == "stiff" and cmp.ride is not None:  # on the road: a ride answer
@@ -821,10 +881,21 @@ class Scenario:
         if config is not None:
             options: list[tuple[str, str | None]] = [("--config", str(config))]
         else:
-            options = command_options(self)
+            options = command_options(self) + self._comfort_options()
         if out is not None:
             options.append(("--out", str(out)))
         return command_line(["report"], options)
+
+    def _comfort_options(self) -> list[tuple[str, str | None]]:
+        """The command line's ``--comfort``, ``--seat-height`` and ``--exposure``."""
+        if not self.comfort:
+            return []
+        options: list[tuple[str, str | None]] = [("--comfort", None)]
+        if self.seat_height is not None:
+            options.append(("--seat-height", repr(self.seat_height)))
+        if self.exposure is not None:
+            options.append(("--exposure", repr(self.exposure)))
+        return options
 
 
 def _named_tableaus() -> dict:

@@ -188,7 +188,10 @@ def vehicle_keys() -> tuple[str, ...]:
 #: The Scenario's fields that hold a model's own options (`ModelOption`) by name;
 #: the options of other registered models are held in ``model_options``.
 OPTION_KEYS = ("tire", "bump_stop", "events")
-RUN_KEYS = ("t_end", "h", "x0", "methods", "max_steps", "model", *OPTION_KEYS, "solvers", "kind")
+RUN_KEYS = (
+    "t_end", "h", "x0", "methods", "max_steps", "model", *OPTION_KEYS, "solvers", "kind",
+    "comfort", "seat_height", "exposure",
+)  # fmt: skip
 
 
 def run_keys() -> tuple[str, ...]:
@@ -527,6 +530,13 @@ def scenario_text(scenario) -> str:
         lines.append(f"solvers = {toml_value(scenario.solvers)}")
     if scenario.kind is not None:
         lines.append(f"kind = {toml_value(scenario.kind)}")
+    if scenario.comfort:  # the ride assessment; left out when off, as older files have it
+        lines.append("comfort = true")
+        lines += [
+            f"{key} = {toml_value(getattr(scenario, key))}"
+            for key in ("seat_height", "exposure")
+            if getattr(scenario, key) is not None
+        ]
     for option in scenario.entry.options:
         value = scenario.option(option.name)
         if value is not None:

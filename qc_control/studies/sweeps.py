@@ -535,13 +535,24 @@ def _last_outside(out: OutputStream, tail: TailBound, carries, row, final, band,
     return last
 
 
+#: The registered metrics that read a half or full car's body rotations (ISO 2631-1's
+#: We-weighted pitch and roll, `qc_control.ride.metrics`), and the outputs they read.
+_ROTATION_READERS = {
+    "a_w_rx": ("roll_acc",),
+    "a_w_ry": ("pitch_acc",),
+    "a_v": ("roll_acc", "pitch_acc"),
+}
+
+
 def _outputs_read(metric_items, roles: SignalRoles, labels: tuple[str, ...]) -> tuple[str, ...]:
     """The output labels the metrics read, in the model's order: the body's and
-    every corner's for registered metrics, all of them for a custom one."""
+    every corner's for registered metrics (and the pitch and roll accelerations
+    a car has, for the metrics of `_ROTATION_READERS`), all of them for a custom one."""
     if any(not isinstance(metric, str) for _, metric, _ in metric_items):
         return labels
     read = {roles.body_acc, roles.body_disp}
     read |= {label for c in roles.corners for label in (c.susp_travel, c.tire_defl)}
+    read |= {label for _, name, _ in metric_items for label in _ROTATION_READERS.get(name, ())}
     return tuple(label for label in labels if label in read)
 
 

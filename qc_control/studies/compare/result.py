@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from ...models.modal import ModalAnalysis
+from ...ride.assessment import RideAssessment
 from ...ride.comfort import Transmissibility
 from .. import columns as col
 from ..confirm import CostCheck
@@ -100,6 +101,11 @@ class MethodComparison(ComparisonProblem):
         On a linear car: the run that checked each estimate of `cost`
         (`qc_control.studies.confirm`); `cost` then holds the confirmed
         counts, and `cost_kind` says 'confirmed' or 'missed' for them.
+    comfort : RideAssessment or None
+        With ``compare_methods(..., comfort=...)`` on a road: the exact
+        reference's ride assessed to ISO 2631-1:1997
+        (`qc_control.ride_assessment` of ``reference`` as the car's), per
+        axis and whole, each number with its clause.
     """
 
     table: pd.DataFrame
@@ -126,6 +132,7 @@ class MethodComparison(ComparisonProblem):
     sampled_car: control.StateSpace | None = None
     ride_cost: RideCost | None = None
     cost_checks: list[CostCheck] | None = None
+    comfort: RideAssessment | None = None
 
     def summary(self) -> pd.DataFrame:
         """The headline columns of `table`, for a terminal."""

@@ -4,7 +4,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import control
@@ -13,6 +13,7 @@ import pandas as pd
 
 from ...numerics.checks import ParameterError
 from ...numerics.lti import is_nonlinear_system
+from ...ride.assessment import RideAssessment, ride_assessment
 from ...ride.road import Road
 from .. import columns as col
 from ..confirm import confirmed_costs
@@ -59,7 +60,11 @@ def _cost_columns(problem: ComparisonProblem, responses: dict) -> pd.DataFrame:
 
 
 def _comparison(
-    problem: ComparisonProblem, measured: Measured, input_description: str, **added: Any
+    problem: ComparisonProblem,
+    measured: Measured,
+    input_description: str,
+    comfort: dict | None = None,
+    **added: Any,
 ) -> MethodComparison:
     """The comparison from what either path measured: errors, modes, cost, ride; ``added``:
     the fields a path computed besides (the peers' study, a sampled loop's car), each
@@ -90,6 +95,8 @@ def _comparison(
     ride, ride_error = (
         ride_comparison(reference, responses, problem.model) if on_road(problem) else (None, None)
     )
+    if comfort is not None:
+        added["comfort"] = _comfort(problem, reference.response, comfort)
     return MethodComparison(
         **vars(problem),
         **added,
@@ -134,6 +141,7 @@ def compare_methods(
     levels: int | None = None,
     solvers: Sequence[str] | None = None,
     rtols: Sequence[float] = RTOLS,
+    comfort: bool | Mapping[str, Any] = False,
 ) -> MethodComparison:
     """Compare fixed-step methods with python-control's exact response.
 
@@ -205,6 +213,13 @@ def compare_methods(
         reference; ``cmp.peers`` holds the work–precision study.
     rtols : sequence of float, default 1e-3, 1e-4, ..., 1e-10
         The peers' tolerance ladder (and the embedded qc pairs').
+    comfort : bool or mapping, default False
+        On a road: assess the exact reference's ride to ISO 2631-1:1997
+        into ``cmp.comfort`` (`qc_control.ride_assessment` of it as the
+        car's response). A mapping gives its ``seat`` (the seat's height
+        above a half or full car's pitch and roll axes [m], for the
+        fore-aft and lateral axes) and ``duration`` (the daily exposure [s]
+        of Annex B's health guidance, 10 min to 24 h).
 
     Returns
     -------
@@ -257,6 +272,7 @@ def compare_methods(
         sys, U, input_description = road_problem(sys, road, T, params)
     sys, model, params = as_model(sys, U, params)
     problem = checked_problem(sys, model, params, T, X0, U, methods, h, repeats)
+    assess = _comfort_request(problem, comfort, input_description)
     peers = check_solvers(solvers)
     if is_sampled(sys):
         if events is not None or levels is not None or peers:
@@ -266,7 +282,9 @@ def compare_methods(
                 "the clock"
             )
         measured = measure_sampled(problem, repeats, timing, progress)
-        return _comparison(problem, measured, input_description, sampled_car=measured.linear)
+        return _comparison(
+            problem, measured, input_description, assess, sampled_car=measured.linear
+        )
     elif is_nonlinear_system(sys):
         measured = measure_nonlinear(problem, events, levels, timing, progress)
     else:
@@ -277,7 +295,36 @@ def compare_methods(
             )
         measured = measure_linear(problem, repeats, timing, progress)
     study = _peer_study(problem, measured, peers, rtols, progress) if peers else None
-    return _comparison(problem, measured, input_description, peers=study)
+    return _comparison(problem, measured, input_description, assess, peers=study)
+
+
+#: What ``compare_methods(comfort={...})`` passes on to `ride_assessment`.
+_COMFORT_KEYS = ("seat", "duration")
+
+
+def _comfort_request(problem: ComparisonProblem, comfort, input_description: str) -> dict | None:
+    """``comfort`` checked before any work: None (no assessment) or the keyword
+    arguments of `ride_assessment`. An assessment needs a road under the car: its
+    samples (``U`` on the road inputs), or a car that reads its road itself as a
+    function of time (the nonlinear car: no ``U``, the road in ``input_description``)."""
+    if comfort is False or comfort is None:
+        return None
+    if comfort is True:
+        comfort = {}
+    if not isinstance(comfort, Mapping) or set(comfort) - set(_COMFORT_KEYS):
+        raise ParameterError(
+            "comfort", comfort, f"True, or a mapping of {' and '.join(_COMFORT_KEYS)}"
+        )
+    if not (on_road(problem) or (problem.U is None and input_description)):
+        raise ParameterError(
+            "comfort", True, "a road under the car: ISO 2631-1 assesses a ride (give road=)"
+        )
+    return dict(comfort)
+
+
+def _comfort(problem: ComparisonProblem, response, request: dict) -> RideAssessment:
+    """The exact reference's ride, assessed as the car's (its model's roles)."""
+    return ride_assessment(response, model=problem.model, **request)
 
 
 def _peer_study(
