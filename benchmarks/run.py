@@ -39,7 +39,8 @@ from qc_control.studies.sweeps import DEFAULT_METRICS, design_grid, sweep
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from explore_redraw import browser_redraw_benchmark  # noqa: E402
 from mpc_solvers import mpc_solvers_benchmark  # noqa: E402
-from shared import g, other_cores_busy, table  # noqa: E402
+from shared import g, other_cores_busy, section, table  # noqa: E402
+from skyhook_car import car_with_skyhook  # noqa: E402
 
 X0 = np.array([0.0, 0.0, 0.05, 0.0])
 
@@ -231,7 +232,7 @@ def memory_and_spectral(T, quick: bool):
     worst = 0.0
     for i in range(0, n * n, max(1, n * n // 25)):
         d = {k: result.loc[i, k] for k in ("ms", "mu", "ks", "ku", "cs")}
-        single = qc.ride_metrics_spectral(d, "C", 20.0, exact=True)
+        single = qc.ride_metrics_spectral(d, road, exact=True)
         for col in ("rms_body_acc [m/s²]", "rms_susp_travel [m]", "rms_tire_load / static [-]"):
             worst = max(worst, abs(result.loc[i, col] / single[col] - 1))
     head = ["sweep", "designs", "samples", "time [s], median (min–max)", "peak memory [MB]"]
@@ -380,65 +381,67 @@ def dask_comparison(quick: bool, m: int = 100_000, chunk: int = 5_000):
 
 
 # -- hand-written loops: what a student writes, the yardstick for the generic stepper
-def hand_euler(f, T, x):
-    out = np.empty((T.size, x.size))
-    out[0] = x
-    h = T[1] - T[0]
-    t = T[0]
-    for i in range(T.size - 1):
-        x = x + h * f(t, x)
-        t += h
-        out[i + 1] = x
-    return out
+def hand_loop(step):
+    """A student's fixed-step loop around one method's step: ``step(f, h)`` gives
+    the step ``x(t) -> x(t + h)``, with its fractions of h worked out once."""
+
+    def run(f, T, x):
+        out = np.empty((T.size, x.size))
+        out[0] = x
+        h = T[1] - T[0]
+        advance = step(f, h)
+        t = T[0]
+        for i in range(T.size - 1):
+            x = advance(t, x)
+            t += h
+            out[i + 1] = x
+        return out
+
+    return run
 
 
-def hand_midpoint(f, T, x):
-    out = np.empty((T.size, x.size))
-    out[0] = x
-    h = T[1] - T[0]
+def euler_step(f, h):
+    return lambda t, x: x + h * f(t, x)
+
+
+def midpoint_step(f, h):
     h2 = h / 2
-    t = T[0]
-    for i in range(T.size - 1):
-        x = x + h * f(t + h2, x + h2 * f(t, x))
-        t += h
-        out[i + 1] = x
-    return out
+    return lambda t, x: x + h * f(t + h2, x + h2 * f(t, x))
 
 
-def hand_heun(f, T, x):
-    out = np.empty((T.size, x.size))
-    out[0] = x
-    h = T[1] - T[0]
+def heun_step(f, h):
     h2 = h / 2
-    t = T[0]
-    for i in range(T.size - 1):
+
+    def step(t, x):
         k1 = f(t, x)
         k2 = f(t + h, x + h * k1)
-        x = x + h2 * (k1 + k2)
-        t += h
-        out[i + 1] = x
-    return out
+        return x + h2 * (k1 + k2)
+
+    return step
 
 
-def hand_rk4(f, T, x):
-    out = np.empty((T.size, x.size))
-    out[0] = x
-    h = T[1] - T[0]
-    h2 = h / 2
-    h6 = h / 6
-    t = T[0]
-    for i in range(T.size - 1):
+def rk4_step(f, h):
+    h2, h6 = h / 2, h / 6
+
+    def step(t, x):
         k1 = f(t, x)
         k2 = f(t + h2, x + h2 * k1)
         k3 = f(t + h2, x + h2 * k2)
         k4 = f(t + h, x + h * k3)
-        x = x + h6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        t += h
-        out[i + 1] = x
-    return out
+        return x + h6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+    return step
 
 
-HAND = {"euler": hand_euler, "midpoint": hand_midpoint, "heun": hand_heun, "rk4": hand_rk4}
+HAND = {
+    m: hand_loop(step)
+    for m, step in (
+        ("euler", euler_step),
+        ("midpoint", midpoint_step),
+        ("heun", heun_step),
+        ("rk4", rk4_step),
+    )
+}
 
 
 def loop_comparison(f, T, repeats: int):
@@ -451,44 +454,13 @@ def loop_comparison(f, T, repeats: int):
         rows.append([m, g(t_hand * 1e3), g(t_gen * 1e3), g(ratio)])
     head = ["method", "hand loop [ms]", "qc.integrate [ms]", "ratio (target ≤ 1.2)"]
     text = (
-        "Both call the same Python `f(t, x) = A @ x`. `qc.integrate` is a plain loop over "
+        "Both call the same Python `f(t, x) = A @ x`; the hand loop is a student's, a loop "
+        "around one step function per method. `qc.integrate` is a plain loop over "
         "the tableau as data (no generated code): the non-zero h·a_ij, h·b_i and c_i·h once "
         f"per step size. CPU times, medians of {repeats} runs of each timed in turns; the "
         "ratio is the median of the ratios of the pairs."
     )
     return head, rows, text
-
-
-def car_with_skyhook():
-    """The seed car (StateSpace, body and wheel velocities as extra outputs) under a
-    clipped skyhook (Karnopp 1974, ``control.nlsys``), joined by ``control.interconnect``."""
-    ss = qc.quarter_car(road=True, actuator=True)
-    A, B, C, D = (np.asarray(m) for m in (ss.A, ss.B, ss.C, ss.D))
-    car = control.ss(
-        A,
-        B,
-        np.vstack([C, np.eye(4)[:2]]),
-        np.vstack([D, np.zeros((2, 2))]),
-        states=ss.state_labels,
-        inputs=ss.input_labels,
-        outputs=[*ss.output_labels, "vs_m", "vu_m"],
-        name="car",
-    )
-
-    def skyhook(t, x, u, p):
-        vs, vu = u
-        force = p["c_sky"] * vs if vs * (vs - vu) > 0 else 0.0
-        return [-min(max(force, -p["fmax"]), p["fmax"])]
-
-    ctrl = control.nlsys(
-        None,
-        skyhook,
-        inputs=["vs_m", "vu_m"],
-        outputs=["fa"],
-        name="skyhook",
-        params={"c_sky": 3000.0, "fmax": 2000.0},
-    )
-    return control.interconnect([car, ctrl], inputs="zr", outputs=ss.output_labels, name="cl")
 
 
 def interconnect_benchmark(quick: bool) -> tuple[list[str], list[str], list[list[str]]]:
@@ -530,17 +502,15 @@ def interconnect_benchmark(quick: bool) -> tuple[list[str], list[str], list[list
         ["qc RK4 h = 1 ms, sys._rhs", g(t_rhs), g(t_control / t_rhs), g(err_ours)],
         ["control.input_output_response (RK45 defaults)", g(t_control), "1", g(err_theirs)],
     ]
-    md = [
-        "### Nonlinear interconnection: car + clipped skyhook",
-        "",
+    md = section(
+        "Nonlinear interconnection: car + clipped skyhook",
         f"The seed car (`control.ss`) and a clipped skyhook (`control.nlsys`) joined by "
         f"`control.interconnect`, on an ISO 8608 class C road at 20 m/s, 0-{t_end:g} s. "
         "Times: paired CPU-time medians; errors against RK4 at h = 1/32 ms (the skyhook's "
         "force jumps, which makes solve_ivp at tight tolerance take minutes).",
-        "",
-        table(head, rows),
-        "",
-    ]
+        head,
+        rows,
+    )
     return md, head, rows
 
 
@@ -605,9 +575,8 @@ def nonlinear_sweep_benchmark(quick: bool) -> tuple[list[str], list[str], list[l
                 g(gap, 2),
             ]
         )
-    md = [
-        "### Nonlinear design sweeps: all designs stepped at once",
-        "",
+    md = section(
+        "Nonlinear design sweeps: all designs stepped at once",
         f"{len(designs)} designs of the nonlinear quarter car (ks × cs grid; body 301.2 kg, "
         "wheel 40 kg, unilateral tire 200 kN/m with gravity, bump and rebound stops at 5 and "
         "8 cm), RK4 at h = 1 ms, "
@@ -619,10 +588,9 @@ def nonlinear_sweep_benchmark(quick: bool) -> tuple[list[str], list[str], list[l
         "(solve_ivp RK45 at its defaults) on designs spread over the grid, scaled to all. "
         "CPU times, paired medians; the last column is the largest state difference of the "
         "batch against `qc.input_output_response` on the timed designs.",
-        "",
-        table(head, rows),
-        "",
-    ]
+        head,
+        rows,
+    )
     return md, head, rows
 
 
@@ -684,16 +652,15 @@ def mpc_benchmark(quick: bool) -> tuple[list[str], list[str], list[list[str]]]:
     loop = qc.closed_loop(car, law)
     t_loop = best_of(lambda: qc.input_output_response(loop.system, T, zr), 1)
     solves = np.asarray(law.log.solve_times) * 1e3
-    md = [
-        "### Model predictive control (issue 25)",
-        "",
+    md = section(
+        "Model predictive control (issue 25)",
         f"One control step of the measured problem (horizon {horizon}, ZOH 10 ms, "
         "Q = diag(1, 1, 1e4, 1e4), R = 1e-6, |fa| ≤ 500 N): qc's condensed QP (DAQP, "
         "median wall time of 20 warm solves) against python-control's "
         "solve_optimal_trajectory (one call), and both optimal costs.",
-        "",
-        table(head, rows),
-        "",
+        head,
+        rows,
+    ) + [
         f"A {t_end:g} s closed loop at 100 Hz on the class C road at 20 m/s, MPC with "
         f"0.5 s preview (horizon 50, |fa| ≤ 1 kN, travel ≤ 8 cm soft), RK4 at 5 ms: "
         f"{g(t_loop)} s (target < 1 s for 10 s); solve per tick median "
@@ -824,8 +791,8 @@ def explore_benchmark(quick: bool) -> tuple[list[str], list[list[str]]]:
     updates (Panel's models, without the browser; `browser_redraw_benchmark` times
     the browser's part, from the key to the painted figures)."""
     from qc_control.cli.explore import explorer
-    from qc_control.cli.scenario import Scenario
     from qc_control.studies.quick import error_ladder, ladder_steps, quick_comparison
+    from qc_control.studies.scenario import Scenario
 
     repeats = 1 if quick else 15
     sc = Scenario(t_end=10.0, h=0.001)
@@ -945,17 +912,15 @@ def busy_benchmark(quick: bool):
     if not quick and ratio[True] < 60:
         missed.append(f"one response on a busy machine: {g(ratio[True])}× control (target ≥ 60)")
     head = ["workload", "BLAS", "quiet [ms]", "busy [ms]", "speed kept", "target"]
-    lines = [
-        "### Quiet and busy",
-        "",
+    lines = section(
+        "Quiet and busy",
         f"The road step on {n:,} samples; busy: one CPU-bound process on each of the "
         f"other {max(1, cores - 1)} core(s). Median of {rounds} rounds, the best of "
         f"{calls} calls in each, the workloads in turns. 'speed kept' is quiet time / "
         "busy time.",
-        "",
-        table(head, rows),
-        "",
-    ]
+        head,
+        rows,
+    )
     return lines, head, rows, missed
 
 
@@ -1114,14 +1079,12 @@ def main(argv=None) -> int:
 
     # -- 2. generic stepper against hand-written loops (Python f)
     head, rows, text = loop_comparison(f, T, 1 if quick else 15)
-    md += [
-        "### The generic stepper against a hand-written loop",
-        "",
+    md += section(
+        "The generic stepper against a hand-written loop",
         text,
-        "",
-        table(head, rows),
-        "",
-    ]
+        head,
+        rows,
+    )
     say("\n" + table(head, rows))
 
     # -- 3. work-precision: each method over h; solve_ivp over rtol
@@ -1152,15 +1115,13 @@ def main(argv=None) -> int:
             ivp[(solver, k)] = (err, t_run, sol.nfev)
             rows.append([solver, f"rtol = 1e-{k}", g(err), str(sol.nfev), g(t_run * 1e3)])
     head = ["method", "setting", "max |xs error| [m]", "RHS evaluations", "time [ms]"]
-    md += [
-        "### Work and precision",
-        "",
+    md += section(
+        "Work and precision",
         "Error against control's exact response over "
         "0-10 s; solve_ivp evaluated at the finest grid's points (t_eval).",
-        "",
-        table(head, rows),
-        "",
-    ]
+        head,
+        rows,
+    )
     say("\n" + table(head, rows))
 
     # solve_ivp at the tolerance that first reaches RK4's error on the default grid
@@ -1206,18 +1167,17 @@ def main(argv=None) -> int:
         for row in rows
         if float(row[4].split()[0]) < float(row[5].split()[-1])
     ]
-    md += [
-        "### Design sweeps",
-        "",
+    md += section(
+        "Design sweeps",
         f"{n_designs} designs (ks × ζ grid), RK4 at h = {h * 1e3:g} ms, {n_samples} samples; "
         f"the sweep computes its {len(DEFAULT_METRICS)} default metrics per design "
         f"({', '.join(DEFAULT_METRICS)}), streamed; the loop only calls control (systems "
         f"built beforehand). Medians of {1 if quick else 5} runs on each side, alternating, "
         "with (min–max); "
         "the ratio is the median of the runs' ratios.",
-        "",
-        table(head, rows),
-        "",
+        head,
+        rows,
+    ) + [
         "What bounds the forced sweep: per sample and design, the road's effect inside a "
         "block is one product of (L+1) input samples with the design's p·L coefficients "
         "(2(L+1)p flops, L = 16, p = 4 outputs read) and the carries' part is 2np flops; "
@@ -1243,32 +1203,29 @@ def main(argv=None) -> int:
     ]
     if float(rows[-1][3].split()[0]) > 1.0:
         missed.append(f"the spectral sweep took {rows[-1][3]} s (target ≤ 1 s)")
-    md += [
-        "### 10,000 designs: peak memory, and the spectral sweep",
-        "",
+    md += section(
+        "10,000 designs: peak memory, and the spectral sweep",
         "Peak memory by tracemalloc (numpy's buffers included) above what was live before "
         "the call; times of one run for the simulated sweeps and median (min–max) of 5 for "
         "the spectral one (`qc.sweep(grid, road=qc.ISO8608Road('C', speed=20))`: batched "
         "Lyapunov equations, exact over the unbounded band). Targets: ≤ 500 MB, spectral "
         f"≤ 1 s. Spectral sweep against one design at a time: largest relative difference "
         f"{g(worst, 2)} (target ≤ 1e-9).",
-        "",
-        table(head, rows),
-        "",
-    ]
+        head,
+        rows,
+    )
     say("\n" + table(head, rows))
 
     head, rows = scaling(quick, Path(__file__).parent)
-    md += [
-        "### Scaling",
-        "",
+    md += section(
+        "Scaling",
         "Road-step sweeps (RK4, h = 1 ms, default metrics): time (median of 3 runs, 1 for "
         "the largest) and peak memory against the number of designs and of samples; the "
         "slope is that of the least-squares line in log-log "
         + ("(plot: `benchmarks/scaling.png`)." if not quick else "(quick mode: no plot)."),
-        "",
-        table(head, rows),
-        "",
+        head,
+        rows,
+    ) + [
         "Time is linear in both (slope near 1) once the fixed costs (validating designs, "
         "building each chunk's powers) are amortised. Memory grows with the samples only "
         "through the input itself (T, U and its padded copy: 24 bytes a sample); a chunk "
@@ -1284,9 +1241,8 @@ def main(argv=None) -> int:
     dask_rows = dask_comparison(quick)
     if dask_rows is not None:
         head, rows = dask_rows
-        md += [
-            "### Distributed: Dask LocalCluster",
-            "",
+        md += section(
+            "Distributed: Dask LocalCluster",
             "A road-step sweep (1001 samples) on a two-worker `LocalCluster` (one thread "
             "each) against one process, chunks of `chunk_size` designs sent with "
             "`client.get_executor()`. The overhead per chunk is CPU time: the client's and "
@@ -1300,10 +1256,9 @@ def main(argv=None) -> int:
             "single process's). The wall-clock "
             "speed-up is bounded by the cores actually free: on this 2-core machine shared "
             "with other work, less than two.",
-            "",
-            table(head, rows),
-            "",
-        ]
+            head,
+            rows,
+        )
         say("\n" + table(head, rows))
     lines, head, rows = interconnect_benchmark(quick)
     md += lines

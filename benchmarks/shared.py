@@ -24,6 +24,12 @@ def table(headers, rows) -> str:
     return "\n".join(out + [line(r) for r in rows])
 
 
+def section(title: str, text: str, head, rows) -> list[str]:
+    """A results section's Markdown lines: its heading, the text saying what was
+    measured and how, and its table."""
+    return [f"### {title}", "", text, "", table(head, rows), ""]
+
+
 def g(x, digits=3):
     return f"{x:.{digits}g}"
 

@@ -31,6 +31,7 @@ import functools
 
 import pytest
 from matplotlib.figure import Figure
+from qc_control.road import Bump
 
 from qc_control import report as report_package
 from qc_control.cli import parser as parser_module
@@ -112,7 +113,7 @@ def half_car_report(tmp_path_factory) -> tuple:
         from qc_control.report import write_report
         from qc_control.studies.scenario import Scenario
 
-        cmp = Scenario(model="half", road={"kind": "bump", "speed": 10.0}, t_end=2.0).run()
+        cmp = Scenario(model="half", road=Bump(speed=10.0), t_end=2.0).run()
         out = tmp_path_factory.mktemp("half-car") / "report"
         _SHARED["half"] = (cmp, write_report(cmp, out, formats=("html",)))
     return _SHARED["half"]

@@ -278,7 +278,7 @@ def test_scenario_with_a_bump_stop_steps_to_every_event():
     The stop engages and releases in compression before the wheel flies; with events
     RK4 keeps order 4 (measured 3.94), stepping across the stop's kink it falls to 0.47.
     """
-    from qc_control.cli.scenario import Scenario
+    from qc_control.studies.scenario import Scenario
 
     cmp = Scenario(model="nonlinear", bump_stop=(0.05, 1e5)).run()
     nl = cmp.nonlinear

@@ -129,7 +129,7 @@ def test_a_comparison_is_its_problem_and_what_was_measured(both_paths):
 
 
 def test_the_scenario_states_its_run_by_the_studies_protocol():
-    from qc_control.cli.scenario import Scenario
+    from qc_control.studies.scenario import Scenario
 
     scenario = Scenario()
     assert isinstance(scenario, Provenance)

@@ -60,8 +60,14 @@ def rk4_largest_step():
     return max(10.0 / n for n in range(100, 200) if polynomial_error(10.0 / n, 4) <= 1e-3)
 
 
+#: The exercise's road: ISO 8608 class C at 20 m/s.
+CLASS_C = qc.road.ISO8608Road("C", speed=20.0)
+
+
 def wk(zeta):
-    m = qc.ride_metrics_spectral(qc.QuarterCarParams(zeta=zeta), "C", 20.0)
+    m = qc.ride_metrics_spectral(
+        qc.QuarterCarParams(zeta=zeta), qc.road.ISO8608Road("C", speed=20.0)
+    )
     return m[[k for k in m.index if "wk" in k.lower()][0]]
 
 

@@ -26,11 +26,12 @@ import control
 import numpy as np
 import pandas as pd
 import pytest
+from qc_control.road import Bump
 from reports_shared import placeholder_figures, untimed, without_pdf  # noqa: F401  (fixtures)
 
 import qc_control as qc
 from qc_control.cli.console import main
-from qc_control.cli.scenario import Scenario
+from qc_control.studies.scenario import Scenario
 
 ROOT = Path(__file__).parent.parent
 browser = chromium.browser  # the module-scoped fixture
@@ -363,7 +364,7 @@ def test_every_road_redraws_and_a_too_coarse_step_gets_the_scenarios_message():
     page.widgets["road"].value = "bump"
     page.widgets["h"].value = 20.0  # the 1 m bump at 20 m/s lasts 50 ms: 4 steps need 12.5 ms
     with pytest.raises(ValueError) as refusal:
-        Scenario(road={"kind": "bump"}, h=0.02)
+        Scenario(road=Bump(), h=0.02)
     assert html_text(str(refusal.value).split("] ", 1)[1]) in page.status.object
     page.widgets["h"].value = None
     assert "h must be given: the box is empty" in page.status.object

@@ -60,7 +60,7 @@ def test_negative_seed_is_named():
 
 def test_spectral_metrics_refuse_too_few_points():
     with pytest.raises(ValueError, match="points must be an integer >= 2.*got 1"):
-        qc.ride_metrics_spectral(qc.QuarterCarParams(), "C", 20.0, points=1)
+        qc.ride_metrics_spectral(qc.QuarterCarParams(), road.ISO8608Road("C", speed=20.0), points=1)
 
 
 def test_empty_design_grid_is_refused():

@@ -29,7 +29,9 @@ References and tolerances, each with its source:
   the method's.
 """
 
+import importlib.util
 import warnings
+from pathlib import Path
 
 import control
 import numpy as np
@@ -332,41 +334,22 @@ def test_discrete_and_static_systems_as_control():
 # ---------------------------------------------------------------- the interconnection fast path
 
 
-def _car_with_velocities():
-    """The seed car as a StateSpace with the body and wheel velocities as extra outputs."""
-    ss = qc.quarter_car(road=True, actuator=True)
-    A, B, C, D = (np.asarray(m) for m in (ss.A, ss.B, ss.C, ss.D))
-    car = control.ss(
-        A,
-        B,
-        np.vstack([C, np.eye(4)[:2]]),
-        np.vstack([D, np.zeros((2, 2))]),
-        states=ss.state_labels,
-        inputs=ss.input_labels,
-        outputs=[*ss.output_labels, "vs_m", "vu_m"],
-        name="car",
-    )
-    return ss, car
+def _benchmark_module(name: str):
+    """A module of benchmarks/ (beside run.py, not a package), loaded by its path."""
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"benchmarks_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
-def _car_and_skyhook(c_sky=3000.0):
-    """The seed car (a StateSpace, velocities as extra outputs) and a clipped skyhook (nlsys)."""
-    ss, car = _car_with_velocities()
-
-    def skyhook(t, x, u, p):  # Karnopp's clipped skyhook, force limited to fmax
-        vs, vu = u
-        f = p["c_sky"] * vs if vs * (vs - vu) > 0 else 0.0
-        return [-min(max(f, -p["fmax"]), p["fmax"])]
-
-    ctrl = control.nlsys(
-        None,
-        skyhook,
-        inputs=["vs_m", "vu_m"],
-        outputs=["fa"],
-        name="skyhook",
-        params={"c_sky": c_sky, "fmax": 2000.0},
-    )
-    return control.interconnect([car, ctrl], inputs="zr", outputs=ss.output_labels, name="cl")
+# The car and clipped skyhook benchmarks/run.py times: the fast path is checked on
+# the very system whose speed-up benchmarks/RESULTS.md reports.
+_skyhook_car = _benchmark_module("skyhook_car")
+_car_with_velocities, _car_and_skyhook = (
+    _skyhook_car.car_with_velocities,
+    _skyhook_car.car_with_skyhook,
+)
 
 
 def test_fast_path_equals_the_rhs_path_to_rounding():

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from conftest import gallery_run
 
-from qc_control.cli.scenario import Scenario
 from qc_control.models.quarter import quarter_car
 from qc_control.ride.road import bump
+from qc_control.studies.scenario import Scenario
 from qc_control.studies.scenarios import POTHOLE, peak_table, pothole_comparison, pothole_road
 
 T = np.linspace(0.0, 3.0, 3001)

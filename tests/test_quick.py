@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 
 import qc_control as qc
-from qc_control.cli.scenario import Scenario, whole_step
 from qc_control.numerics.stability import stability_boundary, step_verdict
+from qc_control.numerics.steps import whole_step
 from qc_control.studies.quick import error_ladder, ladder_steps, quick_comparison
+from qc_control.studies.scenario import Scenario
 
 METHODS = ("euler", "midpoint", "heun", "rk4")
 

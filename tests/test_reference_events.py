@@ -176,7 +176,7 @@ def test_a_car_at_rest_has_an_exact_reference():
 @pytest.mark.slow
 def test_scenario_with_a_stop_of_clearance_0():
     """`Scenario(model='nonlinear', bump_stop=(0, 1e5)).run()`, against the hand solve."""
-    from qc_control.cli.scenario import Scenario
+    from qc_control.studies.scenario import Scenario
 
     cmp = Scenario(model="nonlinear", bump_stop=(0, 1e5)).run()
     x = np.asarray(cmp.reference.states)

@@ -23,12 +23,13 @@ import math
 import numpy as np
 import pytest
 import scipy.linalg
+from qc_control.road import Bump, Sine, Step
 from reports_shared import use_placeholders, use_untimed
 
 import qc_control as qc
 from qc_control.cli.console import main
-from qc_control.cli.scenario import BumpRoad, Scenario, SineRoad, StepRoad
 from qc_control.studies.compare import nonlinear_reference
+from qc_control.studies.scenario import Scenario
 
 P = qc.QuarterCarParams()
 HEIGHT = 0.05  # the step's default height [m]
@@ -69,7 +70,7 @@ def assert_matches(x, expected):
 
 
 def scenario_reference(t0, t_end=0.5, h=None):
-    sc = Scenario(model="nonlinear", road=StepRoad(t0=t0), t_end=t_end, h=h)
+    sc = Scenario(model="nonlinear", road=Step(t0=t0), t_end=t_end, h=h)
     vehicle, T, U, _ = sc.problem()
     assert U is None  # the nonlinear car takes the road as a function of time
     return T, nonlinear_reference(vehicle.system, T, 0.0, sc.x0, events=True)
@@ -113,9 +114,9 @@ def test_a_left_continuous_road_function_with_its_jump():
 
 def test_the_comparison_measures_against_the_same_reference():
     """`Scenario.run` (what `qc-control report` runs) on both commands' scenarios."""
-    cmp = Scenario(model="nonlinear", road=StepRoad(t0=0.5), t_end=0.5).run()
+    cmp = Scenario(model="nonlinear", road=Step(t0=0.5), t_end=0.5).run()
     np.testing.assert_array_equal(np.asarray(cmp.reference.states), 0.0)
-    cmp = Scenario(model="nonlinear", road=StepRoad(t0=0.4999), t_end=0.5, h=0.01).run()
+    cmp = Scenario(model="nonlinear", road=Step(t0=0.4999), t_end=0.5, h=0.01).run()
     assert_matches(np.asarray(cmp.reference.states), rest_then_step(cmp.T, 0.4999))
 
 
@@ -146,9 +147,9 @@ def test_cli_report_of_a_step_at_the_end(options, pictures, tmp_path, capsys, mo
 
 def test_jumps_of_the_roads():
     """A step jumps at t0; a bump, a sine road and no road are continuous."""
-    assert StepRoad(t0=0.3).jumps == (0.3,)
-    assert BumpRoad().jumps == SineRoad().jumps == ()
-    sc = Scenario(model="nonlinear", road=StepRoad(t0=0.3), t_end=1.0)
+    assert Step(t0=0.3).jumps == (0.3,)
+    assert Bump().jumps == Sine().jumps == ()
+    sc = Scenario(model="nonlinear", road=Step(t0=0.3), t_end=1.0)
     assert sc.vehicle_model(road=True).system.jumps == (0.3,)
     assert qc.nonlinear_quarter_car().jumps == qc.nonlinear_quarter_car(road=False).jumps == ()
 
@@ -156,13 +157,13 @@ def test_jumps_of_the_roads():
 @pytest.mark.parametrize(
     "road",
     [
-        StepRoad(t0=0.3),
-        StepRoad(height=-0.02, t0=0.0),
-        BumpRoad(),
-        BumpRoad(height=0.2, length=8.0, speed=20.0, t0=0.1),  # the nonlinear car's default
-        BumpRoad(height=0.1, length=1.3, speed=15.0, t0=0.2),  # no power of 2 to divide by
-        SineRoad(),
-        SineRoad(amplitude=0.03, frequency=7.3),
+        Step(t0=0.3),
+        Step(height=-0.02, t0=0.0),
+        Bump(),
+        Bump(height=0.2, length=8.0, speed=20.0, t0=0.1),  # the nonlinear car's default
+        Bump(height=0.1, length=1.3, speed=15.0, t0=0.2),  # no power of 2 to divide by
+        Sine(),
+        Sine(amplitude=0.03, frequency=7.3),
     ],
     ids=repr,
 )
@@ -171,8 +172,8 @@ def test_a_road_at_one_time_is_its_samples_to_the_last_bit(road):
     other cars and the report on the grid (`samples`, `qc_control.ride.road`'s
     functions): the same number at every time, bit for bit, the step's and the
     bump's edges and the floats either side of them among the times."""
-    edges = [road.t0] if isinstance(road, StepRoad) else []
-    if isinstance(road, BumpRoad):
+    edges = [road.t0] if isinstance(road, Step) else []
+    if isinstance(road, Bump):
         edges = [road.t0, road.t0 + road.length / road.speed]
     near = [np.nextafter(e, d) for e in edges for d in (-np.inf, np.inf)]
     rng = np.random.default_rng(8)

@@ -35,10 +35,10 @@ import pytest
 from reports_shared import use_placeholders
 from scipy.linalg import expm
 
-from qc_control.cli.scenario import Scenario
 from qc_control.report import write_report
 from qc_control.report.figures import work_precision_figure
 from qc_control.report.findings import _cheapest, _same_work
+from qc_control.studies.scenario import Scenario
 
 #: The four reports: the seed car's free response, the seed car over a 5 cm road
 #: step, the README's half car over a bump, the nonlinear car over its bump.

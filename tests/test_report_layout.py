@@ -5,11 +5,12 @@ import re
 
 import numpy as np
 import pytest
+from qc_control.road import Bump
 from reports_shared import run_untimed
 
-from qc_control.cli.scenario import Scenario
 from qc_control.report.comparison import _matrix, _system_blocks
 from qc_control.report.document import _CSS, Code
+from qc_control.studies.scenario import Scenario
 
 
 def parse(text: str, shape) -> np.ndarray:
@@ -27,7 +28,7 @@ def parse(text: str, shape) -> np.ndarray:
 
 @pytest.mark.parametrize("model", ["quarter", "half", "full"])
 def test_a_matrix_prints_in_aligned_blocks_that_fit_the_page(model):
-    sc = Scenario(model=model, road={"kind": "bump", "speed": 10.0})
+    sc = Scenario(model=model, road=Bump(speed=10.0))
     A = np.asarray(sc.entry.model(sc.vehicle, road=True).system.A)
     text = _matrix("A", A)
     for block in text.split("\n\n"):
@@ -52,7 +53,7 @@ def test_a_free_response_shows_no_empty_b(free_response):
 
 
 def test_a_forced_response_shows_b():
-    cmp = run_untimed(Scenario(road={"kind": "bump"}, t_end=1.0, methods=["rk4"]))
+    cmp = run_untimed(Scenario(road=Bump(), t_end=1.0, methods=["rk4"]))
     (code,) = [b for b in _system_blocks(cmp) if isinstance(b, Code)]
     assert "\nB =\n" in code.text
 
@@ -113,7 +114,7 @@ def test_the_title_names_the_vehicle_and_its_reference(model, title):
 
     from qc_control.report import report_title
 
-    sc = Scenario(model=model, road={"kind": "bump", "speed": 10.0})
+    sc = Scenario(model=model, road=Bump(speed=10.0))
     vehicle = sc.entry.model(sc.vehicle, road=True)
     study = object() if model == "nonlinear" else None  # what a nonlinear comparison carries
     assert report_title(SimpleNamespace(model=vehicle, nonlinear=study)) == title

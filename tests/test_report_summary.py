@@ -14,15 +14,16 @@ import re
 import numpy as np
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from qc_control.road import Bump
 from reports_shared import run_untimed
 from scipy.linalg import expm
 
 import qc_control as qc
-from qc_control.cli.scenario import Scenario
 from qc_control.report import build_blocks
 from qc_control.report.document import Heading, Paragraph
 from qc_control.report.figures import reference_figure
 from qc_control.report.summary import summary
+from qc_control.studies.scenario import Scenario
 
 pytestmark = pytest.mark.slow  # each builds a full comparison (seconds each)
 
@@ -70,9 +71,7 @@ def test_the_seed_cars_answer_is_rk4_confirmed_by_a_run(seed):
 
 
 def test_a_method_past_its_limit_is_the_summarys_first_word():
-    cmp = run_untimed(
-        Scenario(model="half", road={"kind": "bump", "speed": 10.0}, h=0.01, t_end=3.0)
-    )
+    cmp = run_untimed(Scenario(model="half", road=Bump(speed=10.0), h=0.01, t_end=3.0))
     first = summary(cmp)[0]
     assert first.startswith("Warning: at h = 0.01 s euler (h_max = 0.006807 s) is beyond")
 

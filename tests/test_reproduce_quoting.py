@@ -14,7 +14,7 @@ import sys
 
 import pytest
 
-from qc_control.cli.scenario import command_line
+from qc_control.studies.scenario_command import command_line
 
 #: Values a design name, a path or a number can bring into the line.
 AWKWARD = [

@@ -9,19 +9,21 @@ import math
 
 import numpy as np
 import pytest
+from qc_control.road import Bump, Sine
 
 from qc_control.cli import parser
-from qc_control.cli.scenario import BumpRoad, Scenario, ScenarioError, SineRoad
 from qc_control.ride.road import BUMP_STEPS, SINE_STEPS
+from qc_control.studies.scenario import Scenario
+from qc_control.studies.scenario_toml import ScenarioError
 
-SHORT_BUMP = {"kind": "bump", "length": 0.05, "speed": 30.0}  # 1.67 ms long
-FAST_SINE = {"kind": "sine", "frequency": 80.0}  # above the 50 Hz Nyquist limit of h = 10 ms
+SHORT_BUMP = Bump(length=0.05, speed=30.0)  # 1.67 ms long
+FAST_SINE = Sine(frequency=80.0)  # above the 50 Hz Nyquist limit of h = 10 ms
 
 
 def test_the_issues_short_bump_falls_between_the_samples_of_ten_ms():
     # the reproduction: at h = 10 ms every sample of this bump is zero
     T = np.linspace(0.0, 10.0, 1001)
-    assert np.max(BumpRoad(length=0.05, speed=30.0).samples(T)) == 0.0
+    assert np.max(Bump(length=0.05, speed=30.0).samples(T)) == 0.0
 
 
 @pytest.mark.parametrize(
@@ -45,12 +47,12 @@ def test_the_default_step_is_refined_with_a_note(road):
 
 
 def test_the_thresholds_are_exact():
-    bump = BumpRoad(length=1.0, speed=20.0)  # 50 ms
+    bump = Bump(length=1.0, speed=20.0)  # 50 ms
     assert bump.largest_step() == pytest.approx(0.05 / BUMP_STEPS, rel=1e-15)
     Scenario(road=bump, h=0.0125, t_end=10.0)  # exactly four steps across it
     with pytest.raises(ScenarioError, match="too coarse"):
         Scenario(road=bump, h=0.0125 * 1.01, t_end=0.0125 * 1.01 * 800)
-    sine = SineRoad(frequency=10.0)
+    sine = Sine(frequency=10.0)
     assert sine.largest_step() == pytest.approx(0.01, rel=1e-15)  # ten steps per 0.1 s period
     Scenario(road=sine, h=0.01)
 
@@ -59,18 +61,18 @@ def test_four_steps_across_a_bump_catch_most_of_its_height():
     # a 1 − cos pulse spanning N steps has a sample within half a step of its
     # peak, so its largest sample is at least (1 + cos(π/N))/2 of the height
     floor = (1 + math.cos(math.pi / BUMP_STEPS)) / 2  # 0.854
-    bump = BumpRoad(height=0.05, length=0.05, speed=30.0)
+    bump = Bump(height=0.05, length=0.05, speed=30.0)
     h = bump.largest_step()
     for t0 in np.linspace(0.1, 0.1 + h, 7):  # every phase of the grid against the bump
         T = np.arange(0.0, 0.2, h)
-        zr = BumpRoad(height=0.05, length=0.05, speed=30.0, t0=t0).samples(T)
+        zr = Bump(height=0.05, length=0.05, speed=30.0, t0=t0).samples(T)
         assert zr.max() >= floor * 0.05 * (1 - 1e-12)
 
 
 def test_ten_steps_per_period_interpolate_a_sine_within_five_percent():
     # linear interpolation between samples θ = 2π/N apart errs by at most
     # A(1 − cos(θ/2)); for N = 10 that is 4.9 % of the amplitude
-    sine = SineRoad(amplitude=0.01, frequency=7.0)
+    sine = Sine(amplitude=0.01, frequency=7.0)
     h = sine.largest_step()
     T = np.arange(0.0, 1.0 + h / 2, h)
     fine = np.linspace(0.0, T[-1], 20001)

@@ -67,34 +67,6 @@ BAD = [
     (dict(x0=[0, 0, math.inf, 0]), "x0 must be 4 comma-separated numbers"),
     (dict(x0="0,0,a,0"), "vs, vu, xs, xu [m/s, m/s, m, m]; got '0,0,a,0'"),
     (dict(road=5), "[scenario] road must be a qc_control.road.Road"),
-    (dict(road={"kind": "wobble"}), "kind must be one of step, bump, sine, iso8608 or none, got"),
-    (
-        dict(road={"kind": "iso8608", "seed": -1}),
-        "[scenario.road] seed must be a whole number >= 0, got -1",
-    ),
-    (dict(road={"kind": "iso8608", "seed": 1.5}), "seed must be a whole number >= 0, got 1.5"),
-    (
-        dict(road={"kind": "iso8608", "road_class": "Z"}),
-        "road_class must be an ISO 8608 class, one of A, B",
-    ),
-    (
-        dict(road={"kind": "iso8608", "band": [3, 1]}),
-        "band must be (n_min, n_max) with 0 < n_min < n_max cycles/m",
-    ),
-    (dict(road={"kind": "bump", "length": 0}), "length must be a finite number > 0 m, got 0"),
-    (dict(road={"kind": "bump", "speed": -1}), "speed must be a finite number > 0 m/s, got -1"),
-    (dict(road={"kind": "sine", "frequency": 0}), "frequency must be a finite number > 0 Hz"),
-    (dict(road={"kind": "step", "height": "x"}), "height must be a finite number m, got 'x'"),
-    (
-        dict(road={"kind": "iso8608", "height": 0.1}),
-        "height = 0.1 does not apply to an iso8608 road: it is a parameter of step and bump",
-    ),
-    (dict(road={"kind": "step", "road_class": "C"}), "road_class = 'C' does not apply to a step"),
-    (dict(road={"seed": 3}), "seed = 3 does not apply without a road"),
-    (
-        dict(road={"kind": "bump", "foo": 1}),
-        "unknown [scenario.road] key 'foo'; a bump road takes height",
-    ),
     (dict(road=ISO8608Road(), h=0.01), "h = 0.01 s is too coarse for an ISO 8608 road at 20 m/s"),
     (dict(vehicle={"ms": -1}), "ms (sprung mass) must be a finite number > 0 kg, got -1"),
     (dict(vehicle={"ms": 1e200, "ks": 1e200}), "time scales span more than 1e+07: cs/mu"),
@@ -109,6 +81,47 @@ def test_each_bad_value_is_named(kwargs, words):
         Scenario(**kwargs)
     assert words in str(info.value)
     assert isinstance(info.value, ValueError)  # callers catching ValueError still do
+
+
+#: A road table of a TOML file (``[scenario.road]``), each bad value named with its
+#: section; a table given to `Scenario` itself is the deprecated form (it warns).
+BAD_ROAD_TABLES = [
+    ({"kind": "wobble"}, "kind must be one of step, bump, sine, iso8608 or none, got"),
+    (
+        {"kind": "iso8608", "seed": -1},
+        "[scenario.road] seed must be a whole number >= 0, got -1",
+    ),
+    ({"kind": "iso8608", "seed": 1.5}, "seed must be a whole number >= 0, got 1.5"),
+    (
+        {"kind": "iso8608", "road_class": "Z"},
+        "road_class must be an ISO 8608 class, one of A, B",
+    ),
+    (
+        {"kind": "iso8608", "band": [3, 1]},
+        "band must be (n_min, n_max) with 0 < n_min < n_max cycles/m",
+    ),
+    ({"kind": "bump", "length": 0}, "length must be a finite number > 0 m, got 0"),
+    ({"kind": "bump", "speed": -1}, "speed must be a finite number > 0 m/s, got -1"),
+    ({"kind": "sine", "frequency": 0}, "frequency must be a finite number > 0 Hz"),
+    ({"kind": "step", "height": "x"}, "height must be a finite number m, got 'x'"),
+    (
+        {"kind": "iso8608", "height": 0.1},
+        "height = 0.1 does not apply to an iso8608 road: it is a parameter of step and bump",
+    ),
+    ({"kind": "step", "road_class": "C"}, "road_class = 'C' does not apply to a step"),
+    ({"seed": 3}, "seed = 3 does not apply without a road"),
+    (
+        {"kind": "bump", "foo": 1},
+        "unknown [scenario.road] key 'foo'; a bump road takes height",
+    ),
+]
+
+
+@pytest.mark.parametrize("table, words", BAD_ROAD_TABLES)
+def test_each_bad_value_of_a_road_table_is_named(table, words):
+    with pytest.raises(ScenarioError) as info:
+        Scenario.from_mapping({"scenario": {"road": table}})
+    assert words in str(info.value)
 
 
 # -------------------------------------------------------------- defaults

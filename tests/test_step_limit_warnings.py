@@ -14,10 +14,10 @@ import pytest
 
 import qc_control as qc
 from qc_control.cli import parser
-from qc_control.cli.scenario import Scenario
 from qc_control.report.figures import DIVERGED_RANGE, diverged_at, overlay_figure
+from qc_control.studies.scenario import Scenario
 
-BUMP = {"kind": "bump", "speed": 10.0}
+BUMP = qc.road.Bump(speed=10.0)
 
 
 def euler_limit(system) -> float:

@@ -14,11 +14,11 @@ from reports_shared import placeholder_figures, untimed, without_pdf  # noqa: F4
 
 import qc_control as qc
 from qc_control.cli.parser import run
-from qc_control.cli.scenario import Scenario
 from qc_control.models.modal import modal_analysis
 from qc_control.models.quarter import QuarterCarParams, quarter_car, quarter_car_model
 from qc_control.numerics.stability import max_stable_step
 from qc_control.studies.compare import compare_methods
+from qc_control.studies.scenario import Scenario
 
 
 def _maxwell_matrix(p: QuarterCarParams, km: float) -> np.ndarray:

@@ -6,24 +6,31 @@ is reported of them, and that the table and the figure read one measurement.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pandas as pd
 import pytest
 
 import qc_control as qc
+from qc_control.studies import timing
 from qc_control.studies.timing import Timing, interleaved_times, same_work
 
 
-def test_runs_take_turns_in_each_round_and_the_order_flips():
+def test_runs_take_turns_in_each_round_and_the_order_flips(monkeypatch):
+    # a turn repeats a short run until the turn time has passed: an endless turn
+    # time makes every turn its most calls whatever the machine's speed
+    monkeypatch.setattr(timing, "_TURN_TIME", math.inf)
+    n = timing._MOST_CALLS
     calls: list[str] = []
     runs = {k: (lambda k=k: calls.append(k)) for k in "abc"}
     times = interleaved_times(runs, rounds=3, warmup=True)
-    # a warm-up call each, then per round a turn each of 5 consecutive calls (a
+    # a warm-up call each, then per round a turn each of n consecutive calls (a
     # short run's turn: its least disturbed call is kept), the order flipping
-    turns = [calls[3 + 5 * i] for i in range(9)]
+    turns = [calls[3 + n * i] for i in range(9)]
     assert calls[:3] == list("abc") and turns == list("abc") + list("cba") + list("abc")
-    assert all(len(set(calls[3 + 5 * i : 8 + 5 * i])) == 1 for i in range(9))
-    assert len(calls) == 3 + 3 * 3 * 5
+    assert all(len(set(calls[3 + n * i : 3 + n * (i + 1)])) == 1 for i in range(9))
+    assert len(calls) == 3 + 3 * 3 * n
     assert set(times) == set("abc") and all(t.rounds == 3 for t in times.values())
     for t in times.values():
         assert 0 <= t.low <= t.wall <= t.high and t.cpu >= 0

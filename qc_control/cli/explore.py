@@ -40,6 +40,7 @@ from ..numerics.messages import install_hint
 from ..numerics.methods import TABLEAUS
 from ..numerics.stability import stability_boundary
 from ..numerics.steps import whole_step
+from ..studies import columns as col
 from ..studies.compare import DEFAULT_METHODS
 from ..studies.quick import QuickComparison, error_ladder, ladder_steps, quick_comparison
 from ..studies.scenario import Scenario
@@ -434,7 +435,7 @@ class _Page:
             mine = ladder[ladder["method"] == method]
             src["conv"].data = {"x": mine["h"].to_numpy(), "y": mine["error"].to_numpy()}
             src["ladder"] = ladder
-        at_h = quick.table.loc[method, "max |xs err| [m]"]
+        at_h = quick.table.loc[method, col.max_error("xs", "m")]
         src["mark"].data = {"x": [quick.h], "y": [at_h]}
         if not len(src["region"].data["xs"]):
             curves = _boundary(method)
@@ -445,16 +446,16 @@ class _Page:
 
     def _tables(self, sc: Scenario, quick: QuickComparison, label: str, unit: str) -> None:
         table = quick.table
-        err = f"max |{label} err| [{unit}]"
+        err, xs_err = col.max_error(label, unit), col.max_error("xs", "m")
         handin = pd.DataFrame(
             {
-                "order": table["order"],
-                "h [s]": quick.h,
-                "RHS evals": table["RHS evals"],
+                col.ORDER: table[col.ORDER],
+                col.STEP: quick.h,
+                col.RHS_EVALS: table[col.RHS_EVALS],
                 err: table[err],
-                "max |xs err| [m]": table["max |xs err| [m]"],
-                "h_max [s]": table["h_max [s]"],
-                "limited by": table["limited by"],
+                xs_err: table[xs_err],
+                col.H_MAX: table[col.H_MAX],
+                col.LIMITED_BY: table[col.LIMITED_BY],
             }
         )
         handin = handin.loc[:, ~handin.columns.duplicated()]

@@ -124,10 +124,13 @@ class DefaultRun:
     t_end, h : float
         End time and step [s].
     road : mapping or None
-        The default road, ``{'kind': 'bump', 'height': ...}``
-        (`qc_control.cli.scenario.road_from_mapping`'s layout), or None for
-        no road (the free response). A road of the same kind given in part
-        takes the rest of its parameters from this one.
+        The default road, ``{'kind': 'bump', 'height': ...}``, in the layout of
+        a TOML file's ``[scenario.road]`` table (the
+        `qc_control.road.Road` it describes is
+        `qc_control.studies.scenario_toml.road_from_mapping`'s), or None for
+        no road (the free response). A table, not a ``Road``: the roads live in
+        ``ride``, a layer above the models. A road of the same kind given in
+        part takes the rest of its parameters from this one.
     x0 : sequence of float or None
         The free response's start, in state order; None: the body
         (``roles.body_disp``) released from ``release`` [m], every other

@@ -249,8 +249,8 @@ def peer_blocks(cmp, figs: dict[str, Image]) -> list:
             "counted at the right-hand side itself: scipy's nfev, plus n per finite-difference "
             "Jacobian that Radau and BDF build outside it (LSODA's are inside its nfev). "
             "The methods' times are those of qc's default engine (for a linear car the "
-            "LTI engine, which gives the same trajectory as stepping; best of 3), the "
-            "peers' the best of their runs."
+            "LTI engine, which gives the same trajectory as stepping), the peers' as they "
+            "run; each is the median of its interleaved timing rounds."
         ),
         figs["peers_evaluations.png"],
         figs["peers_time.png"],

@@ -204,7 +204,7 @@ def _sampled_designs(car: VehicleModel) -> dict[str, Callable[[], tuple[VehicleM
             limits={"fa": FORCE_LIMIT, "susp_travel": TRAVEL_LIMIT},
             preview=preview,
         )
-        return closed_loop(car, law), f"LQR's weights, OSQP, {law.description}"
+        return closed_loop(car, law), f"LQR's weights, DAQP, {law.description}"
 
     return {
         "LQR, sampled": lqr,

@@ -308,7 +308,9 @@ def measure_linear(
 
 def engine_times(problem: ComparisonProblem, convergence: pd.DataFrame) -> pd.DataFrame:
     """The fixed-step ladder timed as a user runs it: a linear car through the LTI engine
-    (qc's default for it, the same trajectory), best of 3; a nonlinear one as stepped.
+    (qc's default for it, the same trajectory), in 3 interleaved rounds
+    (`qc_control.studies.timing`, as the comparison times its runs); a nonlinear
+    one as stepped.
 
     A step beyond a method's stability limit is one the default engine steps step
     by step (a diverging run, never among the cheapest): its time is the
@@ -318,16 +320,14 @@ def engine_times(problem: ComparisonProblem, convergence: pd.DataFrame) -> pd.Da
         return convergence
     tabs = {t.name: t for t in problem.methods}
     eig = np.linalg.eigvals(np.asarray(problem.system.A, dtype=float))
-    times = []
-    for method, level, stepped in zip(
-        convergence[col.METHOD], convergence[col.LEVEL], convergence[col.TIME]
-    ):
+    runs: dict[int, Callable[[], object]] = {}
+    times = list(convergence[col.TIME])
+    for row, (method, level) in enumerate(zip(convergence[col.METHOD], convergence[col.LEVEL])):
         T, U = refined(problem.T, level), refined_input(problem.T, problem.U, level)
-        if _stepped_by_default(tabs[method], T, problem.substeps, eig):
-            times.append(stepped)
-            continue
-        run = functools.partial(
-            _simulate, problem.system, T, problem.X0, U, tabs[method], problem.substeps
-        )
-        times.append(best_time(run, 3, warmup=True))
+        if not _stepped_by_default(tabs[method], T, problem.substeps, eig):
+            runs[row] = functools.partial(
+                _simulate, problem.system, T, problem.X0, U, tabs[method], problem.substeps
+            )
+    for row, timing in interleaved_times(runs, 3).items():
+        times[row] = timing.wall
     return convergence.assign(time=times)
