@@ -39,7 +39,7 @@ from qc_control.studies.sweeps import DEFAULT_METRICS, design_grid, sweep
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from explore_redraw import browser_redraw_benchmark  # noqa: E402
 from mpc_solvers import mpc_solvers_benchmark  # noqa: E402
-from shared import g, other_cores_busy, section, table  # noqa: E402
+from shared import g, other_cores_busy, section, table, titled  # noqa: E402
 from skyhook_car import car_with_skyhook  # noqa: E402
 
 X0 = np.array([0.0, 0.0, 0.05, 0.0])
@@ -502,16 +502,13 @@ def interconnect_benchmark(quick: bool) -> tuple[list[str], list[str], list[list
         ["qc RK4 h = 1 ms, sys._rhs", g(t_rhs), g(t_control / t_rhs), g(err_ours)],
         ["control.input_output_response (RK45 defaults)", g(t_control), "1", g(err_theirs)],
     ]
-    md = section(
-        "Nonlinear interconnection: car + clipped skyhook",
+    text = (
         f"The seed car (`control.ss`) and a clipped skyhook (`control.nlsys`) joined by "
         f"`control.interconnect`, on an ISO 8608 class C road at 20 m/s, 0-{t_end:g} s. "
         "Times: paired CPU-time medians; errors against RK4 at h = 1/32 ms (the skyhook's "
-        "force jumps, which makes solve_ivp at tight tolerance take minutes).",
-        head,
-        rows,
+        "force jumps, which makes solve_ivp at tight tolerance take minutes)."
     )
-    return md, head, rows
+    return titled("Nonlinear interconnection: car + clipped skyhook", text, head, rows)
 
 
 def nonlinear_sweep_benchmark(quick: bool) -> tuple[list[str], list[str], list[list[str]]]:
@@ -575,8 +572,7 @@ def nonlinear_sweep_benchmark(quick: bool) -> tuple[list[str], list[str], list[l
                 g(gap, 2),
             ]
         )
-    md = section(
-        "Nonlinear design sweeps: all designs stepped at once",
+    text = (
         f"{len(designs)} designs of the nonlinear quarter car (ks × cs grid; body 301.2 kg, "
         "wheel 40 kg, unilateral tire 200 kN/m with gravity, bump and rebound stops at 5 and "
         "8 cm), RK4 at h = 1 ms, "
@@ -587,11 +583,9 @@ def nonlinear_sweep_benchmark(quick: bool) -> tuple[list[str], list[str], list[l
         "and streams its default metrics; the loop calls `control.input_output_response` "
         "(solve_ivp RK45 at its defaults) on designs spread over the grid, scaled to all. "
         "CPU times, paired medians; the last column is the largest state difference of the "
-        "batch against `qc.input_output_response` on the timed designs.",
-        head,
-        rows,
+        "batch against `qc.input_output_response` on the timed designs."
     )
-    return md, head, rows
+    return titled("Nonlinear design sweeps: all designs stepped at once", text, head, rows)
 
 
 def mpc_benchmark(quick: bool) -> tuple[list[str], list[str], list[list[str]]]:
@@ -924,6 +918,17 @@ def busy_benchmark(quick: bool):
     return lines, head, rows, missed
 
 
+def take(md: list[str], lines: list[str], head, rows) -> None:
+    """A section into RESULTS.md's lines, and its table on the terminal as it comes."""
+    md.extend(lines)
+    print("\n" + table(head, rows))
+
+
+def put(md: list[str], title: str, text: str, head, rows, *notes: str) -> None:
+    """A section made here, with any paragraphs that read its table."""
+    take(md, section(title, text, head, rows, *notes), head, rows)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smoke mode: small sizes, 1 repeat")
@@ -1079,13 +1084,13 @@ def main(argv=None) -> int:
 
     # -- 2. generic stepper against hand-written loops (Python f)
     head, rows, text = loop_comparison(f, T, 1 if quick else 15)
-    md += section(
+    put(
+        md,
         "The generic stepper against a hand-written loop",
         text,
         head,
         rows,
     )
-    say("\n" + table(head, rows))
 
     # -- 3. work-precision: each method over h; solve_ivp over rtol
     rows = []
@@ -1115,14 +1120,14 @@ def main(argv=None) -> int:
             ivp[(solver, k)] = (err, t_run, sol.nfev)
             rows.append([solver, f"rtol = 1e-{k}", g(err), str(sol.nfev), g(t_run * 1e3)])
     head = ["method", "setting", "max |xs error| [m]", "RHS evaluations", "time [ms]"]
-    md += section(
+    put(
+        md,
         "Work and precision",
         "Error against control's exact response over "
         "0-10 s; solve_ivp evaluated at the finest grid's points (t_eval).",
         head,
         rows,
     )
-    say("\n" + table(head, rows))
 
     # solve_ivp at the tolerance that first reaches RK4's error on the default grid
     rk4_err = float(
@@ -1167,7 +1172,8 @@ def main(argv=None) -> int:
         for row in rows
         if float(row[4].split()[0]) < float(row[5].split()[-1])
     ]
-    md += section(
+    put(
+        md,
         "Design sweeps",
         f"{n_designs} designs (ks × ζ grid), RK4 at h = {h * 1e3:g} ms, {n_samples} samples; "
         f"the sweep computes its {len(DEFAULT_METRICS)} default metrics per design "
@@ -1177,7 +1183,6 @@ def main(argv=None) -> int:
         "the ratio is the median of the runs' ratios.",
         head,
         rows,
-    ) + [
         "What bounds the forced sweep: per sample and design, the road's effect inside a "
         "block is one product of (L+1) input samples with the design's p·L coefficients "
         "(2(L+1)p flops, L = 16, p = 4 outputs read) and the carries' part is 2np flops; "
@@ -1191,9 +1196,7 @@ def main(argv=None) -> int:
         "time comes from a backward search from where the bound proves the body inside "
         "its 2 % band. What remains is per chunk: validating designs, building each "
         "chunk's step maps, power tables, Gram sums and eigendecompositions.",
-        "",
-    ]
-    say("\n" + table(head, rows))
+    )
 
     head, rows, worst = memory_and_spectral(T, quick)
     missed += [
@@ -1203,7 +1206,8 @@ def main(argv=None) -> int:
     ]
     if float(rows[-1][3].split()[0]) > 1.0:
         missed.append(f"the spectral sweep took {rows[-1][3]} s (target ≤ 1 s)")
-    md += section(
+    put(
+        md,
         "10,000 designs: peak memory, and the spectral sweep",
         "Peak memory by tracemalloc (numpy's buffers included) above what was live before "
         "the call; times of one run for the simulated sweeps and median (min–max) of 5 for "
@@ -1214,10 +1218,10 @@ def main(argv=None) -> int:
         head,
         rows,
     )
-    say("\n" + table(head, rows))
 
     head, rows = scaling(quick, Path(__file__).parent)
-    md += section(
+    put(
+        md,
         "Scaling",
         "Road-step sweeps (RK4, h = 1 ms, default metrics): time (median of 3 runs, 1 for "
         "the largest) and peak memory against the number of designs and of samples; the "
@@ -1225,23 +1229,21 @@ def main(argv=None) -> int:
         + ("(plot: `benchmarks/scaling.png`)." if not quick else "(quick mode: no plot)."),
         head,
         rows,
-    ) + [
         "Time is linear in both (slope near 1) once the fixed costs (validating designs, "
         "building each chunk's powers) are amortised. Memory grows with the samples only "
         "through the input itself (T, U and its padded copy: 24 bytes a sample); a chunk "
         "holds a segment of outputs (~1 MB) and a run of block carries (~2 MB) whatever the "
         "length. It grows with the designs through what is kept per design: the parameters, "
         "their matrices and the result table (about 1 kB a design).",
-        "",
-    ]
-    say("\n" + table(head, rows))
+    )
     if not quick:
         md += ["![scaling](scaling.png)", ""]
 
     dask_rows = dask_comparison(quick)
     if dask_rows is not None:
         head, rows = dask_rows
-        md += section(
+        put(
+            md,
             "Distributed: Dask LocalCluster",
             "A road-step sweep (1001 samples) on a two-worker `LocalCluster` (one thread "
             "each) against one process, chunks of `chunk_size` designs sent with "
@@ -1259,18 +1261,15 @@ def main(argv=None) -> int:
             head,
             rows,
         )
-        say("\n" + table(head, rows))
     lines, head, rows = interconnect_benchmark(quick)
-    md += lines
-    say("\n" + table(head, rows))
+    take(md, lines, head, rows)
     missed += [
         f"car + skyhook, {row[0]}: {row[2]}x control (target ≥ 5)"
         for row in rows
         if "fast path" in row[0] and float(row[2]) < 5
     ]
     lines, head, rows = nonlinear_sweep_benchmark(quick)
-    md += lines
-    say("\n" + table(head, rows))
+    take(md, lines, head, rows)
     missed += [
         f"the nonlinear sweep on {row[0]}: {row[5]}x a loop of control (target ≥ 300)"
         for row in rows
@@ -1285,13 +1284,11 @@ def main(argv=None) -> int:
         if not quick and float(row[3]) < 1000
     ]
     lines, head, rows, late = mpc_solvers_benchmark(quick)
-    md += lines
-    say("\n" + table(head, rows))
+    take(md, lines, head, rows)
     missed += late
 
     lines, head, rows, late = busy_benchmark(quick)
-    md += lines
-    say("\n" + table(head, rows))
+    take(md, lines, head, rows)
     missed += late
 
     lines, head, rows = browser_redraw_benchmark(quick)
@@ -1304,13 +1301,11 @@ def main(argv=None) -> int:
     ]
 
     lines, head, rows, late = identification_benchmark(quick)
-    md += lines
-    say("\n" + table(head, rows))
+    take(md, lines, head, rows)
     missed += late
 
     lines, head, rows = work_precision_benchmark(quick)
-    md += lines
-    say("\n" + table(head, rows))
+    take(md, lines, head, rows)
 
     md += [
         "## What failed",

@@ -24,10 +24,18 @@ def table(headers, rows) -> str:
     return "\n".join(out + [line(r) for r in rows])
 
 
-def section(title: str, text: str, head, rows) -> list[str]:
+def section(title: str, text: str, head, rows, *notes: str) -> list[str]:
     """A results section's Markdown lines: its heading, the text saying what was
-    measured and how, and its table."""
-    return [f"### {title}", "", text, "", table(head, rows), ""]
+    measured and how, its table, and any paragraphs that read the table."""
+    return [f"### {title}", "", text, "", table(head, rows), ""] + [
+        line for note in notes for line in (note, "")
+    ]
+
+
+def titled(title: str, text: str, head, rows) -> tuple[list[str], list, list]:
+    """A benchmark's result: its section's lines, and its table's head and rows on
+    their own (RESULTS.md takes the section; a ``--only`` smoke run, the table)."""
+    return section(title, text, head, rows), head, rows
 
 
 def g(x, digits=3):
