@@ -20,7 +20,7 @@ import pandas as pd
 import qc_control as qc
 from qc_control.models.controllers import HINF_AVAILABLE
 from qc_control.report.control import transmissibility_chart
-from qc_control.report.outputs import output_folder, show_inline
+from qc_control.report.outputs import output_folder, save_and_show
 from qc_control.studies.control_study import compare_controllers
 
 out = output_folder("active_suspension")  # OUT_DIR from the command line, if any
@@ -55,8 +55,7 @@ with pd.option_context("display.width", 200, "display.max_columns", 20):
     )
 for signal in ("body_acc", "tire_defl"):
     fig = transmissibility_chart(cmp, signal)
-    fig.savefig(out / f"transmissibility_{signal}.png", dpi=100)
-    show_inline(fig)
+    save_and_show(fig, out / f"transmissibility_{signal}.png", dpi=100)
 
 # the passive comfort / road-holding front, with the linear controllers marked
 front = qc.pareto_front(
@@ -65,6 +64,5 @@ front = qc.pareto_front(
     travel_limit=0.05,
     controllers={"skyhook": qc.closed_loop(car, qc.skyhook(3000.0)), "LQR": lqr},
 )
-front.figure.savefig(out / "pareto.png", dpi=100)
-show_inline(front.figure)
+save_and_show(front.figure, out / "pareto.png", dpi=100)
 print(f"{len(front.designs)} non-dominated passive designs of {len(front.all_designs)}")

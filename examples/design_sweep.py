@@ -17,7 +17,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.report.outputs import output_folder, show_inline
+from qc_control.report.outputs import output_folder, save_and_show
 
 out = output_folder("design_sweep")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
@@ -48,8 +48,7 @@ ax.set(
 )
 fig.legend(fontsize="small", loc="outside right upper")  # outside: never over a curve
 ax.grid(alpha=0.3)
-fig.savefig(out / "design_sweep.png", dpi=110)
-show_inline(fig)
+save_and_show(fig, out / "design_sweep.png", dpi=110)
 
 best = table.loc[table["rms_body_acc [m/s²]"].idxmin()]
 print(

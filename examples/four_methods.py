@@ -18,7 +18,7 @@ import control
 import numpy as np
 
 import qc_control as qc
-from qc_control.report.outputs import output_folder, show_inline
+from qc_control.report.outputs import output_folder, save_and_show
 from qc_control.report.plotting import output_signal, plot_outputs
 
 out = output_folder("four_methods")  # OUT_DIR from the command line, if any
@@ -39,12 +39,10 @@ for method, resp in runs.items():
 # below it. Midpoint and Heun give the same trajectory on this linear model:
 # the figure draws Heun dashed over Midpoint and says so in the legend.
 fig = plot_outputs(runs, "xs", reference=exact, reference_label="exact (control)")
-fig.savefig(out / "four_methods.png", dpi=120)
-show_inline(fig)
+save_and_show(fig, out / "four_methods.png", dpi=120)
 
 # %%
 # Any output by its label: the body acceleration, in m/s².
 fig = plot_outputs(runs, "body_acc", reference=exact, reference_label="exact (control)")
-fig.savefig(out / "four_methods_body_acc.png", dpi=120)
-show_inline(fig)
+save_and_show(fig, out / "four_methods_body_acc.png", dpi=120)
 print(f"wrote {out / 'four_methods.png'} and {out / 'four_methods_body_acc.png'}")

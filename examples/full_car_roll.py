@@ -23,7 +23,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.report.outputs import output_folder, show_inline
+from qc_control.report.outputs import output_folder, save_and_show
 
 out = output_folder("full_car_roll")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
@@ -59,6 +59,5 @@ acc_ax.set(xlabel="time [s]", ylabel="roll acceleration [rad/s²]")
 for ax in (roll_ax, acc_ax):
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")
-fig.savefig(out / "full_car_roll.png", dpi=110)
-show_inline(fig)
+save_and_show(fig, out / "full_car_roll.png", dpi=110)
 print(f"wrote {out / 'full_car_roll.png'}")

@@ -23,7 +23,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.report.outputs import output_folder, show_inline
+from qc_control.report.outputs import output_folder, save_and_show
 
 out = output_folder("half_car_pitch")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
@@ -56,8 +56,7 @@ pitch_ax.set(xlabel="time [s]", ylabel="pitch θ [deg] (nose up +)")
 for ax in (heave_ax, pitch_ax):
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")
-fig.savefig(out / "half_car_bump.png", dpi=110)
-show_inline(fig)
+save_and_show(fig, out / "half_car_bump.png", dpi=110)
 
 # %%
 # Wheelbase filtering at 15 m/s: the notches of heave and pitch.
@@ -75,8 +74,7 @@ for k, fk in enumerate(tr.wheelbase_notches("heave")):
 ax.set(xlabel="frequency [Hz]", title=f"One road under both axles at {speed:g} m/s")
 ax.grid(alpha=0.3, which="both")
 ax.legend(fontsize="small", loc="lower left")
-fig.savefig(out / "half_car_wheelbase_filtering.png", dpi=110)
-show_inline(fig)
+save_and_show(fig, out / "half_car_wheelbase_filtering.png", dpi=110)
 print(f"\nwheelbase {L:.3f} m at {speed:g} m/s, V/(a+b) = {speed / L:.3f} Hz")
 for signal, label in (("heave", "heave_acc"), ("pitch", "pitch_acc")):
     gain = np.abs(tr.response[label])

@@ -23,7 +23,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.report.outputs import output_folder, show_inline
+from qc_control.report.outputs import output_folder, save_and_show
 
 out = output_folder("lift_off")  # OUT_DIR from the command line, if any
 
@@ -70,6 +70,5 @@ for ax in (ax1, ax2):
     for t in reference.t_events:
         ax.axvline(t, color="grey", lw=0.8, ls="--")
     ax.legend()
-fig.savefig(out / "lift_off.png", dpi=100)
-show_inline(fig)
+save_and_show(fig, out / "lift_off.png", dpi=100)
 print(f"wrote {out / 'lift_off.png'}")

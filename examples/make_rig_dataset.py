@@ -25,7 +25,7 @@ import scipy.signal
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.report.outputs import output_folder, show_inline
+from qc_control.report.outputs import output_folder, save_and_show
 
 #: The car the records come from (the answer the identification should find).
 TRUE_CAR = dict(ms=320.0, mu=45.0, ks=22000.0, ku=190000.0, cs=1800.0, cu=150.0)
@@ -115,5 +115,4 @@ if __name__ == "__main__":
         ax.set_ylabel(f"{label} [{unit}]")
     axes[-1].set_xlabel("time [s]")
     axes[0].set_title("Simulated rig record (not a measurement)")
-    fig.savefig(out / "rig_record.png", dpi=100)
-    show_inline(fig)
+    save_and_show(fig, out / "rig_record.png", dpi=100)

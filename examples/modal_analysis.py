@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.report.outputs import output_folder, show_inline
+from qc_control.report.outputs import output_folder, save_and_show
 
 out = output_folder("modal_analysis")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
@@ -39,8 +39,7 @@ bottom.axhline(
 )
 bottom.set(xlabel="tire stiffness / suspension stiffness, ku/ks [-]", ylabel="body frequency [Hz]")
 bottom.legend(fontsize="small", loc="lower right")
-fig.savefig(out / "modal_tire_stiffness.png", dpi=110)
-show_inline(fig)
+save_and_show(fig, out / "modal_tire_stiffness.png", dpi=110)
 print(
     f"\nAt ku/ks = 1000 the body's ζ is {body[-1].zeta:.4f} (nominal {seed.zeta}); "
     f"wrote {out / 'modal_tire_stiffness.png'}"

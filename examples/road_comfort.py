@@ -19,7 +19,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 import qc_control as qc
-from qc_control.report.outputs import output_folder, show_inline
+from qc_control.report.outputs import output_folder, save_and_show
 from qc_control.ride import road
 
 out = output_folder("road_comfort")  # OUT_DIR from the command line, if any
@@ -80,6 +80,5 @@ for ax in (left, right):
     ax.grid(alpha=0.3, which="both")
 # outside the axes: inside, class D's line ran under the legend
 fig.legend(*left.get_legend_handles_labels(), fontsize="small", loc="outside right upper")
-fig.savefig(out / "road_comfort.png", dpi=110)
-show_inline(fig)
+save_and_show(fig, out / "road_comfort.png", dpi=110)
 print(f"wrote {out / 'road_comfort.png'}")

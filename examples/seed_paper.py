@@ -16,7 +16,7 @@ import numpy as np
 import qc_control as qc
 from qc_control.report import SEED_FIGURES
 from qc_control.report.figures import method_figure
-from qc_control.report.outputs import output_folder, show_inline
+from qc_control.report.outputs import output_folder, save_and_show
 
 out = output_folder("seed_paper")  # OUT_DIR from the command line, if any
 print(f"writing into {out.resolve()}")
@@ -29,8 +29,7 @@ cmp = qc.compare_methods(qc.QuarterCarParams(), T, [0.0, 0.0, 0.05, 0.0], timing
 for method, number in SEED_FIGURES.items():  # Euler 3, Midpoint 4, RK4 5, Heun 6
     path = out / f"seed_figure_{number}_{method}.png"
     fig = method_figure(cmp, method)
-    fig.savefig(path, dpi=110)
-    show_inline(fig)
+    save_and_show(fig, path, dpi=110)
     print(f"Figure {number}: {path}")
 
 # %%

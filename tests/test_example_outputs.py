@@ -80,3 +80,27 @@ def test_show_inline_publishes_a_figure_in_a_kernel_and_is_silent_elsewhere(monk
     monkeypatch.setitem(sys.modules, "IPython", SimpleNamespace(get_ipython=lambda: shell))
     show_inline(object())
     assert published == [{"image/png": b"png"}]
+
+
+def test_save_and_show_writes_the_png_it_names_and_shows_it_in_a_kernel(tmp_path, monkeypatch):
+    import sys
+    from types import SimpleNamespace
+
+    from matplotlib.figure import Figure
+
+    from qc_control.report.outputs import save_and_show
+
+    shown = []
+    shell = SimpleNamespace(
+        display_formatter=SimpleNamespace(format=lambda obj: (obj, {})),
+        display_pub=SimpleNamespace(publish=lambda data, metadata: shown.append(data)),
+    )
+    monkeypatch.setitem(sys.modules, "IPython", SimpleNamespace(get_ipython=lambda: shell))
+    fig = Figure(figsize=(2, 1))
+    path = save_and_show(fig, tmp_path / "a.png", dpi=50)
+    assert path == tmp_path / "a.png"
+    # a PNG's signature, and 2 x 1 inches at 50 dpi: the size the call asked for
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    assert int.from_bytes(data[16:20], "big") == 100 and int.from_bytes(data[20:24], "big") == 50
+    assert shown == [fig]

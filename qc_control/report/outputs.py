@@ -6,7 +6,8 @@ gallery, and as the gallery's downloadable notebooks. In a Jupyter kernel
 so an example that read ``sys.argv[1]`` wrote into a folder named ``-f``.
 `output_folder` takes the folder from its argument, else from the command
 line of a script, else the default; `show_inline` displays a figure in a
-notebook and does nothing elsewhere.
+notebook and does nothing elsewhere; `save_and_show` does both for a figure
+an example writes.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import argparse
 import sys
 from pathlib import Path
 
-__all__ = ["output_folder", "show_inline", "in_notebook"]
+__all__ = ["output_folder", "show_inline", "save_and_show", "in_notebook"]
 
 
 def in_notebook(argv: list[str] | None = None) -> bool:
@@ -69,3 +70,12 @@ def show_inline(fig) -> None:
     # (the inline backend's PNG for a Figure) and publish the result
     data, metadata = shell.display_formatter.format(fig)
     shell.display_pub.publish(data=data, metadata=metadata)
+
+
+def save_and_show(fig, path, dpi: int = 110) -> Path:
+    """Write ``fig`` to ``path`` (the figure an example hands in) and display it
+    when this runs in a notebook (`show_inline`). Returns the path."""
+    path = Path(path)
+    fig.savefig(path, dpi=dpi)
+    show_inline(fig)
+    return path
