@@ -14,41 +14,27 @@ import qc_control as qc
 from qc_control.models.halfcar import FullCarParams, HalfCarParams
 from qc_control.models.vehicle import STANDARD_GRAVITY
 
+
+def axles(**pairs):
+    """Front and rear values as ``name=(front, rear)``: the keywords ``name_front``
+    and ``name_rear`` of the car's parameters."""
+    return {
+        f"{k}_{axle}": v[i] for k, v in pairs.items() for i, axle in enumerate(("front", "rear"))
+    }
+
+
+# the body's values on one line, the axles' in front and rear pairs
+HALF_BODY = {"ms": 640.0, "Iy": 1100.0, "a": 1.2, "b": 1.5, "seat_x": 0.35}
 HALF = HalfCarParams(
-    ms=640.0,
-    Iy=1100.0,
-    a=1.2,
-    b=1.5,
-    ks_front=21e3,
-    ks_rear=18e3,
-    cs_front=1400.0,
-    cs_rear=1700.0,
-    mu_front=45.0,
-    mu_rear=38.0,
-    ku_front=190e3,
-    ku_rear=170e3,
-    seat_x=0.35,
+    **HALF_BODY,
+    **axles(ks=(21e3, 18e3), cs=(1400.0, 1700.0), mu=(45.0, 38.0), ku=(190e3, 170e3)),
 )
+FULL_BODY = {"ms": 1300.0, "Ix": 500.0, "Iy": 2200.0, "a": 1.1, "b": 1.6, "seat_x": 0.3}
 FULL = FullCarParams(
-    ms=1300.0,
-    Ix=500.0,
-    Iy=2200.0,
-    a=1.1,
-    b=1.6,
-    track_front=1.55,
-    track_rear=1.50,
-    ks_front=22e3,
-    ks_rear=19e3,
-    cs_front=1300.0,
-    cs_rear=1500.0,
-    mu_front=42.0,
-    mu_rear=37.0,
-    ku_front=200e3,
-    ku_rear=180e3,
-    arb_front=15e3,
-    arb_rear=6e3,
-    seat_x=0.3,
+    **FULL_BODY,
     seat_y=0.37,
+    **axles(track=(1.55, 1.50), ks=(22e3, 19e3), cs=(1300.0, 1500.0), mu=(42.0, 37.0)),
+    **axles(ku=(200e3, 180e3), arb=(15e3, 6e3)),
 )
 
 

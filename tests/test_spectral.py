@@ -20,6 +20,13 @@ from qc_control.ride.spectral import (
     white_velocity_wk_variance,
 )
 
+#: The stationary RMS values every spectral path gives, each with its unit.
+RMS_COLUMNS = (
+    "rms_body_acc [m/s²]",
+    "rms_body_acc_wk [m/s²]",
+    "rms_susp_travel [m]",
+    "rms_tire_load / static [-]",
+)
 CARS = [
     qc.QuarterCarParams(),
     qc.QuarterCarParams(ks=15e3, zeta=0.1),
@@ -107,12 +114,7 @@ def test_quadrature_over_a_wide_band_equals_lyapunov():
     1e-6 relative, the Wk-weighted one included."""
     wide = ride_metrics_spectral(road=road.ISO8608Road(band=(1e-6, 1e7)), points=20000)
     exact = ride_metrics_spectral(exact=True)
-    for key in (
-        "rms_body_acc [m/s²]",
-        "rms_body_acc_wk [m/s²]",
-        "rms_susp_travel [m]",
-        "rms_tire_load / static [-]",
-    ):
+    for key in RMS_COLUMNS:
         assert wide[key] == pytest.approx(exact[key], rel=1e-6), key
     assert "exact" in exact.attrs["band"] and "band" in wide.attrs["band"]
     assert exact["rms_xs [m]"] == math.inf
@@ -199,12 +201,7 @@ def test_spectral_sweep_equals_single_designs():
             continue
         single = ride_metrics_spectral(qc.QuarterCarParams(**d), road_, exact=True)
         assert row["stable"]
-        for column in (
-            "rms_body_acc [m/s²]",
-            "rms_body_acc_wk [m/s²]",
-            "rms_susp_travel [m]",
-            "rms_tire_load / static [-]",
-        ):
+        for column in RMS_COLUMNS:
             assert row[column] == pytest.approx(single[column], rel=1e-9), column
 
 

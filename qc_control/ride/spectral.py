@@ -540,11 +540,11 @@ def spectral_a_v(per_axis, posture: str = "seated"):
     return np.sqrt(sum((rules[a].k_comfort * v) ** 2 for a, v in per_axis.items()))
 
 
-#: The metrics a spectral sweep computes unless told otherwise (the
-#: Wk-weighted one costs a 12-state Lyapunov equation per design; ask for it).
 #: The ISO 2631-1 metrics of `qc_control.ride.metrics` with an exact stationary value:
 #: the body's axes as `spectral_axis_rms` weights them, no seat height (as the metrics).
 ISO2631_SPECTRAL = ("a_w_z", "a_w_rx", "a_w_ry", "a_v")
+#: The metrics a spectral sweep computes unless told otherwise (the
+#: Wk-weighted one costs a 12-state Lyapunov equation per design; ask for it).
 SPECTRAL_METRICS = ("rms_body_acc", "rms_susp_travel", "rms_tire_load / static")
 #: Every metric with an exact stationary value under white road velocity.
 SPECTRAL_CAPABLE = (
