@@ -128,75 +128,20 @@ def files(tmp_path, monkeypatch):
     return tmp_path
 
 
-BAD = [
-    (["modes", "--ms", "-1"], "ms (sprung mass) must be a finite number > 0 kg, got -1.0"),
-    (["modes", "--ku", "nan"], "ku (tire stiffness) must be a finite number > 0 N/m, got nan"),
-    (["modes", "--ms", "abc"], "--ms: invalid float value: 'abc'"),
-    (["modes", "--config", "missing.toml"], "config file 'missing.toml' cannot be read"),
-    (["modes", "--config", "binary.toml"], "config file 'binary.toml' is not a TOML text file"),
-    (["modes", "--config", "wheelbase.toml"], "'wheelbase'"),
-    (["modes", "--bogus"], "unrecognized arguments: --bogus"),
-    ([], "command"),
-    (["report", "--out", ""], "the report folder (--out) is empty"),
-    # a negative value is the option's value, refused for what it is (issue 39 item 14)
-    (["report", "--model", "nonlinear", "--bump-stop", "-0.05,1e5"], "got [-0.05, 100000.0]"),
-    (["report", "--scenario", "stiff", "--model", "half"], "--scenario 'stiff' is a run of"),
-    (["report", "--mount-stiffness", "1e6", "--zeta", "0"], "a damper top mount needs a damper"),
-    (["report", "--road", "step", "--road-t0", "20"], "--road-t0 20 s is after the run's end"),
-    (["report", "--h", "1e-320"], "more than 1.8e308 steps per method"),
-    (["report", "--t-end", "1e308", "--h", "1"], "1e+308 steps per method"),
-    (["report", "--t-end", "1e6", "--h", "0.01"], "1e+08 steps per method"),
-    (["report", "--t-end", "1e4", "--h", "0.01", "--max-steps", "1000"], "max_steps = 1,000"),
-    (
-        ["report", "--road", "iso8608", "--seed", "-1"],
-        "--seed must be a whole number >= 0, got -1",
-    ),
-    (["report", "--seed", "-1"], "--seed -1 does not apply without a road"),
-    (["report", "--road", "bump", "--seed", "3"], "--seed 3 does not apply to a bump road"),
-    (["report", "--road-height", "0.1"], "--road-height 0.1 does not apply without a road"),
-    (["report", "--road", "wobble"], "--road must be one of step, bump, sine, iso8608 or none"),
-    (["report", "--road", "iso8608", "--h", "0.01"], "--h 0.01 s is too coarse for an ISO 8608"),
-    (
-        ["report", "--road", "iso8608", "--road-class", "Z"],
-        "--road-class must be an ISO 8608 class, one of A, B, C, D, E, F, G, H, got 'Z'",
-    ),
-    # found by tests/test_properties.py: 1/(20 × 1e308 Hz) underflows to a 0 s limit, whose
-    # log10 was a math domain error (an internal error) when the default step was lowered
-    (["report", "--road", "sine", "--road-frequency", "1e308"], "<= 0 s (give a lower freq"),
-    (["report", "--road", "bump", "--speed", "0"], "--speed must be a finite number > 0 m/s"),
-    (["report", "--road-band", "1,a"], "argument --road-band: expected comma-separated numbers"),
-    (["report", "--ms", "1e200", "--ks", "1e200"], "time scales span more than"),
-    (["report", "--x0", "1,2"], "--x0 must be 4 comma-separated numbers, all finite: vs, vu"),
-    (["report", "--x0", "1,a,0,0"], "--x0 must be 4 comma-separated numbers"),
-    # found by tests/test_properties.py: an internal OverflowError in the cost study
-    (["report", "--x0", "1e308,0,0,0"], "--x0 1e+308 is beyond 1e+150"),
-    (["control-report", "--model", "half"], "control-report compares controllers on the quarter"),
-    (["modes", "--model", "half", "--ks_front", "1"], "unrecognized arguments: --ks_front"),
-    (["report", "--methods", "rk5"], "--methods: unknown method 'rk5'"),
-    (["report", "--methods", ""], "--methods must name at least one method"),
-    (["report", "--t-end", "-1"], "--t-end must be a finite number > 0 s, got -1.0"),
-    (["report", "--t-end", "1.234"], "must be a whole number (at least 2) of steps"),
-    (["report", "--config", "seed.toml"], "'seed.toml': [scenario] seed = 3 does not apply"),
-    (["report", "--config", "step_class.toml"], "road_class = 'C' does not apply to a step"),
-    (["report", "--config", "methods.toml"], "[scenario] methods must be a list of method names"),
-    (["report", "--config", "binary.toml"], "'binary.toml' is not a TOML text file"),
-    (["report", "--out", "foreign/notes.txt/sub"], "foreign/notes.txt' is not a directory"),
-    (["report", "--out", "foreign/notes.txt"], "is a file, not a report directory"),
-    (["report", "--out", "foreign"], "refusing to overwrite 'foreign'"),
-    (["report", "--t-e", "3"], "unrecognized arguments: --t-e"),  # no abbreviations
-    # the nonlinear car's options (issue 11 item 6)
-    (["report", "--model", "nonlinear", "--tire", "soft"], "--tire must be 'unilateral' or"),
-    (["report", "--model", "nonlinear", "--bump-stop", "0.05"], "--bump-stop must be CLEARANCE,"),
-    (["report", "--model", "nonlinear", "--bump-stop=-1,5"], "a clearance >= 0 m and a stiff"),
-    (["report", "--model", "nonlinear", "--bump-stop", "a,b"], "expected comma-separated num"),
-    (["report", "--model", "nonlinear", "--bump-height", "x"], "--bump-height: invalid float"),
-    (["report", "--model", "nonlinear", "--bump-length", "0"], "--bump-length must be a finite"),
-    (["report", "--tire", "linear"], "--tire 'linear' applies to the nonlinear car only"),
-    (["report", "--no-events"], "--no-events False applies to the nonlinear car only"),
-    (["report", "--bump-stop", "0.05,1e5"], "--bump-stop [0.05, 100000.0] applies to the non"),
-    (["report", "--bump-height", "0.1", "--road-height", "0.1"], "are the same value: give one"),
-    (["report", "--bump-height", "0.1", "--road", "sine"], "applies to a bump road, not --road"),
-]
+def bad_input_cases(path: Path) -> list:
+    """The cases of a transcript of bad command lines (``tests/data``): a line
+    ``qc-control ARGS``, then the expected words indented; ``#`` lines comment."""
+    cases = []
+    for line in path.read_text(encoding="utf-8").splitlines():
+        if line.startswith("qc-control"):
+            command = line
+        elif line.startswith("    "):
+            args = shlex.split(command)[1:]
+            cases.append(pytest.param(args, line.strip(), id=command))
+    return cases
+
+
+BAD = bad_input_cases(Path(__file__).with_name("data") / "cli_bad_input.txt")
 
 
 def _deprecation(line: str) -> bool:
