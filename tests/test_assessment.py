@@ -160,7 +160,7 @@ def test_health_zone_scales_as_eq_b1():
     assert eight.zone == pytest.approx((0.43, 0.86), rel=1e-12)
     assert two.zone == pytest.approx((0.86, 1.72), rel=1e-12)
     none = qc.ride_assessment({"z": z}, T=T).health
-    assert none.zone is None and "duration" in none.note
+    assert none.zone is None and "duration=" in none.note and "--exposure" in none.note
     # Figure B.1 spans 10 min to 24 h: no zone outside it, said so
     short = qc.ride_assessment({"z": z}, T=T, duration=300.0).health
     assert short.zone is None and "10 min to 24 h" in short.note

@@ -163,11 +163,17 @@ def test_the_command_refuses_comfort_off_a_road_in_one_line(tmp_path, capsys):
     assert len(err) == 1 and err[0].startswith("qc-control: error: --exposure")
 
 
-def _report_text(tmp_path, args) -> str:
+def _report_text(tmp_path, args, part="## Ride comfort", end="## Road and ride") -> str:
+    """The report's section from ``part`` to ``end`` (or the whole report with
+    ``part=None``)."""
     out = tmp_path / "r"
     assert main(["report", *args, "-q", "--out", str(out)]) == 0
     text = (out / "report.md").read_text(encoding="utf-8")
-    return text[text.index("## Ride comfort") : text.index("## Road and ride")]
+    return text if part is None else _part(text, part, end)
+
+
+def _part(text: str, part: str, end: str) -> str:
+    return text[text.index(part) : text.index(end, text.index(part))]
 
 
 def _number(section: str, row: str, column: int) -> float:
@@ -193,8 +199,16 @@ def test_the_command_reports_a_half_car_on_a_class_c_road(tmp_path):
 
 @pytest.mark.usefixtures("untimed", "placeholder_figures", "without_pdf")
 def test_the_command_reports_the_pothole_leading_with_mtvv_and_vdv(tmp_path):
-    section = _report_text(tmp_path, ["--scenario", "pothole", "--comfort"])
+    report = _report_text(tmp_path, ["--scenario", "pothole", "--comfort"], part=None)
+    section = _part(report, "## Ride comfort", "## Road and ride")
     expected = _pothole_exact()
+    # the findings lead with the same: MTVV and VDV, the numbers of the section
+    finding = next(
+        x for x in _part(report, "## Findings", "## Reproduce").splitlines() if "2631-1:1997" in x
+    )
+    assert finding.startswith("Assessed as ISO 2631-1:1997 does")
+    assert "the assessment is MTVV and VDV" in finding
+    assert f"VDV = {expected['z'].vdv:.3g} m/s²·s^¼" in finding
     header = next(x for x in section.splitlines() if x.startswith("| axis |"))
     assert header.split("|")[5:7] == [" MTVV ", " VDV [unit·s^¼] "]
     # 4 significant digits printed: 5e-4 relative

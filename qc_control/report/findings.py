@@ -210,6 +210,18 @@ def _ride(cmp) -> list[str]:
     ]
 
 
+def _comfort(cmp) -> list[str]:
+    """The ISO 2631-1 assessment's leading sentence (the additional methods' where
+    they are the assessment, else a_v and Annex C's words), pointing to its section."""
+    comfort = getattr(cmp, "comfort", None)
+    if comfort is None:
+        return []
+    lead = comfort.verdict[0]
+    return [
+        f"Assessed as ISO 2631-1:1997 does (section Ride comfort): {lead[:1].upper()}{lead[1:]}."
+    ]
+
+
 def _same_work(cmp) -> list[str]:
     """Methods that make the same evaluations do the same work: whatever their times
     say, within the spread of the timing rounds or beyond it, the difference is the
@@ -242,4 +254,5 @@ def findings(cmp) -> list[str]:
         + _damping(cmp)
         + _orders(cmp)
         + _ride(cmp)
+        + _comfort(cmp)
     )

@@ -227,7 +227,8 @@ def health_guidance(per_axis, posture: str, span: float, duration) -> HealthGuid
     a_w = k[axis] * scored[axis][0]
     if duration is None:
         note = (
-            "give the daily exposure (duration= in s, 10 min to 24 h) to place "
+            "give the daily exposure, 10 min to 24 h (ride_assessment's duration= in s, "
+            "qc-control report's --exposure in h), to place "
             f"k·a_w = {a_w:.3g} m/s² ({axis}) against Annex B's caution zone"
         )
         return HealthGuidance(None, a_w, axis, None, None, None, None, note)
