@@ -262,10 +262,12 @@ def _rational(method) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def _r_of(method, z):
     """``R(z)`` of ``method`` from its cached coefficients (``inf`` at a pole)."""
     p, q, _ = _rational(method)
-    num = np.polynomial.polynomial.polyval(z, p)
-    if q.size == 1:
-        return num
-    with np.errstate(divide="ignore", invalid="ignore"):
+    # a step far outside the region (hλ of a diverged state's Jacobian) overflows
+    # R to inf, read as unstable: the right answer, not a numerical fault to warn of
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        num = np.polynomial.polynomial.polyval(z, p)
+        if q.size == 1:
+            return num
         return num / np.polynomial.polynomial.polyval(z, q)
 
 
