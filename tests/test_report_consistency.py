@@ -38,14 +38,15 @@ from scipy.linalg import expm
 from qc_control.report import write_report
 from qc_control.report.figures import work_precision_figure
 from qc_control.report.findings import _cheapest, _same_work
+from qc_control.road import Bump, Step
 from qc_control.studies.scenario import Scenario
 
 #: The four reports: the seed car's free response, the seed car over a 5 cm road
 #: step, the README's half car over a bump, the nonlinear car over its bump.
 CASES = {
     "seed": {},
-    "road step": {"road": {"kind": "step"}},
-    "half car": {"model": "half", "road": {"kind": "bump", "speed": 10.0}, "t_end": 2.0},
+    "road step": {"road": Step()},
+    "half car": {"model": "half", "road": Bump(speed=10.0), "t_end": 2.0},
     "nonlinear car": {"model": "nonlinear"},
 }
 
