@@ -32,13 +32,13 @@ import control
 import numpy as np
 import pandas as pd
 import pytest
+from qc_control.road import Bump, Step
 from reports_shared import use_placeholders
 from scipy.linalg import expm
 
 from qc_control.report import write_report
 from qc_control.report.figures import work_precision_figure
 from qc_control.report.findings import _cheapest, _same_work
-from qc_control.road import Bump, Step
 from qc_control.studies.scenario import Scenario
 
 #: The four reports: the seed car's free response, the seed car over a 5 cm road
