@@ -240,10 +240,12 @@ def test_the_roads_guide_says_what_its_cells_compute(tmp_path, monkeypatch):
     assert rough.comfort == ("fairly uncomfortable",) and shock.comfort == ("not uncomfortable",)
     assert rough.health.rms_verdict == "below"
     assert shock.verdict[0].startswith("MTVV/a_w 1.69 > 1.5 on z")
-    spectral = spectral_axis_rms(car, road.intensity, seat=0.5)
-    assert abs(spectral["z"] / rough["z"].a_w - 1) < 0.04
-    assert round(spectral["ry"] / rough["ry"].a_w, 1) == 1.7
-    assert round(spectral["x"] / rough["x"].a_w, 1) == 1.4
+    # "every axis within 2 %" with the rear wheel's delay (measured 0.6-1.6 %), and
+    # "1.7 times" the pitch without it
+    spectral = spectral_axis_rms(car, road.intensity, seat=0.5, speed=road.speed)
+    assert all(abs(spectral[a] / rough[a].a_w - 1) < 0.02 for a in ("x", "z", "ry"))
+    independent = spectral_axis_rms(car, road.intensity, seat=0.5)
+    assert round(independent["ry"] / rough["ry"].a_w, 1) == 1.7
     # RK4 at 1 ms on the pothole against the exact response on 0-3 s (the page stops a
     # sample earlier, long after the shock): 1e-4 (measured 9e-8)
     exact = _pothole_exact()

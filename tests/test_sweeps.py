@@ -486,7 +486,9 @@ def test_the_spectral_sweep_gives_iso2631_metrics_as_the_single_design_lyapunov(
         HALF_GRID, model=build(road=True), road=HALF_ROAD, metrics=ISO_METRICS, progress=False
     )
     for k, cs in enumerate(HALF_GRID["cs_front"]):
-        alone = spectral_axis_rms(build(params(cs_front=cs), road=True), HALF_ROAD.intensity)
+        alone = spectral_axis_rms(
+            build(params(cs_front=cs), road=True), HALF_ROAD.intensity, speed=HALF_ROAD.speed
+        )
         row = got.metrics.iloc[k]
         assert row["a_w_z [m/s²]"] == pytest.approx(alone["z"], rel=1e-12)
         for axis in ("rx", "ry"):
@@ -540,3 +542,23 @@ def test_a_sweep_reads_a_cars_pitch_and_roll_for_the_rotation_metrics(name):
             expected = exact[axis].a_w if axis in rotations else 0.0
             assert value == pytest.approx(expected, rel=1e-3)
         assert row["a_v [m/s²]"] == pytest.approx(exact.a_v, rel=1e-3)
+
+
+@pytest.mark.parametrize("name", CARS)
+def test_the_spectral_sweep_delays_each_design_by_its_own_wheelbase(name):
+    """Designs of different wheelbases in one batch: each design's rear wheels meet
+    the road (a + b)/speed after the front ones, its own a + b: the batched values
+    equal the single design's to 1e-12 (rounding only), and differ from the
+    independent tracks' (which a shared delay, or none, would give)."""
+    from qc_control.ride.iso2631_spectral import spectral_axis_rms
+
+    build, params, _ = CARS[name]
+    grid = {"a": [0.9, 1.1, 1.5]}
+    got = sweep(grid, model=build(road=True), road=HALF_ROAD, metrics=ISO_METRICS, progress=False)
+    for k, a in enumerate(grid["a"]):
+        car = build(params(a=a), road=True)
+        alone = spectral_axis_rms(car, HALF_ROAD.intensity, speed=HALF_ROAD.speed)
+        independent = spectral_axis_rms(car, HALF_ROAD.intensity)
+        value = got.metrics.iloc[k]["a_w_ry [rad/s²]"]
+        assert value == pytest.approx(alone["ry"], rel=1e-12)
+        assert abs(value / independent["ry"] - 1) > 0.05

@@ -674,4 +674,4 @@ def _batch(designs: Sequence[Any], *, kind: str, road: bool, actuator: bool) -> 
     nc = len(corners[0]) if corners else (2 if kind == "half" else 4)
     stiffness = tuple(np.array([c[i].tire_stiffness for c in corners]) for i in range(nc))
     load = tuple(np.array([c[i].static_load for c in corners]) for i in range(nc))
-    return BatchedModel(A, B, C, D, stiffness, load)
+    return BatchedModel(A, B, C, D, stiffness, load, values["a"] + values["b"])

@@ -102,8 +102,10 @@ class BatchedModel:
     """``m`` designs of one model, as stacked matrices for the sweep engine.
 
     ``A (m, n, n)``, ``B (m, n, k)``, ``C (m, p, n)``, ``D (m, p, k)``; per
-    corner, ``tire_stiffness`` and ``static_load`` of shape ``(m,)``. Labels
-    are those of the single model, which every design shares.
+    corner, ``tire_stiffness`` and ``static_load`` of shape ``(m,)``; for a car
+    with axles, each design's ``wheelbase`` ``a + b`` [m] ``(m,)`` (the rear
+    wheels' delay on a road; None for one wheel). Labels are those of the
+    single model, which every design shares.
     """
 
     A: np.ndarray
@@ -112,6 +114,7 @@ class BatchedModel:
     D: np.ndarray
     tire_stiffness: tuple[np.ndarray, ...]
     static_load: tuple[np.ndarray, ...]
+    wheelbase: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -235,7 +238,9 @@ def stack_models(models: Sequence[VehicleModel]) -> BatchedModel:
         np.array([m.corners[i].tire_stiffness for m in models]) for i in range(corners)
     )
     load = tuple(np.array([m.corners[i].static_load for m in models]) for i in range(corners))
-    return BatchedModel(A, B, C, D, stiffness, load)
+    axles = all(hasattr(m.params, "a") and hasattr(m.params, "b") for m in models)
+    wheelbase = np.array([m.params.a + m.params.b for m in models]) if axles else None
+    return BatchedModel(A, B, C, D, stiffness, load, wheelbase)
 
 
 def params_as(cls, params):

@@ -27,6 +27,7 @@ from .spectral import (
     DEFAULT_ROAD,
     SPECTRAL_CAPABLE,
     iso8608_spelling,
+    rear_delay,
     spectral_metrics,
     white_velocity_variances,
 )
@@ -292,6 +293,21 @@ def ride_metrics(response, params=None, metrics=RIDE_METRICS) -> pd.Series:
     )
 
 
+def _track_power(H: np.ndarray, f: np.ndarray, followers, tau) -> np.ndarray:
+    """``Σ |H|²`` over a car's tracks ``(outputs, f)`` from its responses to each
+    road input ``H (outputs, inputs, f)``: a rear input ``j`` following ``i`` by
+    ``τ`` (`qc_control.ride.spectral.rear_delay`) adds as ``|H_i + H_j e^{-j2πfτ}|²``,
+    the independent tracks' powers add."""
+    power = np.zeros((H.shape[0], f.size))
+    alone = set(range(H.shape[1]))
+    for i, j in followers:
+        power += np.abs(H[:, i] + H[:, j] * np.exp(-2j * np.pi * f * tau)) ** 2
+        alone -= {i, j}
+    for i in sorted(alone):
+        power += np.abs(H[:, i]) ** 2
+    return power
+
+
 def _older_road(road, speed, band, road_class) -> ISO8608Road:
     """The `ISO8608Road` of `ride_metrics_spectral`'s arguments: ``road`` itself, or
     from 0.1's ``road_class, speed, band`` (positional or by name) with a
@@ -339,8 +355,11 @@ def ride_metrics_spectral(
       0.011–2.83 cycles/m), integrated against the vehicle's frequency
       response:
 
-      .. math:: σ_y^2 = \\int_{v n_{min}}^{v n_{max}} \\sum_r |H_{y r}(j2πf)|^2\\,
+      .. math:: σ_y^2 = \\int_{v n_{min}}^{v n_{max}} \\sum_{\\text{tracks}}
+                \\big|H_{y,\\text{front}} + H_{y,\\text{rear}}\\, e^{-j2πfτ}\\big|^2
                 G_t(f)\\, df, \\qquad G_t(f) = \\frac{G_d(f/v)}{v}
+
+      (``τ = (a + b)/v``; one wheel: ``|H_y|²``)
 
       (trapezoidal rule in ``ln f`` on ``points`` log-spaced frequencies),
       what a road sampled by ``road.samples`` (`qc_control.ride.road.iso8608`)
@@ -361,8 +380,9 @@ def ride_metrics_spectral(
     params : vehicle parameters, dict or VehicleModel, optional
         The vehicle (its registered model with road inputs,
         `qc_control.models.registry.vehicle_model`); a `VehicleModel` with
-        road inputs (each road input an independent track of the same
-        class). The seed's car by default.
+        road inputs. Its rear wheels meet the front wheels' road
+        ``(a + b)/speed`` later (`qc_control.ride.spectral.rear_delay`); a full
+        car's left and right tracks are independent. The seed's car by default.
     road : qc.road.ISO8608Road, optional
         The road: its class, speed [m/s] and band; default
         `qc_control.ride.spectral.DEFAULT_ROAD` (class C at 20 m/s).
@@ -393,7 +413,7 @@ def ride_metrics_spectral(
     labels.append(roles.body_disp)
     labels = list(dict.fromkeys(labels))
     if exact:
-        values = spectral_metrics(model, q, SPECTRAL_CAPABLE)
+        values = spectral_metrics(model, q, SPECTRAL_CAPABLE, speed=speed)
         body = f"rms_{roles.body_disp} [{model.unit(roles.body_disp)}]"
         # the body's height follows the road's random walk: inf
         values[body] = math.sqrt(white_velocity_variances(model)[roles.body_disp])
@@ -419,7 +439,7 @@ def ride_metrics_spectral(
         raise ValueError(f"model {model.name!r} has no road input: build it with road=True")
     H = np.asarray(control.frequency_response(sys, 2 * np.pi * f).complex)
     H = H.reshape(sys.noutputs, sys.ninputs, f.size)[:, roads]
-    gain = (np.abs(H) ** 2).sum(axis=1)  # independent tracks: powers add
+    gain = _track_power(H, f, *rear_delay(model, speed))
     road_psd = g0 * ((f / speed) / ISO8608_N0) ** -2.0 / speed  # one-sided, m²/Hz
     wk = np.abs(np.asarray(wk_filter()(2j * np.pi * f))).reshape(-1)
     log_f = np.log(f)

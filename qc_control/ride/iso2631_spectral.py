@@ -14,9 +14,11 @@ series with the axis's Annex A weighting ``(A_w, b_w, c_w, d_w)``
 
 gives the weighted RMS ``a_w = (q · c_c P c_cᵀ)^½`` with
 ``A_c P + P A_cᵀ + B_c B_cᵀ = 0`` (Lyapunov): exact over the unbounded
-band, no simulation. The tracks are independent white road velocities, as
-in `qc_control.ride.spectral.white_velocity_variances` (a rear wheel
-following the front one a wheelbase later is not represented).
+band, no simulation. Given the car's speed, its rear wheels meet the front
+wheels' road ``τ = (a + b)/v`` later, which adds the cross terms
+``2 c_c e^{A_c τ} X c_cᵀ`` (`qc_control.ride.spectral.road_variances`: a
+cross-Gramian, exact for the delay); a full car's left and right tracks are
+independent.
 """
 
 from __future__ import annotations

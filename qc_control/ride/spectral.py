@@ -25,11 +25,13 @@ from __future__ import annotations
 
 import functools
 import warnings
+from typing import Any
 
 import control
 import numpy as np
 import scipy.linalg
 
+from ..models.registry import model_for_params
 from ..models.vehicle import VehicleModel
 from ..numerics import checks
 from ..numerics.checks import ParameterError, positive
@@ -48,6 +50,8 @@ __all__ = [
     "white_velocity_wk_variance",
     "iso8608_intensity",
     "ISO8608Road",
+    "road_variances",
+    "rear_delay",
     "road_intensity",
     "iso8608_spelling",
     "DEFAULT_ROAD",
@@ -126,8 +130,16 @@ def stationary_covariance(A, B) -> np.ndarray:
     single = A.ndim == 2
     A3 = A.reshape((-1,) + A.shape[-2:])
     B3 = np.broadcast_to(B, A.shape[:-2] + B.shape[-2:]).reshape((A3.shape[0],) + B.shape[-2:])
+    P = _gramian(A3, B3 @ np.swapaxes(B3, -1, -2))
+    P = 0.5 * (P + np.swapaxes(P, -1, -2))
+    return P[0] if single else P.reshape(A.shape)
+
+
+def _gramian(A3: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """``X`` solving ``A X + X Aᵀ + Q = 0`` for each of ``m`` Hurwitz designs
+    ``(m, n, n)``; ``Q`` need not be symmetric (a cross-Gramian ``b_i b_jᵀ``).
+    The solvers of `stationary_covariance`'s notes, each valid for any ``Q``."""
     m, n = A3.shape[0], A3.shape[-1]
-    Q = B3 @ np.swapaxes(B3, -1, -2)
     if n <= _KRONECKER_MAX_STATES:
         eye = np.eye(n)
         # row-major vec: vec(A P) = (A ⊗ I) vec P, vec(P Aᵀ) = (I ⊗ A) vec P
@@ -144,8 +156,7 @@ def stationary_covariance(A, B) -> np.ndarray:
         if bad.size:
             for i in bad:
                 P[i] = scipy.linalg.solve_continuous_lyapunov(A3[i], -Q[i])
-    P = 0.5 * (P + np.swapaxes(P, -1, -2))
-    return P[0] if single else P.reshape(A.shape)
+    return P
 
 
 def lyapunov_variances(A, B, C) -> np.ndarray:
@@ -184,6 +195,82 @@ def lyapunov_variances(A, B, C) -> np.ndarray:
     A, B, C = _as_batch(A, B, C)
     P = stationary_covariance(A, B)
     return np.einsum("...ij,...jk,...ik->...i", C, P, C)
+
+
+def road_variances(A, B, C, followers=(), delay=None) -> np.ndarray:
+    """`lyapunov_variances`, with some inputs the delayed copies of others.
+
+    Input ``j`` of a pair ``(i, j)`` in ``followers`` is input ``i``'s white
+    noise ``τ`` later (a rear wheel meeting the front wheel's road a
+    wheelbase later); the other inputs are independent. With ``y_i`` the
+    response to input ``i`` alone, ``E[y_i(t) y_j(t)ᵀ] = C e^{Aτ} X_ij Cᵀ``,
+    ``A X_ij + X_ij Aᵀ + b_i b_jᵀ = 0`` (the white noise reaches ``y_j`` ``τ``
+    after ``y_i``: substitute ``w_j(t) = w_i(t - τ)`` in the two convolution
+    integrals), so
+
+    .. math:: σ^2 = \\mathrm{diag}\\Big(C P C^T + \\sum_{(i,j)} \\big(C e^{Aτ} X_{ij} C^T
+              + (C e^{Aτ} X_{ij} C^T)^T\\big)\\Big),
+
+    exact for the pure delay ``e^{-sτ}`` (no Padé approximation): it equals
+    Parseval's ``(1/2π) ∫ |Σ_i H_i(jω) e^{-jωτ_i}|² dω``.
+
+    Parameters
+    ----------
+    A, B, C : array_like
+        As `lyapunov_variances`.
+    followers : sequence of (int, int)
+        ``(leading input, following input)`` column pairs of ``B``.
+    delay : float or array_like (m,)
+        ``τ`` [s] of every pair, one per design for a batch.
+
+    Returns
+    -------
+    ndarray, shape (p,) or (m, p)
+    """
+    A, B, C = _as_batch(A, B, C)
+    var = lyapunov_variances(A, B, C)
+    if not followers:
+        return var
+    A3 = A.reshape((-1,) + A.shape[-2:])
+    m = A3.shape[0]
+    B3 = np.broadcast_to(B, A.shape[:-2] + B.shape[-2:]).reshape((m,) + B.shape[-2:])
+    C3 = np.broadcast_to(C, A.shape[:-2] + C.shape[-2:]).reshape((m,) + C.shape[-2:])
+    tau = np.broadcast_to(np.asarray(delay, dtype=float), (m,))
+    E = scipy.linalg.expm(A3 * tau[:, None, None])  # e^{Aτ}, per design
+    cross = np.zeros((m, C3.shape[1]))
+    for i, j in followers:
+        X = _gramian(A3, B3[:, :, i, None] @ B3[:, :, j, None].swapaxes(-1, -2))
+        cross += 2.0 * np.einsum("mpi,mij,mjk,mpk->mp", C3, E, X, C3)
+    return var + cross.reshape(var.shape)
+
+
+def rear_delay(model: VehicleModel, speed, batch=None) -> tuple[tuple[tuple[int, int], ...], Any]:
+    """``(followers, τ)`` of `road_variances` for a car at ``speed`` [m/s]: its
+    rear wheels meet its front wheels' road ``τ = (a + b)/speed`` later.
+
+    The pairs follow the car's road layout (`ModelEntry.road_layout`, as the
+    time-domain roads of `qc_control.studies.on_road` do): ``'axles'``, the
+    rear input follows the front one; ``'corners'``, each rear corner its own
+    side's front corner (the left and right tracks independent of each other).
+    A one-wheel car, or ``speed`` None, has none: ``((), None)``; then every
+    road input is an independent track.
+    """
+    if speed is None:
+        return (), None
+    speed = positive("speed", speed, "m/s")
+    entry = model_for_params(model.params)
+    pairs = _FOLLOWERS.get(entry.road_layout if entry is not None else "single", ())
+    if not pairs:
+        return (), None
+    wheelbase = model.params.a + model.params.b if batch is None else batch.wheelbase
+    if wheelbase is None:
+        raise ValueError("the batch has no wheelbases: build it with model.batch(designs)")
+    return pairs, np.asarray(wheelbase, dtype=float) / speed
+
+
+#: Per road layout, the (front, rear) pairs of its road inputs (in
+#: `VehicleModel.road_inputs` order) where the rear follows the front.
+_FOLLOWERS = {"axles": ((0, 1),), "corners": ((0, 2), (1, 3))}
 
 
 def require_linear(model: VehicleModel, what: str = "") -> None:
@@ -255,15 +342,16 @@ def white_velocity_system(model: VehicleModel, batch=None):
 
 
 def white_velocity_variances(
-    model: VehicleModel, *, intensity: float = 1.0, outputs=None, batch=None
+    model: VehicleModel, *, intensity: float = 1.0, outputs=None, batch=None, speed=None
 ) -> dict:
     """Stationary output variances of a vehicle on white road velocity.
 
-    Every road input of ``model`` is driven by its own white road velocity
-    of two-sided intensity ``intensity`` [m²/s], ``E[zr'(t) zr'(s)] =
-    intensity · δ(t - s)``, the road displacement being its integral; the
-    tracks are independent (a rear wheel that follows the front one with a
-    wheelbase delay is not represented).
+    Every track of ``model`` is driven by white road velocity of two-sided
+    intensity ``intensity`` [m²/s], ``E[zr'(t) zr'(s)] = intensity · δ(t -
+    s)``, the road displacement being its integral. Given the ``speed``, a
+    car's rear wheels meet its front wheels' road ``(a + b)/speed`` later
+    (`rear_delay`, `road_variances`: exact for the delay); without it, every
+    road input is an independent track.
 
     .. math:: σ_y^2 = q\\, \\mathrm{diag}(C P C^T), \\qquad
               A P + P A^T + A^{-1} B_r B_r^T A^{-T} = 0
@@ -283,6 +371,8 @@ def white_velocity_variances(
         Output labels; default all.
     batch : BatchedModel, optional
         Many designs at once: each value is then an array ``(m,)``.
+    speed : float, optional
+        The car's speed [m/s], for the rear wheels' delay (`rear_delay`).
 
     Returns
     -------
@@ -306,14 +396,16 @@ def white_velocity_variances(
         raise ValueError(f"no output {unknown[0]!r}; outputs are {labels}")
     A, Bw, C, gain = white_velocity_system(model, batch)
     rows = [labels.index(o) for o in wanted]
-    var = q * lyapunov_variances(A, Bw, C[..., rows, :])
+    var = q * road_variances(A, Bw, C[..., rows, :], *rear_delay(model, speed, batch))
     scale = np.abs(C[..., rows, :]).max(axis=-1) + 1.0
     follows = gain[..., rows] > 1e-9 * scale
     var = np.where(follows, np.inf, var)
     return {o: (float(var[..., i]) if var.ndim == 1 else var[..., i]) for i, o in enumerate(wanted)}
 
 
-def white_velocity_wk_variance(model: VehicleModel, *, intensity: float = 1.0, batch=None):
+def white_velocity_wk_variance(
+    model: VehicleModel, *, intensity: float = 1.0, batch=None, speed=None
+):
     """Stationary variance of the ISO 2631-1 Wk-weighted body acceleration on white road velocity.
 
     The car of `white_velocity_system` in series with `qc_control.ride.iso2631.wk_filter`
@@ -324,7 +416,8 @@ def white_velocity_wk_variance(model: VehicleModel, *, intensity: float = 1.0, b
               B_c = \\begin{bmatrix} A^{-1} B_r \\\\ 0 \\end{bmatrix}, \\quad
               C_c = [D_w C_a \\;\\; C_w],
 
-    and ``σ² = q · C_c P C_cᵀ`` with ``A_c P + P A_cᵀ + B_c B_cᵀ = 0``.
+    and ``σ² = q · C_c P C_cᵀ`` with ``A_c P + P A_cᵀ + B_c B_cᵀ = 0`` (with the
+    rear wheels' delay at ``speed`` [m/s], `road_variances`).
 
     Returns
     -------
@@ -351,7 +444,7 @@ def white_velocity_wk_variance(model: VehicleModel, *, intensity: float = 1.0, b
     Cc = np.zeros(batch_shape + (1, n + nw))
     Cc[..., 0, :n] = Dw[0, 0] * Ca
     Cc[..., 0, n:] = Cw[0]
-    var = q * lyapunov_variances(Ac, Bc, Cc)[..., 0]
+    var = q * road_variances(Ac, Bc, Cc, *rear_delay(model, speed, batch))[..., 0]
     return float(var) if var.ndim == 0 else var
 
 
@@ -465,8 +558,9 @@ def _axis_rows(model: VehicleModel, C: np.ndarray, seat) -> dict[str, np.ndarray
     return rows
 
 
-def _weighted_variance(A, Bw, c, name: str, q: float):
-    """``q c_c P c_cᵀ`` of the car's row ``c`` in series with weighting ``name``."""
+def _weighted_variance(A, Bw, c, name: str, q: float, delayed=((), None)):
+    """``q c_c P c_cᵀ`` of the car's row ``c`` in series with weighting ``name``
+    (``delayed``: `rear_delay`'s followers and delay)."""
     Aw, bw, cw, dw = _weighting_matrices(name)
     n, nw = A.shape[-1], Aw.shape[0]
     batch = A.shape[:-2]
@@ -479,7 +573,7 @@ def _weighted_variance(A, Bw, c, name: str, q: float):
     Cc = np.zeros(batch + (1, n + nw))
     Cc[..., 0, :n] = dw * c
     Cc[..., 0, n:] = cw
-    return q * lyapunov_variances(Ac, Bc, Cc)[..., 0]
+    return q * road_variances(Ac, Bc, Cc, *delayed)[..., 0]
 
 
 def spectral_axis_rms(
@@ -489,6 +583,7 @@ def spectral_axis_rms(
     seat: float | None = None,
     posture: str = "seated",
     batch=None,
+    speed: float | None = None,
 ) -> dict:
     """Exact stationary ISO 2631-1 weighted RMS ``a_w`` of each axis on white road velocity.
 
@@ -505,6 +600,11 @@ def spectral_axis_rms(
         The weighting of each axis (`qc_control.ride.guidance.AXIS_RULES`).
     batch : BatchedModel, optional
         Many designs: each value is then an array ``(m,)``.
+    speed : float, optional
+        The car's speed [m/s] (an ISO 8608 road's ``speed``): its rear wheels
+        meet the front wheels' road ``(a + b)/speed`` later (`rear_delay`).
+        Without it the tracks are independent, which is not a car on one
+        road: a half car's pitch at 20 m/s comes out 1.7 times too large.
 
     Returns
     -------
@@ -524,9 +624,10 @@ def spectral_axis_rms(
     A, Bw, C, gain = white_velocity_system(model, batch)
     rules = AXIS_RULES[posture]
     rows = _axis_rows(model, C, seat)
+    delayed = rear_delay(model, speed, batch)
     out: dict = {}
     for axis in (a for a in AXES if a in rows and a in rules):
-        var = _weighted_variance(A, Bw, rows[axis], rules[axis].weighting, q)
+        var = _weighted_variance(A, Bw, rows[axis], rules[axis].weighting, q, delayed)
         out[axis] = float(np.sqrt(var)) if np.ndim(var) == 0 else np.sqrt(var)
     if not out:
         raise ParameterError("posture", posture, f"a posture with the axes of {model.name!r}")
@@ -555,7 +656,7 @@ SPECTRAL_CAPABLE = (
 
 @one_blas_thread
 def spectral_metrics(
-    model: VehicleModel, intensity: float, names=SPECTRAL_METRICS, batch=None
+    model: VehicleModel, intensity: float, names=SPECTRAL_METRICS, batch=None, speed=None
 ) -> dict:
     """Exact stationary RMS metrics of a vehicle (or a batch of designs) on white road velocity.
 
@@ -579,6 +680,9 @@ def spectral_metrics(
         Metric names (or columns) among `SPECTRAL_CAPABLE`.
     batch : BatchedModel, optional
         Many designs at once: values are then arrays ``(m,)``.
+    speed : float, optional
+        The car's speed [m/s]: its rear wheels meet the front wheels' road
+        ``(a + b)/speed`` later (`rear_delay`); without it, independent tracks.
 
     Returns
     -------
@@ -595,7 +699,7 @@ def spectral_metrics(
     labels = [roles.body_acc] + [c.susp_travel for c in roles.corners]
     labels += [c.tire_defl for c in roles.corners]
     var = white_velocity_variances(
-        model, intensity=intensity, outputs=list(dict.fromkeys(labels)), batch=batch
+        model, intensity=intensity, outputs=list(dict.fromkeys(labels)), batch=batch, speed=speed
     )
     stiffness = (
         batch.tire_stiffness if batch is not None else [c.tire_stiffness for c in roles.corners]
@@ -603,7 +707,7 @@ def spectral_metrics(
     load = batch.static_load if batch is not None else [c.static_load for c in roles.corners]
     out: dict = {}
     axes = (
-        spectral_axis_rms(model, intensity, batch=batch)
+        spectral_axis_rms(model, intensity, batch=batch, speed=speed)
         if any(metric.name in ISO2631_SPECTRAL for _, metric, _ in items)
         else {}
     )
@@ -615,7 +719,7 @@ def spectral_metrics(
             out[column] = np.sqrt(var[roles.body_acc])
         elif metric.name == "rms_body_acc_wk":
             out[column] = np.sqrt(
-                white_velocity_wk_variance(model, intensity=intensity, batch=batch)
+                white_velocity_wk_variance(model, intensity=intensity, batch=batch, speed=speed)
             )
         elif metric.name == "rms_susp_travel":
             out[column] = np.sqrt(var[corner.susp_travel])

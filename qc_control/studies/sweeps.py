@@ -191,6 +191,7 @@ def _take(batch: BatchedModel, idx) -> BatchedModel:
         batch.D[idx],
         tuple(k[idx] for k in batch.tire_stiffness),
         tuple(w[idx] for w in batch.static_load),
+        None if batch.wheelbase is None else batch.wheelbase[idx],
     )
 
 
@@ -949,7 +950,9 @@ def _spectral_sweep(designs, U, road: Road, metrics, model) -> SweepResult:
         keep = np.flatnonzero(hurwitz)
         for start in range(0, keep.size, 4096):  # bounds the Kronecker systems' memory
             part = keep[start : start + 4096]
-            values = spectral_metrics(model, road.intensity, names, batch=_take(batch, part))
+            values = spectral_metrics(
+                model, road.intensity, names, batch=_take(batch, part), speed=road.speed
+            )
             for column in columns:
                 table[column][good[part]] = values[column]
     frame, err_frame = _tables(designs, params, errors, model, stable, table)
