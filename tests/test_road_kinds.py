@@ -85,6 +85,9 @@ def test_a_profile_is_linear_between_its_points_and_level_outside():
         (lambda: road.Profile([0.0, 1.0], [0.0]), "z"),
         (lambda: road.Profile([0.0, 1.0, 1.0], [0.0, 0.0, 0.0]), "x[2]"),
         (lambda: road.Profile([0.0, 1.0], [0.0, np.nan]), "z[1]"),
+        # the entry that is not a number, in the array that holds it
+        (lambda: road.Profile([0.0, 1.0, 2.0], [0.0, "a", 0.0]), "z[1]"),
+        (lambda: road.Profile([0.0, "b", 2.0], [0.0, 0.0, 0.0]), "x[1]"),
         (lambda: road.Profile([0.0, 1.0], [0.0, 0.0], speed=0.0), "speed"),
     ],
 )

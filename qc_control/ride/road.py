@@ -956,14 +956,28 @@ class Profile(Road):
         )
 
 
+def _numbers(name: str, values, what: str) -> np.ndarray:
+    """``values`` as a float array; a `ParameterError` naming ``name`` (and, for a
+    sequence, the first entry that is not a number) otherwise."""
+    try:
+        return np.array(values, dtype=float)
+    except (TypeError, ValueError):
+        pass
+    try:
+        for i, v in enumerate(values):
+            try:
+                float(v)
+            except (TypeError, ValueError):
+                raise ParameterError(f"{name}[{i}]", v, f"a number: {name} is {what}") from None
+    except TypeError:  # not a sequence at all
+        pass
+    raise ParameterError(name, values, f"{what} as numbers")
+
+
 def _profile_arrays(x, z) -> tuple[np.ndarray, np.ndarray]:
     """``x, z`` of a `Profile` as read-only float arrays, refused by name unless
     finite, of one length of at least two, and ``x`` strictly increasing."""
-    try:
-        xa = np.array(x, dtype=float)
-        za = np.array(z, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError("x", x, "distances [m] and heights [m] as numbers") from None
+    xa, za = _numbers("x", x, "distances [m]"), _numbers("z", z, "heights [m]")
     if xa.ndim != 1 or xa.size < 2:
         raise ParameterError("x", x, "at least two distances [m] in a 1-D array")
     if za.shape != xa.shape:
