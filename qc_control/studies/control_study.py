@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import control
@@ -347,7 +347,7 @@ def _measure(
     model: VehicleModel,
     runs: dict[str, tuple[np.ndarray, np.ndarray]],
     method: str,
-    metrics: dict[str, Sequence[str]],
+    metrics: Mapping[str, Sequence[str]],
 ) -> tuple[dict, str]:
     """One design's row of ``metrics[run]`` over the bump and road runs, and a note if a
     run failed."""
