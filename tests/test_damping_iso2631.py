@@ -12,6 +12,10 @@ References, each computed here apart from the study:
   `qc_control.ride.iso2631.wk_filter` realisation): two state-space
   realisations of one weighting, so one optimum.
 * the road-holding variance of Gobbi & Mastinu (2001), written out here.
+* a half and a full car's a_w_z, a_w_ry, a_w_rx per design from
+  `spectral_axis_rms` of the car built here, and a_v from ISO 2631-1:1997
+  §6.5 with the seated factors of §8.2.3 written out (k_z = 1, k_ry = 0.4
+  m/rad, k_rx = 0.63 m/rad).
 """
 
 import math
@@ -23,6 +27,7 @@ import scipy.optimize
 import qc_control as qc
 from qc_control.models.vehicle import STANDARD_GRAVITY
 from qc_control.ride.iso2631_spectral import spectral_axis_rms
+from qc_control.studies.damping import OBJECTIVES
 
 SEED = qc.QuarterCarParams()
 C20 = qc.road.ISO8608Road("C", speed=20.0)
@@ -91,6 +96,15 @@ def test_the_a_w_z_optimum_is_the_wk_comfort_optimum():
     assert iso.metrics[AWZ] == pytest.approx(older.metrics["rms_body_acc_wk [m/s²]"], rel=1e-6)
 
 
+def non_dominated(pts):
+    """Indices of the rows of ``pts`` no other row beats in every column (brute force)."""
+
+    def dominated(v):
+        return np.any(np.all(pts <= v, axis=1) & np.any(pts < v, axis=1))
+
+    return {i for i, v in enumerate(pts) if not dominated(v)}
+
+
 def test_a_v_of_a_quarter_car_is_its_vertical():
     """ISO 2631-1 §6.5 with k_z = 1 (§8.2.3) and no rotation: a_v = a_w_z exactly."""
     opt = qc.optimal_damping(SEED, "a_v", road=C20)
@@ -115,16 +129,11 @@ def test_the_a_w_z_front_is_non_dominated_and_exact_per_design():
     vary = {"cs": list(np.geomspace(0.1, 3.0, 12) * CRITICAL), "ks": [2e4, 3e4, 6e4]}
     pf = qc.pareto_front(SEED, vary, ("a_w_z", "road_holding"), road=C20)
     allp = pf.all_designs
-    # every design's a_w_z is the single-design Lyapunov value (1e-9 relative: the
-    # batched Kronecker solve against the eigen-decomposition of one 12-state system)
+    # every design's a_w_z is the single-design Lyapunov value (1e-9 relative: the same
+    # equation solved for the batch and for one design differs by rounding only)
     for _, row in allp.iterrows():
         assert row[AWZ] == pytest.approx(a_w_z(row["cs"], row["ks"]), rel=1e-9)
-    pts = allp[[AWZ, "rms_tire_load / static [-]"]].to_numpy()
-
-    def dominated(v):
-        return np.any(np.all(pts <= v, axis=1) & np.any(pts < v, axis=1))
-
-    expected = {i for i, v in enumerate(pts) if not dominated(v)}
+    expected = non_dominated(allp[[AWZ, "rms_tire_load / static [-]"]].to_numpy())
     assert set(np.flatnonzero(allp["pareto"])) == expected and len(pf.designs) == len(expected)
     assert AWZ in pf.markers.columns
     assert "ISO 2631-1" in pf.figure.axes[0].get_xlabel()
@@ -139,9 +148,15 @@ def test_the_a_w_z_front_is_non_dominated_and_exact_per_design():
             "objective['a_w_q']",
             ["'a_w_z'"],
         ),
-        (lambda: qc.optimal_damping(SEED, "a_w_ry"), "objective", ["pitches", "qc.sweep"]),
+        (lambda: qc.optimal_damping(SEED, "a_w_ry"), "objective", ["pitches", "HalfCarParams"]),
         (lambda: qc.pareto_front(SEED, objectives=("a_w_z", "a_w_q")), "objectives", ["'a_v'"]),
         (lambda: qc.pareto_front(SEED, objectives=("a_w_z", "a_w_rx")), "objectives", ["rolls"]),
+        (
+            lambda: qc.pareto_front(qc.HalfCarParams(), {"cs_front": [1e3]}, ("a_w_z", "a_w_rx")),
+            "objectives",
+            ["rolls", "'a_w_rx'"],
+        ),
+        (lambda: qc.pareto_front(qc.HalfCarParams()), "vary", ["cs_front", "HalfCarParams"]),
     ],
 )
 def test_a_bad_objective_is_refused_naming_the_argument_and_the_choices(call, name, words):
@@ -155,3 +170,38 @@ def test_a_bad_objective_is_refused_naming_the_argument_and_the_choices(call, na
 def test_an_iso_objective_has_no_closed_form():
     with pytest.raises(ValueError, match="no closed form"):
         qc.optimal_damping(SEED, "a_w_z", solver="closed form")
+
+
+ROTATIONS = {"a_w_ry [rad/s²]": ("ry", 0.4), "a_w_rx [rad/s²]": ("rx", 0.63)}
+
+
+@pytest.mark.parametrize(
+    "params, objectives",
+    [
+        (qc.HalfCarParams(), ("a_w_z", "a_w_ry", "a_v")),
+        (qc.FullCarParams(), ("a_w_rx", "a_w_ry", "a_v")),
+    ],
+)
+def test_a_half_and_a_full_cars_front_in_pitch_and_roll(params, objectives):
+    vary = {"cs_front": [500.0, 1290.0, 3000.0], "cs_rear": [600.0, 1620.0, 3500.0]}
+    pf = qc.pareto_front(params, vary, objectives, road=C20)
+    allp = pf.all_designs
+    build = qc.half_car_model if isinstance(params, qc.HalfCarParams) else qc.full_car_model
+    for _, row in allp.iterrows():
+        design = type(params)(**{**params.to_dict(), "cs_front": row["cs_front"],
+                                 "cs_rear": row["cs_rear"]})  # fmt: skip
+        axes = spectral_axis_rms(build(design, road=True), Q)
+        # 1e-9 relative: the batch's Lyapunov solve against one design's, rounding only
+        total = axes["z"] ** 2
+        for column, (axis, k) in ROTATIONS.items():
+            if axis in axes:
+                total += (k * axes[axis]) ** 2
+                if column in allp:
+                    assert row[column] == pytest.approx(axes[axis], rel=1e-9), column
+        assert row["a_v [m/s²]"] == pytest.approx(math.sqrt(total), rel=1e-9)
+        if "a_w_z [m/s²]" in allp:
+            assert row["a_w_z [m/s²]"] == pytest.approx(axes["z"], rel=1e-9)
+    cols = [OBJECTIVES[o][0] for o in objectives]
+    assert set(np.flatnonzero(allp["pareto"])) == non_dominated(allp[cols].to_numpy())
+    # the closed-form optima are the quarter car's: a half or full car marks only itself
+    assert list(pf.markers.index) == ["passive (this car)"]

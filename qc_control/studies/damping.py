@@ -53,6 +53,7 @@ import pandas as pd
 import scipy.optimize
 
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
+from ..models.registry import model_for_params, vehicle_model
 from ..models.vehicle import STANDARD_GRAVITY, VehicleModel
 from ..numerics.checks import ParameterError, choice, positive
 from ..ride.metrics import METRICS
@@ -91,12 +92,14 @@ OBJECTIVES = {
     # ISO 2631-1's exact stationary values, under their registry names and columns
     "a_w_z": (METRICS["a_w_z"].column(), "ISO 2631-1 Wk-weighted RMS vertical acceleration"),
     "a_v": (METRICS["a_v"].column(), "ISO 2631-1 vibration total value"),
+    "a_w_ry": (METRICS["a_w_ry"].column(), "ISO 2631-1 We-weighted RMS pitch acceleration"),
+    "a_w_rx": (METRICS["a_w_rx"].column(), "ISO 2631-1 We-weighted RMS roll acceleration"),
 }
 #: The objectives computed by `qc_control.ride.spectral.spectral_metrics` (no closed form).
 ISO2631_OBJECTIVES = tuple(name for name in OBJECTIVES if name in ISO2631_SPECTRAL)
-#: ISO 2631-1's body rotations: exact metrics of a car that pitches or rolls, which these
-#: studies (one damper ``cs``) do not take -> what a user runs instead.
-_ROTATIONS = {"a_w_ry": "pitches", "a_w_rx": "rolls"}
+#: ISO 2631-1's body rotations -> (the car's output that has it, the verb): an objective
+#: only of a car that pitches or rolls (a half or full car's `pareto_front`).
+_ROTATIONS = {"a_w_ry": ("pitch_acc", "pitches"), "a_w_rx": ("roll_acc", "rolls")}
 
 
 def spectral_ride(
@@ -199,23 +202,27 @@ class DampingOptimum:
     method: str
 
 
-def _refuse_rotation(name: str, value, objective) -> None:
-    """ISO 2631-1's pitch and roll, refused by name: the quarter car these studies vary
-    (one damper ``cs``) has neither; a half or full car's come from the spectral sweep."""
-    if objective in _ROTATIONS:
-        raise ParameterError(
-            name,
-            value,
-            f"one of {sorted(OBJECTIVES)}",
-            message=(
-                f"{name}={value!r}: {objective!r} needs a car whose body "
-                f"{_ROTATIONS[objective]}, and this study varies the one damper cs of a "
-                "quarter car, which neither pitches nor rolls; a half or full car's a_w_ry, "
-                "a_w_rx and a_v come exactly from qc.sweep({'cs_front': [...], 'cs_rear': "
-                "[...]}, model=..., road=qc.road.ISO8608Road(...), metrics=[...]). "
-                f"Objectives here: {sorted(OBJECTIVES)}"
-            ),
-        )
+def _refuse_rotation(name: str, value, objective, model: VehicleModel | None = None) -> None:
+    """ISO 2631-1's pitch or roll, refused by name on a car without it: ``model``'s
+    outputs say; without a model, the quarter car `optimal_damping` varies (one damper
+    ``cs``), which neither pitches nor rolls."""
+    if objective not in _ROTATIONS:
+        return
+    label, verb = _ROTATIONS[objective]
+    if model is not None and label in model.system.output_labels:
+        return
+    car = "the quarter car optimal_damping varies" if model is None else repr(model.name)
+    raise ParameterError(
+        name,
+        value,
+        f"one of {sorted(OBJECTIVES)}",
+        message=(
+            f"{name}={value!r}: {objective!r} needs a car whose body {verb}, which {car} "
+            "does not; draw a half or full car's front by its parameters, e.g. "
+            "qc.pareto_front(qc.HalfCarParams(), {'cs_front': [...], 'cs_rear': [...]}, "
+            f"('a_w_z', 'a_w_ry')). Objectives: {sorted(OBJECTIVES)}"
+        ),
+    )
 
 
 def _weights(objective) -> dict[str, float]:
@@ -457,15 +464,20 @@ def pareto_front(
 
     Parameters
     ----------
-    params : QuarterCarParams, dict or None
-        The base vehicle.
+    params : QuarterCarParams, HalfCarParams, FullCarParams, dict or None
+        The base vehicle (a dict or None: the quarter car's). On a half or
+        full car the body's metrics are the whole car's and ``'road_holding'``
+        and ``'travel'`` are the first corner's (the front), as `spectral_ride`
+        reads them.
     vary : mapping
-        Parameter name -> values; default ``cs`` from 0.05 to 4 times
-        critical damping (60 values).
+        Parameter name -> values; for the quarter car, default ``cs`` from
+        0.05 to 4 times critical damping (60 values); a half or full car's
+        must be given (e.g. ``{'cs_front': [...], 'cs_rear': [...]}``).
     objectives : sequence of str
         Two or more of `OBJECTIVES` (``'comfort'``, ``'comfort_wk'``,
         ``'road_holding'``, ``'travel'``, and ISO 2631-1's exact ``'a_w_z'``
-        and ``'a_v'`` [m/s²], e.g. ``('a_w_z', 'road_holding')``); the
+        and ``'a_v'`` [m/s²], and of a car that pitches or rolls ``'a_w_ry'``
+        and ``'a_w_rx'`` [rad/s²]; e.g. ``('a_w_z', 'road_holding')``); the
         figure plots the first two.
     road : None, ISO8608Road or float
         See `spectral_ride`; default `qc_control.ride.spectral.DEFAULT_ROAD`, ISO 8608
@@ -483,11 +495,11 @@ def pareto_front(
     -------
     ParetoFront
     """
-    p = as_params(params)
+    p, model, vary = _pareto_car(params, vary)
     q = road_intensity(road, stacklevel=2)  # read once: every design sees the same number
     objectives = list(objectives)
     for o in objectives:
-        _refuse_rotation("objectives", objectives, o)
+        _refuse_rotation("objectives", objectives, o, model)
     if len(objectives) < 2 or any(o not in OBJECTIVES for o in objectives):
         raise ParameterError(
             "objectives",
@@ -495,12 +507,8 @@ def pareto_front(
             f"two or more of {sorted(OBJECTIVES)}",
             message=f"objectives must be two or more of {sorted(OBJECTIVES)}, got {objectives!r}",
         )
-    if vary is None:
-        critical = 2 * math.sqrt(p.ks * p.ms)
-        vary = {"cs": list(np.geomspace(0.05, 4.0, 60) * critical)}
     designs = design_grid(vary, p)
-    model = quarter_car_model(p, road=True)
-    batch = model.batch([QuarterCarParams.from_mapping(d) for d in designs])
+    batch = model.batch([type(p).from_mapping(d) for d in designs])
     wk, iso = "comfort_wk" in objectives, [o for o in ISO2631_OBJECTIVES if o in objectives]
 
     def ride(m: VehicleModel, batch=None) -> pd.DataFrame:
@@ -527,7 +535,7 @@ def pareto_front(
     marks: dict[str, pd.Series] = {}
     seed_row = ride(model).iloc[0]
     marks["passive (this car)"] = seed_row
-    for goal in ("comfort", "road_holding"):
+    for goal in ("comfort", "road_holding") if isinstance(p, QuarterCarParams) else ():
         opt = optimal_damping(p, goal, road=q, travel_limit=travel_limit, sigmas=sigmas)
         marks[f"passive optimum: {goal} (cs={opt.cs:.0f})"] = ride(
             quarter_car_model(opt.params, road=True)
@@ -541,6 +549,28 @@ def pareto_front(
     markers = pd.DataFrame(marks).T
     fig = _pareto_figure(frame, front, markers, cols, travel_limit, sigmas)
     return ParetoFront(front, frame, markers, fig)
+
+
+def _pareto_car(params, vary) -> tuple[Any, VehicleModel, Mapping[str, Sequence[float]]]:
+    """``(params, model, vary)``: a registered vehicle's parameters (a half or full car)
+    as given, anything else read as the quarter car's (`as_params`); the quarter car's
+    default grid is ``cs`` from 0.05 to 4 times critical damping (60 values)."""
+    if model_for_params(params) is None or isinstance(params, QuarterCarParams):
+        p = as_params(params)
+        model = quarter_car_model(p, road=True)
+    else:
+        p, model = params, vehicle_model(params, road=True)
+    if vary is None:
+        if not isinstance(p, QuarterCarParams):
+            raise ParameterError(
+                "vary",
+                vary,
+                f"a grid of {type(p).__name__}'s parameters, e.g. "
+                "{'cs_front': [...], 'cs_rear': [...]}",
+            )
+        critical = 2 * math.sqrt(p.ks * p.ms)
+        vary = {"cs": list(np.geomspace(0.05, 4.0, 60) * critical)}
+    return p, model, vary
 
 
 def _pareto_figure(frame, front, markers, cols, travel_limit, sigmas) -> Figure:
