@@ -17,6 +17,7 @@ import pytest
 
 import qc_control as qc
 from qc_control.ride import road
+from qc_control.ride.iso2631_spectral import spectral_axis_rms
 from qc_control.studies.control_study import (
     BUMP_METRICS,
     DEFAULT_BUMP,
@@ -87,6 +88,24 @@ def test_every_design_has_the_columns_and_the_defaults_stay(cmp):
     # the default columns are still there, and the Wk RMS is ISO's a_w_z
     assert "road: rms_body_acc_wk [m/s²]" in cmp.table.columns
     assert (cmp.table["road: rms_body_acc_wk [m/s²]"] == cmp.table["road: a_w_z [m/s²]"]).all()
+
+
+def test_the_exact_table_gains_the_iso_metrics_asked_for(cmp):
+    """The linear loops' stationary a_w_z against `spectral_axis_rms` of the loop built
+    here (1e-9 relative: the same Lyapunov equation, rounding only); a_v is a_w_z on a
+    car that neither pitches nor rolls (§6.5, k_z = 1)."""
+    q = qc.road.ISO8608Road("C", speed=20.0).intensity
+    for design, model in linear_designs().items():
+        a_w = spectral_axis_rms(model, q)["z"]
+        assert cmp.exact.loc[design, "a_w_z [m/s²]"] == pytest.approx(a_w, rel=1e-9)
+        assert cmp.exact.loc[design, "a_v [m/s²]"] == pytest.approx(a_w, rel=1e-9)
+
+
+def test_without_road_metrics_the_columns_are_the_defaults():
+    one = compare_controllers(P, designs=["passive (seed)"], road_duration=1.0, bump_duration=1.0)
+    names = [c.split(": ", 1)[1].split(" [")[0] for c in one.table.columns]
+    assert names[: len(BUMP_METRICS) + len(ROAD_METRICS)] == [*BUMP_METRICS, *ROAD_METRICS]
+    assert "a_w_z [m/s²]" not in one.exact.columns
 
 
 @pytest.mark.parametrize(

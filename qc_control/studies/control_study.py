@@ -47,7 +47,13 @@ from ..ride.comfort import ride_metrics
 from ..ride.metrics import METRICS, mean_square
 from ..ride.road import Bump, ISO8608Road, as_road
 from ..ride.spectral import DEFAULT_ROAD, iso8608_spelling
-from .damping import ParetoFront, optimal_damping, pareto_front, spectral_ride
+from .damping import (
+    ISO2631_OBJECTIVES,
+    ParetoFront,
+    optimal_damping,
+    pareto_front,
+    spectral_ride,
+)
 
 __all__ = [
     "ControlComparison",
@@ -133,7 +139,9 @@ class ControlComparison:
     exact : pandas.DataFrame
         Linear design -> its exact stationary RMS metrics on the road's
         white road velocity (`qc_control.studies.damping.spectral_ride`: Lyapunov,
-        unbounded band), free of the finite run's sampling spread.
+        unbounded band), free of the finite run's sampling spread; with the
+        ISO 2631-1 metrics of ``road_metrics`` that have such a value
+        (``a_w_z``, ``a_v``, ``a_w_ry``, ``a_w_rx``).
     pareto : ParetoFront or None
         The passive comfort / road-holding front (cs x ks around the car)
         with the linear controllers marked.
@@ -239,9 +247,13 @@ def _hinf(car, beta):
     return closed_loop(car, design.controller), what
 
 
-def _exact_table(linear: dict[str, VehicleModel], iso: ISO8608Road) -> pd.DataFrame:
-    """The exact stationary metrics of the linear designs (empty when none is chosen)."""
-    rows = [spectral_ride(m, iso).set_axis([n]) for n, m in linear.items()]
+def _exact_table(
+    linear: dict[str, VehicleModel], iso: ISO8608Road, road_metrics: Sequence[str] = ()
+) -> pd.DataFrame:
+    """The exact stationary metrics of the linear designs (empty when none is chosen),
+    with those of ISO 2631-1's in ``road_metrics`` that have one (``a_w_z``, ``a_v``...)."""
+    named = [n for n in ISO2631_OBJECTIVES for m in road_metrics if m in (n, METRICS[n].column())]
+    rows = [spectral_ride(m, iso, iso2631=named).set_axis([n]) for n, m in linear.items()]
     exact = pd.concat(rows) if rows else pd.DataFrame()
     exact.index.name = "design"
     return exact
@@ -511,7 +523,8 @@ def compare_controllers(
         (§6.3.2), ``mtvv`` [m/s²] (largest 1 s running RMS, §6.3.1) and
         ``msdv`` [m/s^1.5] (Wf, §9.2.2), e.g. ``road_metrics=ROAD_METRICS +
         ISO2631_METRICS``; on a bump, whose crest factor is well over 9, the
-        standard reports VDV and MTVV.
+        standard reports VDV and MTVV. Those of the road run with an exact stationary
+        value (``a_w_z``, ``a_v``) are added to ``exact`` too.
     road_class, speed, road_seed, bump_height
         Deprecated: the road's class, speed [m/s] and seed, and the bump's
         height [m], the older form of ``road=qc.road.ISO8608Road(road_class,
@@ -605,7 +618,7 @@ def compare_controllers(
         },
         method=method,
         dt={"bump": DT_BUMP, "road": DT_ROAD},
-        exact=_exact_table(linear, iso),
+        exact=_exact_table(linear, iso, metrics["road"]),
         pareto=front,
         notes=notes,
     )
