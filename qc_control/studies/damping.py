@@ -37,7 +37,10 @@ Wk-weighted RMS vertical acceleration, and ``a_v``, the vibration total
 value ``(Σ k² a_w²)^½`` (ISO 2631-1:1997 §6.4-6.5, §8.2.3), each the exact
 weighting-augmented Lyapunov value of
 `qc_control.ride.spectral.spectral_metrics`; like every objective they enter
-the weighted sum as their squares, ``a_w² = σ²`` of the weighted signal.
+the weighted sum as their squares, ``a_w² = σ²`` of the weighted signal. The
+body's pitch and roll, ``a_w_ry`` and ``a_w_rx`` (We, k = 0.4 and 0.63 m/rad
+in ``a_v``), are objectives of a car that has them: `pareto_front` of a half
+or full car; `optimal_damping` varies the quarter car's one damper.
 """
 
 from __future__ import annotations
@@ -297,7 +300,9 @@ def optimal_damping(
         neither pitches nor rolls, equal to ``a_w_z``), or weights
         ``{'comfort': 1, 'road_holding': 50, 'travel': 0}`` of the summed
         variances (``'travel'`` alone has no finite optimum: ValueError); an
-        RMS objective such as ``a_w_z`` enters as its square.
+        RMS objective such as ``a_w_z`` enters as its square. ``'a_w_ry'`` and
+        ``'a_w_rx'`` are refused (`qc_control.ParameterError` naming
+        ``objective``): the quarter car neither pitches nor rolls.
     road : None, ISO8608Road or float
         See `spectral_ride`; it scales every variance by ``q`` and so moves
         the optimum only through ``travel_limit``.
@@ -601,7 +606,9 @@ def _pareto_figure(frame, front, markers, cols, travel_limit, sigmas) -> Figure:
             )
     ax.set_xlabel(f"{OBJECTIVES[_name_of(x)][1]} [{x.split('[')[-1]}")
     ax.set_ylabel(f"{OBJECTIVES[_name_of(y)][1]} [{y.split('[')[-1]}")
-    title = "Passive designs: comfort against road holding"
+    # the objectives by name ("comfort", "road holding", ISO 2631-1's "a_w_ry" ...)
+    x_name, y_name = (_name_of(c).replace("road_holding", "road holding") for c in (x, y))
+    title = f"Passive designs: {x_name} against {y_name}"
     if travel_limit is not None:
         title += f" ({sigmas:g}σ travel <= {1e3 * travel_limit:g} mm)"
     ax.set_title(title)
