@@ -90,7 +90,7 @@ DEFAULT_BUMP = Bump(height=0.05, length=1.0, speed=10.0, t0=0.5)
 BUMP_METRICS = ("peak_body_acc", "peak_susp_travel", "settling_time")
 #: Metrics of the road run.
 ROAD_METRICS = ("rms_body_acc", "rms_body_acc_wk", "rms_susp_travel", "rms_tire_load / static")
-#: ISO 2631-1's assessment of the seat's vertical, by registry name: the Wk-weighted RMS,
+#: ISO 2631-1's assessment of the body's vertical, by registry name: the Wk-weighted RMS,
 #: the vibration total value, VDV, MTVV (§6.1-6.5) and the motion sickness dose (§9.2.2);
 #: e.g. ``compare_controllers(road_metrics=ROAD_METRICS + ISO2631_METRICS)``.
 ISO2631_METRICS = ("a_w_z", "a_v", "vdv", "mtvv", "msdv")
@@ -523,8 +523,8 @@ def compare_controllers(
         (§6.3.2), ``mtvv`` [m/s²] (largest 1 s running RMS, §6.3.1) and
         ``msdv`` [m/s^1.5] (Wf, §9.2.2), e.g. ``road_metrics=ROAD_METRICS +
         ISO2631_METRICS``; on a bump, whose crest factor is well over 9, the
-        standard reports VDV and MTVV. Those of the road run with an exact stationary
-        value (``a_w_z``, ``a_v``) are added to ``exact`` too.
+        standard reports VDV and MTVV. The road run's with an exact
+        stationary value (``a_w_z``, ``a_v``) are added to ``exact`` too.
     road_class, speed, road_seed, bump_height
         Deprecated: the road's class, speed [m/s] and seed, and the bump's
         height [m], the older form of ``road=qc.road.ISO8608Road(road_class,
