@@ -12,6 +12,10 @@ through the LTI engine, semi-active ones through
   and the mean actuator power ``⟨fa·(vs - vu)⟩`` (positive: the actuator
   delivers energy; a semi-active damper only dissipates, so its power is
   <= 0);
+- any other metric of the registry `qc_control.ride.metrics` by name, on
+  either run (``road_metrics=``, ``bump_metrics=``): ISO 2631-1's ``a_w_z``,
+  ``a_v``, ``vdv``, ``mtvv`` and ``msdv`` for the assessment the standard
+  asks for (ISO 2631-1:1997 §6.3-6.5, §9.2.2);
 - the transmissibility from the road to the body acceleration and to the
   tire deflection of every linear design (``control.frequency_response``;
   a semi-active loop has none).
@@ -23,7 +27,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import control
@@ -40,10 +44,16 @@ from ..numerics.limits import check_memory
 from ..numerics.steps import auto_substeps
 from ..responses.timeresp import forced_response, input_output_response
 from ..ride.comfort import ride_metrics
-from ..ride.metrics import mean_square
+from ..ride.metrics import METRICS, mean_square
 from ..ride.road import Bump, ISO8608Road, as_road
 from ..ride.spectral import DEFAULT_ROAD, iso8608_spelling
-from .damping import ParetoFront, optimal_damping, pareto_front, spectral_ride
+from .damping import (
+    ISO2631_OBJECTIVES,
+    ParetoFront,
+    optimal_damping,
+    pareto_front,
+    spectral_ride,
+)
 
 __all__ = [
     "ControlComparison",
@@ -51,6 +61,7 @@ __all__ = [
     "DESIGNS",
     "BUMP_METRICS",
     "ROAD_METRICS",
+    "ISO2631_METRICS",
     "DEFAULT_BUMP",
 ]
 
@@ -79,6 +90,10 @@ DEFAULT_BUMP = Bump(height=0.05, length=1.0, speed=10.0, t0=0.5)
 BUMP_METRICS = ("peak_body_acc", "peak_susp_travel", "settling_time")
 #: Metrics of the road run.
 ROAD_METRICS = ("rms_body_acc", "rms_body_acc_wk", "rms_susp_travel", "rms_tire_load / static")
+#: ISO 2631-1's assessment of the body's vertical, by registry name: the Wk-weighted RMS,
+#: the vibration total value, VDV, MTVV (§6.1-6.5) and the motion sickness dose (§9.2.2);
+#: e.g. ``compare_controllers(road_metrics=ROAD_METRICS + ISO2631_METRICS)``.
+ISO2631_METRICS = ("a_w_z", "a_v", "vdv", "mtvv", "msdv")
 #: The sampled-data designs: the ECU's period [s], the MPC's horizon (ticks: 0.5 s, the
 #: longest preview), the actuator's force limit [N] (hard) and the travel limit [m]
 #: (soft, `qc_control.models.mpc.TRAVEL_PENALTY`).
@@ -106,7 +121,8 @@ class ControlComparison:
         Design name -> what it is (law, gains, device range).
     table : pandas.DataFrame
         One row per design: the bump metrics (``bump: ...``) and the road
-        metrics (``road: ...``), with units in the column names.
+        metrics (``road: ...``), with units in the column names
+        (`compare_controllers`' ``bump_metrics`` and ``road_metrics``).
     freqs_hz : ndarray
     transmissibility : dict[str, dict[str, ndarray]]
         Linear design -> ``{'body_acc': |H|, 'tire_defl': |H|}`` from the
@@ -123,7 +139,9 @@ class ControlComparison:
     exact : pandas.DataFrame
         Linear design -> its exact stationary RMS metrics on the road's
         white road velocity (`qc_control.studies.damping.spectral_ride`: Lyapunov,
-        unbounded band), free of the finite run's sampling spread.
+        unbounded band), free of the finite run's sampling spread; with the
+        ISO 2631-1 metrics of ``road_metrics`` that have such a value
+        (``a_w_z``, ``a_v``, ``a_w_ry``, ``a_w_rx``).
     pareto : ParetoFront or None
         The passive comfort / road-holding front (cs x ks around the car)
         with the linear controllers marked.
@@ -229,9 +247,13 @@ def _hinf(car, beta):
     return closed_loop(car, design.controller), what
 
 
-def _exact_table(linear: dict[str, VehicleModel], iso: ISO8608Road) -> pd.DataFrame:
-    """The exact stationary metrics of the linear designs (empty when none is chosen)."""
-    rows = [spectral_ride(m, iso).set_axis([n]) for n, m in linear.items()]
+def _exact_table(
+    linear: dict[str, VehicleModel], iso: ISO8608Road, road_metrics: Sequence[str] = ()
+) -> pd.DataFrame:
+    """The exact stationary metrics of the linear designs (empty when none is chosen),
+    with those of ISO 2631-1's in ``road_metrics`` that have one (``a_w_z``, ``a_v``...)."""
+    named = [n for n in ISO2631_OBJECTIVES for m in road_metrics if m in (n, METRICS[n].column())]
+    rows = [spectral_ride(m, iso, iso2631=named).set_axis([n]) for n, m in linear.items()]
     exact = pd.concat(rows) if rows else pd.DataFrame()
     exact.index.name = "design"
     return exact
@@ -302,16 +324,53 @@ def _check_run_length(built: dict, road_duration: float, bump_duration: float) -
     )
 
 
+def _durations(road_duration, bump_duration) -> tuple[float, float]:
+    """The runs' lengths [s], each at least one step of its run, refused by name otherwise."""
+    road_duration = positive("road_duration", road_duration, "s")
+    bump_duration = positive("bump_duration", bump_duration, "s")
+    for name, value, dt in (("road", road_duration, DT_ROAD), ("bump", bump_duration, DT_BUMP)):
+        if value < dt:
+            raise ValueError(
+                f"{name}_duration={value!r} s is shorter than one {dt * 1e3:g} ms step of the "
+                f"{name} run; give at least {dt:g} s"
+            )
+    return road_duration, bump_duration
+
+
+def _metric_names(name: str, value) -> tuple[str, ...]:
+    """``value`` as metric names of the registry (or their columns), refused by ``name``."""
+    known = f"metric names of qc_control.ride.metrics ({', '.join(METRICS)})"
+    if isinstance(value, str) or not isinstance(value, Iterable):
+        raise ParameterError(name, value, f"a sequence of {known}")
+    names = tuple(value)
+    columns = {m.column() for m in METRICS.values()}
+    unknown = [n for n in names if n not in METRICS and n not in columns]
+    if unknown:
+        raise ParameterError(
+            name,
+            value,
+            known,
+            message=f"{name}={value!r}: unknown metric {unknown[0]!r}; choose from {known}",
+        )
+    return names
+
+
 def _measure(
-    model: VehicleModel, runs: dict[str, tuple[np.ndarray, np.ndarray]], method: str
+    model: VehicleModel,
+    runs: dict[str, tuple[np.ndarray, np.ndarray]],
+    method: str,
+    metrics: Mapping[str, Sequence[str]],
 ) -> tuple[dict, str]:
-    """One design's row of metrics over the bump and road runs, and a note if a run failed."""
+    """One design's row of ``metrics[run]`` over the bump and road runs, and a note if a
+    run failed."""
     bump_resp = _run(model, *runs["bump"], method)
     bump_ecu = _ecu(model, bump_resp, "bump")
     road_resp = _run(model, *runs["road"], method)
     road_ecu = _ecu(model, road_resp, "road")
-    row = {f"bump: {k}": v for k, v in ride_metrics(bump_resp, model, BUMP_METRICS).items()}
-    row.update({f"road: {k}": v for k, v in ride_metrics(road_resp, model, ROAD_METRICS).items()})
+    row = {f"bump: {k}": v for k, v in ride_metrics(bump_resp, model, metrics["bump"]).items()}
+    row.update(
+        {f"road: {k}": v for k, v in ride_metrics(road_resp, model, metrics["road"]).items()}
+    )
     row["road: rms actuator force [N]"], row["road: mean actuator power [W]"] = _actuator(road_resp)
     failed = [r for r in (bump_resp, road_resp) if not r.success]
     note = f"the fixed-step run did not succeed ({failed[0].message})" if failed else ""
@@ -418,6 +477,8 @@ def compare_controllers(
     cmax: float = 4000.0,
     hinf_beta: float = 0.5,
     freqs_hz=None,
+    road_metrics: Sequence[str] = ROAD_METRICS,
+    bump_metrics: Sequence[str] = BUMP_METRICS,
     road_class: str | None = None,
     speed: float | None = None,
     road_seed: int | None = None,
@@ -452,6 +513,18 @@ def compare_controllers(
         The H∞ design's travel/comfort weight (MATLAB's β).
     freqs_hz : array_like, optional
         Transmissibility frequencies; default 200 from 0.1 to 30 Hz.
+    road_metrics, bump_metrics : sequence of str, default `ROAD_METRICS`, `BUMP_METRICS`
+        The metrics of each run, by name from `qc_control.ride.metrics.METRICS`
+        (as `qc_control.ride_metrics` takes them), each a column ``road: name
+        [unit]`` or ``bump: name [unit]`` for every design, passive, active
+        and semi-active alike. ISO 2631-1's assessment of the vertical
+        (`ISO2631_METRICS`): ``a_w_z`` [m/s²] (Wk-weighted RMS, §6.1),
+        ``a_v`` [m/s²] (vibration total value, §6.5), ``vdv`` [m/s^1.75]
+        (§6.3.2), ``mtvv`` [m/s²] (largest 1 s running RMS, §6.3.1) and
+        ``msdv`` [m/s^1.5] (Wf, §9.2.2), e.g. ``road_metrics=ROAD_METRICS +
+        ISO2631_METRICS``; on a bump, whose crest factor is well over 9, the
+        standard reports VDV and MTVV. The road run's with an exact
+        stationary value (``a_w_z``, ``a_v``) are added to ``exact`` too.
     road_class, speed, road_seed, bump_height
         Deprecated: the road's class, speed [m/s] and seed, and the bump's
         height [m], the older form of ``road=qc.road.ISO8608Road(road_class,
@@ -465,7 +538,9 @@ def compare_controllers(
     Raises
     ------
     ValueError
-        For an unknown or empty ``designs``, a bad value
+        For an unknown or empty ``designs``, an unknown metric
+        (`qc_control.ParameterError` naming ``road_metrics`` or
+        ``bump_metrics``), a bad value
         (`qc_control.ParameterError` naming it), or runs whose samples would
         not fit in memory (`qc_control.numerics.limits.ResourceLimitError`,
         before any is made).
@@ -474,15 +549,12 @@ def compare_controllers(
     """
     iso, pulse = _older_roads(road, bump, road_class, speed, road_seed, bump_height)
     p = as_params(params)
-    road_duration = positive("road_duration", road_duration, "s")
-    bump_duration = positive("bump_duration", bump_duration, "s")
-    for name, value, dt in (("road", road_duration, DT_ROAD), ("bump", bump_duration, DT_BUMP)):
-        if value < dt:
-            raise ValueError(
-                f"{name}_duration={value!r} s is shorter than one {dt * 1e3:g} ms step of the "
-                f"{name} run; give at least {dt:g} s"
-            )
+    road_duration, bump_duration = _durations(road_duration, bump_duration)
     positive("cmax", cmax, "N·s/m")
+    metrics = {
+        "road": _metric_names("road_metrics", road_metrics),
+        "bump": _metric_names("bump_metrics", bump_metrics),
+    }
     built = _design_set(p, iso, float(cmax), _design_names(designs), hinf_beta)
     _check_run_length(built, road_duration, bump_duration)
     T_road = check_time_grid(np.arange(0.0, road_duration + DT_ROAD / 2, DT_ROAD), "T")
@@ -494,7 +566,7 @@ def compare_controllers(
     f = np.geomspace(0.1, 30.0, 200) if freqs_hz is None else np.asarray(freqs_hz, float)
     rows, trans, notes = {}, {}, []
     for name, (model, _) in built.items():
-        rows[name], note = _measure(model, runs, method)
+        rows[name], note = _measure(model, runs, method, metrics)
         if note:
             notes.append(f"{name}: {note}")
         if isinstance(model.system, control.StateSpace):
@@ -546,7 +618,7 @@ def compare_controllers(
         },
         method=method,
         dt={"bump": DT_BUMP, "road": DT_ROAD},
-        exact=_exact_table(linear, iso),
+        exact=_exact_table(linear, iso, metrics["road"]),
         pareto=front,
         notes=notes,
     )

@@ -31,7 +31,16 @@ is the larger of the two.
 Objectives without a closed form (the ISO 2631-1 Wk-weighted comfort, or a
 vehicle other than the quarter car) are minimised by
 ``scipy.optimize.minimize_scalar`` on the exact Lyapunov metric
-(`qc_control.ride.spectral`).
+(`qc_control.ride.spectral`). ISO 2631-1's stationary metrics are objectives
+by their registry names (`qc_control.ride.metrics`): ``a_w_z``, the
+Wk-weighted RMS vertical acceleration, and ``a_v``, the vibration total
+value ``(Σ k² a_w²)^½`` (ISO 2631-1:1997 §6.4-6.5, §8.2.3), each the exact
+weighting-augmented Lyapunov value of
+`qc_control.ride.spectral.spectral_metrics`; like every objective they enter
+the weighted sum as their squares, ``a_w² = σ²`` of the weighted signal. The
+body's pitch and roll, ``a_w_ry`` and ``a_w_rx`` (We, k = 0.4 and 0.63 m/rad
+in ``a_v``), are objectives of a car that has them: `pareto_front` of a half
+or full car; `optimal_damping` varies the quarter car's one damper.
 """
 
 from __future__ import annotations
@@ -47,13 +56,17 @@ import pandas as pd
 import scipy.optimize
 
 from ..models.quarter import QuarterCarParams, as_params, quarter_car_model
+from ..models.registry import model_for_params, vehicle_model
 from ..models.vehicle import STANDARD_GRAVITY, VehicleModel
 from ..numerics.checks import ParameterError, choice, positive
+from ..ride.metrics import METRICS
 from ..ride.road import ISO8608Road
 from ..ride.spectral import (
     DEFAULT_ROAD,
+    ISO2631_SPECTRAL,
     require_linear,
     road_intensity,
+    spectral_metrics,
     white_velocity_variances,
     white_velocity_wk_variance,
 )
@@ -64,6 +77,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "OBJECTIVES",
+    "ISO2631_OBJECTIVES",
     "DampingOptimum",
     "ParetoFront",
     "spectral_ride",
@@ -78,10 +92,22 @@ OBJECTIVES = {
     "comfort_wk": ("rms_body_acc_wk [m/s²]", "ISO 2631-1 Wk-weighted RMS body acceleration"),
     "road_holding": ("rms_tire_load / static [-]", "RMS dynamic tire load over the static load"),
     "travel": ("rms_susp_travel [m]", "RMS suspension travel"),
+    # ISO 2631-1's exact stationary values, under their registry names and columns
+    "a_w_z": (METRICS["a_w_z"].column(), "ISO 2631-1 Wk-weighted RMS vertical acceleration"),
+    "a_v": (METRICS["a_v"].column(), "ISO 2631-1 vibration total value"),
+    "a_w_ry": (METRICS["a_w_ry"].column(), "ISO 2631-1 We-weighted RMS pitch acceleration"),
+    "a_w_rx": (METRICS["a_w_rx"].column(), "ISO 2631-1 We-weighted RMS roll acceleration"),
 }
+#: The objectives computed by `qc_control.ride.spectral.spectral_metrics` (no closed form).
+ISO2631_OBJECTIVES = tuple(name for name in OBJECTIVES if name in ISO2631_SPECTRAL)
+#: ISO 2631-1's body rotations -> (the car's output that has it, the verb): an objective
+#: only of a car that pitches or rolls (a half or full car's `pareto_front`).
+_ROTATIONS = {"a_w_ry": ("pitch_acc", "pitches"), "a_w_rx": ("roll_acc", "rolls")}
 
 
-def spectral_ride(model: VehicleModel, road=None, *, batch=None, wk: bool = False) -> pd.DataFrame:
+def spectral_ride(
+    model: VehicleModel, road=None, *, batch=None, wk: bool = False, iso2631: Sequence[str] = ()
+) -> pd.DataFrame:
     """Exact RMS ride metrics of linear designs on white road velocity.
 
     Parameters
@@ -97,11 +123,17 @@ def spectral_ride(model: VehicleModel, road=None, *, batch=None, wk: bool = Fals
         Many designs of ``model`` at once.
     wk : bool
         Also the Wk-weighted comfort (one more Lyapunov solve of 4 more states).
+    iso2631 : sequence of str, default ()
+        Also these of `ISO2631_OBJECTIVES` (``'a_w_z'``, ``'a_v'``), the exact
+        stationary ISO 2631-1 values of `qc_control.ride.spectral.spectral_metrics`
+        (the car in series with each axis's Annex A weighting, one Lyapunov
+        solve per axis).
 
     Returns
     -------
     pandas.DataFrame
-        One row per design: the columns of `OBJECTIVES` (Wk only with ``wk``).
+        One row per design: the columns of `OBJECTIVES` (Wk only with ``wk``,
+        ISO 2631-1's only as ``iso2631`` names them).
     """
     q = road_intensity(road, stacklevel=2)
     corner = model.corners[0]
@@ -122,6 +154,8 @@ def spectral_ride(model: VehicleModel, road=None, *, batch=None, wk: bool = Fals
         cols[OBJECTIVES["comfort_wk"][0]] = np.sqrt(
             white_velocity_wk_variance(model, intensity=q, batch=batch)
         )
+    if iso2631:
+        cols.update(spectral_metrics(model, q, list(iso2631), batch=batch))
     return pd.DataFrame({k: np.atleast_1d(v) for k, v in cols.items()})
 
 
@@ -171,8 +205,32 @@ class DampingOptimum:
     method: str
 
 
+def _refuse_rotation(name: str, value, objective, model: VehicleModel | None = None) -> None:
+    """ISO 2631-1's pitch or roll, refused by name on a car without it: ``model``'s
+    outputs say; without a model, the quarter car `optimal_damping` varies (one damper
+    ``cs``), which neither pitches nor rolls."""
+    if objective not in _ROTATIONS:
+        return
+    label, verb = _ROTATIONS[objective]
+    if model is not None and label in model.system.output_labels:
+        return
+    car = "the quarter car optimal_damping varies" if model is None else repr(model.name)
+    raise ParameterError(
+        name,
+        value,
+        f"one of {sorted(OBJECTIVES)}",
+        message=(
+            f"{name}={value!r}: {objective!r} needs a car whose body {verb}, which {car} "
+            "does not; draw a half or full car's front by its parameters, e.g. "
+            "qc.pareto_front(qc.HalfCarParams(), {'cs_front': [...], 'cs_rear': [...]}, "
+            f"('a_w_z', 'a_w_ry')). Objectives: {sorted(OBJECTIVES)}"
+        ),
+    )
+
+
 def _weights(objective) -> dict[str, float]:
     if isinstance(objective, str):
+        _refuse_rotation("objective", objective, objective)
         if objective not in OBJECTIVES:
             raise ParameterError(
                 "objective", objective, f"one of {sorted(OBJECTIVES)} or a mapping of weights"
@@ -185,6 +243,7 @@ def _weights(objective) -> dict[str, float]:
         )
     out = {}
     for k, v in objective.items():
+        _refuse_rotation(f"objective[{k!r}]", k, k)
         if k not in OBJECTIVES:
             raise ParameterError(f"objective[{k!r}]", k, f"one of {sorted(OBJECTIVES)}")
         out[k] = positive(f"weight of {k!r}", v, "") if v != 0 else 0.0
@@ -235,9 +294,15 @@ def optimal_damping(
         `VehicleModel` (with a road input) is optimised numerically through
         its ``rebuild``.
     objective : str or mapping
-        ``'comfort'``, ``'comfort_wk'``, ``'road_holding'``, or weights
+        ``'comfort'``, ``'comfort_wk'``, ``'road_holding'``, ISO 2631-1's
+        ``'a_w_z'`` (Wk-weighted RMS vertical acceleration, m/s²) or
+        ``'a_v'`` (vibration total value, m/s²; on a quarter car, which
+        neither pitches nor rolls, equal to ``a_w_z``), or weights
         ``{'comfort': 1, 'road_holding': 50, 'travel': 0}`` of the summed
-        variances (``'travel'`` alone has no finite optimum: ValueError).
+        variances (``'travel'`` alone has no finite optimum: ValueError); an
+        RMS objective such as ``a_w_z`` enters as its square. ``'a_w_ry'`` and
+        ``'a_w_rx'`` are refused (`qc_control.ParameterError` naming
+        ``objective``): the quarter car neither pitches nor rolls.
     road : None, ISO8608Road or float
         See `spectral_ride`; it scales every variance by ``q`` and so moves
         the optimum only through ``travel_limit``.
@@ -247,7 +312,7 @@ def optimal_damping(
         1 for an RMS limit, 3 for a 3σ limit.
     solver : 'auto', 'closed form' or 'numerical'
         ``'auto'`` uses the closed form where one exists (the quarter car,
-        any weights without ``comfort_wk``).
+        any weights without ``comfort_wk`` or an ISO 2631-1 metric).
     bounds : (float, float), optional
         The numerical search's ``cs`` interval [N·s/m]; default 0.01 to 100
         times the critical damping ``2√(ks·ms)``.
@@ -297,18 +362,20 @@ def optimal_damping(
             "(cs_front, cs_rear): sweep them with qc.sweep({'cs_front': [...], 'cs_rear': "
             "[...]}, model=..., road=qc.ISO8608Road(...))"
         )
-    closed = isinstance(p, QuarterCarParams) and "comfort_wk" not in weights
+    weighted = {"comfort_wk", *ISO2631_OBJECTIVES}  # a weighting filter: no closed form
+    closed = isinstance(p, QuarterCarParams) and not weighted & set(weights)
     closed = closed and not isinstance(params, VehicleModel) and not p.cu  # seed's tire
     if method == "closed form" and not closed:
         raise ValueError(
-            "no closed form for this objective or vehicle (Wk weighting, or not a quarter "
-            "car): use solver='numerical' or 'auto'"
+            "no closed form for this objective or vehicle (an ISO 2631-1 weighting, or not "
+            "a quarter car): use solver='numerical' or 'auto'"
         )
     use_closed = closed and method != "numerical"
     wk = "comfort_wk" in weights
+    iso = [k for k in ISO2631_OBJECTIVES if k in weights]
 
     def objective_value(m: VehicleModel) -> tuple[float, pd.Series]:
-        row = spectral_ride(m, q, wk=wk).iloc[0]
+        row = spectral_ride(m, q, wk=wk, iso2631=iso).iloc[0]
         return sum(w * row[OBJECTIVES[k][0]] ** 2 for k, w in weights.items()), row
 
     if use_closed:
@@ -402,13 +469,21 @@ def pareto_front(
 
     Parameters
     ----------
-    params : QuarterCarParams, dict or None
-        The base vehicle.
+    params : QuarterCarParams, HalfCarParams, FullCarParams, dict or None
+        The base vehicle (a dict or None: the quarter car's). On a half or
+        full car the body's metrics are the whole car's and ``'road_holding'``
+        and ``'travel'`` are the first corner's (the front), as `spectral_ride`
+        reads them.
     vary : mapping
-        Parameter name -> values; default ``cs`` from 0.05 to 4 times
-        critical damping (60 values).
+        Parameter name -> values; for the quarter car, default ``cs`` from
+        0.05 to 4 times critical damping (60 values); a half or full car's
+        must be given (e.g. ``{'cs_front': [...], 'cs_rear': [...]}``).
     objectives : sequence of str
-        Two or more of `OBJECTIVES`; the figure plots the first two.
+        Two or more of `OBJECTIVES` (``'comfort'``, ``'comfort_wk'``,
+        ``'road_holding'``, ``'travel'``, and ISO 2631-1's exact ``'a_w_z'``
+        and ``'a_v'`` [m/s²], and of a car that pitches or rolls ``'a_w_ry'``
+        and ``'a_w_rx'`` [rad/s²]; e.g. ``('a_w_z', 'road_holding')``); the
+        figure plots the first two.
     road : None, ISO8608Road or float
         See `spectral_ride`; default `qc_control.ride.spectral.DEFAULT_ROAD`, ISO 8608
         class C at 20 m/s.
@@ -425,9 +500,11 @@ def pareto_front(
     -------
     ParetoFront
     """
-    p = as_params(params)
+    p, model, vary = _pareto_car(params, vary)
     q = road_intensity(road, stacklevel=2)  # read once: every design sees the same number
     objectives = list(objectives)
+    for o in objectives:
+        _refuse_rotation("objectives", objectives, o, model)
     if len(objectives) < 2 or any(o not in OBJECTIVES for o in objectives):
         raise ParameterError(
             "objectives",
@@ -435,14 +512,15 @@ def pareto_front(
             f"two or more of {sorted(OBJECTIVES)}",
             message=f"objectives must be two or more of {sorted(OBJECTIVES)}, got {objectives!r}",
         )
-    if vary is None:
-        critical = 2 * math.sqrt(p.ks * p.ms)
-        vary = {"cs": list(np.geomspace(0.05, 4.0, 60) * critical)}
     designs = design_grid(vary, p)
-    model = quarter_car_model(p, road=True)
-    batch = model.batch([QuarterCarParams.from_mapping(d) for d in designs])
-    wk = "comfort_wk" in objectives
-    table = spectral_ride(model, q, batch=batch, wk=wk)
+    batch = model.batch([type(p).from_mapping(d) for d in designs])
+    wk, iso = "comfort_wk" in objectives, [o for o in ISO2631_OBJECTIVES if o in objectives]
+
+    def ride(m: VehicleModel, batch=None) -> pd.DataFrame:
+        """The objectives' metrics of ``m`` (or its designs) on this road."""
+        return spectral_ride(m, q, batch=batch, wk=wk, iso2631=iso)
+
+    table = ride(model, batch)
     frame = pd.concat([pd.DataFrame(designs)[list(vary)], table], axis=1)
     travel = frame[OBJECTIVES["travel"][0]].to_numpy()
     feasible = np.ones(len(frame), dtype=bool)
@@ -460,22 +538,44 @@ def pareto_front(
     front = frame[pareto].sort_values(cols[0]).reset_index(drop=True)
 
     marks: dict[str, pd.Series] = {}
-    seed_row = spectral_ride(model, q, wk=wk).iloc[0]
+    seed_row = ride(model).iloc[0]
     marks["passive (this car)"] = seed_row
-    for goal in ("comfort", "road_holding"):
+    for goal in ("comfort", "road_holding") if isinstance(p, QuarterCarParams) else ():
         opt = optimal_damping(p, goal, road=q, travel_limit=travel_limit, sigmas=sigmas)
-        marks[f"passive optimum: {goal} (cs={opt.cs:.0f})"] = spectral_ride(
-            quarter_car_model(opt.params, road=True), q, wk=wk
+        marks[f"passive optimum: {goal} (cs={opt.cs:.0f})"] = ride(
+            quarter_car_model(opt.params, road=True)
         ).iloc[0]
     for name, ctrl in (controllers or {}).items():
         if isinstance(ctrl, VehicleModel):
             require_linear(ctrl, f"controllers[{name!r}]: the closed loop")
-            marks[name] = spectral_ride(ctrl, q, wk=wk).iloc[0]
+            marks[name] = ride(ctrl).iloc[0]
         else:
             marks[name] = pd.Series(dict(ctrl))
     markers = pd.DataFrame(marks).T
     fig = _pareto_figure(frame, front, markers, cols, travel_limit, sigmas)
     return ParetoFront(front, frame, markers, fig)
+
+
+def _pareto_car(params, vary) -> tuple[Any, VehicleModel, Mapping[str, Sequence[float]]]:
+    """``(params, model, vary)``: a registered vehicle's parameters (a half or full car)
+    as given, anything else read as the quarter car's (`as_params`); the quarter car's
+    default grid is ``cs`` from 0.05 to 4 times critical damping (60 values)."""
+    if model_for_params(params) is None or isinstance(params, QuarterCarParams):
+        p = as_params(params)
+        model = quarter_car_model(p, road=True)
+    else:
+        p, model = params, vehicle_model(params, road=True)
+    if vary is None:
+        if not isinstance(p, QuarterCarParams):
+            raise ParameterError(
+                "vary",
+                vary,
+                f"a grid of {type(p).__name__}'s parameters, e.g. "
+                "{'cs_front': [...], 'cs_rear': [...]}",
+            )
+        critical = 2 * math.sqrt(p.ks * p.ms)
+        vary = {"cs": list(np.geomspace(0.05, 4.0, 60) * critical)}
+    return p, model, vary
 
 
 def _pareto_figure(frame, front, markers, cols, travel_limit, sigmas) -> Figure:
@@ -506,7 +606,9 @@ def _pareto_figure(frame, front, markers, cols, travel_limit, sigmas) -> Figure:
             )
     ax.set_xlabel(f"{OBJECTIVES[_name_of(x)][1]} [{x.split('[')[-1]}")
     ax.set_ylabel(f"{OBJECTIVES[_name_of(y)][1]} [{y.split('[')[-1]}")
-    title = "Passive designs: comfort against road holding"
+    # the objectives by name ("comfort", "road holding", ISO 2631-1's "a_w_ry" ...)
+    x_name, y_name = (_name_of(c).replace("road_holding", "road holding") for c in (x, y))
+    title = f"Passive designs: {x_name} against {y_name}"
     if travel_limit is not None:
         title += f" ({sigmas:g}σ travel <= {1e3 * travel_limit:g} mm)"
     ax.set_title(title)
