@@ -119,6 +119,9 @@ def spectral_ride(
         its intensity ``2π² n0² Gd(n0) v``), or an intensity ``q`` [m²/s]
         (`qc_control.ride.spectral.road_intensity`). A ``(class, speed)``
         pair still works, with a DeprecationWarning naming the ISO8608Road.
+        On an ISO 8608 road a car's rear wheels meet the front wheels' road
+        ``(a + b)/speed`` later (`qc_control.ride.spectral.rear_delay`); an
+        intensity alone has no speed, and its tracks are independent.
     batch : BatchedModel, optional
         Many designs of ``model`` at once.
     wk : bool
@@ -136,12 +139,15 @@ def spectral_ride(
         ISO 2631-1's only as ``iso2631`` names them).
     """
     q = road_intensity(road, stacklevel=2)
+    # an ISO 8608 road has a speed: a car's rear wheels meet it a wheelbase later
+    speed = road.speed if isinstance(road, ISO8608Road) else None
     corner = model.corners[0]
     var = white_velocity_variances(
         model,
         intensity=q,
         outputs=[model.body_acc, corner.susp_travel, corner.tire_defl],
         batch=batch,
+        speed=speed,
     )
     kt = corner.tire_stiffness if batch is None else batch.tire_stiffness[0]
     load = corner.static_load if batch is None else batch.static_load[0]
@@ -152,11 +158,22 @@ def spectral_ride(
     }
     if wk:
         cols[OBJECTIVES["comfort_wk"][0]] = np.sqrt(
-            white_velocity_wk_variance(model, intensity=q, batch=batch)
+            white_velocity_wk_variance(model, intensity=q, batch=batch, speed=speed)
         )
     if iso2631:
-        cols.update(spectral_metrics(model, q, list(iso2631), batch=batch))
+        cols.update(spectral_metrics(model, q, list(iso2631), batch=batch, speed=speed))
     return pd.DataFrame({k: np.atleast_1d(v) for k, v in cols.items()})
+
+
+def _read_road(road):
+    """A study's road, read once (an older ``(class, speed)`` pair warns here, once):
+    an `ISO8608Road` (its speed delays a car's rear wheels), or the intensity ``q``."""
+    q = road_intensity(road, stacklevel=3)
+    if isinstance(road, ISO8608Road):
+        return road
+    if isinstance(road, tuple):
+        return ISO8608Road(road[0], speed=road[1])
+    return q
 
 
 def closed_form_terms(p: QuarterCarParams, objective: str) -> tuple[float, float]:
@@ -349,7 +366,7 @@ def optimal_damping(
     method = solver
     choice("solver", method, ("auto", "closed form", "numerical"))
     sigmas = positive("sigmas", sigmas, "")
-    q = road_intensity(road, stacklevel=2)
+    road = _read_road(road)
     model = (
         params
         if isinstance(params, VehicleModel)
@@ -375,7 +392,7 @@ def optimal_damping(
     iso = [k for k in ISO2631_OBJECTIVES if k in weights]
 
     def objective_value(m: VehicleModel) -> tuple[float, pd.Series]:
-        row = spectral_ride(m, q, wk=wk, iso2631=iso).iloc[0]
+        row = spectral_ride(m, road, wk=wk, iso2631=iso).iloc[0]
         return sum(w * row[OBJECTIVES[k][0]] ** 2 for k, w in weights.items()), row
 
     if use_closed:
@@ -401,7 +418,7 @@ def optimal_damping(
         cs = math.exp(float(res.x))
         how = "scipy.optimize"
     if travel_limit is not None:
-        floor = _travel_floor(p, q, travel_limit, sigmas)
+        floor = _travel_floor(p, road_intensity(road), travel_limit, sigmas)
         if cs < floor:
             cs, how = floor, f"{how}, travel limit"
     best = model.rebuild(_with_cs(p, cs))
@@ -501,7 +518,7 @@ def pareto_front(
     ParetoFront
     """
     p, model, vary = _pareto_car(params, vary)
-    q = road_intensity(road, stacklevel=2)  # read once: every design sees the same number
+    road = _read_road(road)  # read once: every design sees the same road
     objectives = list(objectives)
     for o in objectives:
         _refuse_rotation("objectives", objectives, o, model)
@@ -518,7 +535,7 @@ def pareto_front(
 
     def ride(m: VehicleModel, batch=None) -> pd.DataFrame:
         """The objectives' metrics of ``m`` (or its designs) on this road."""
-        return spectral_ride(m, q, batch=batch, wk=wk, iso2631=iso)
+        return spectral_ride(m, road, batch=batch, wk=wk, iso2631=iso)
 
     table = ride(model, batch)
     frame = pd.concat([pd.DataFrame(designs)[list(vary)], table], axis=1)
@@ -541,7 +558,7 @@ def pareto_front(
     seed_row = ride(model).iloc[0]
     marks["passive (this car)"] = seed_row
     for goal in ("comfort", "road_holding") if isinstance(p, QuarterCarParams) else ():
-        opt = optimal_damping(p, goal, road=q, travel_limit=travel_limit, sigmas=sigmas)
+        opt = optimal_damping(p, goal, road=road, travel_limit=travel_limit, sigmas=sigmas)
         marks[f"passive optimum: {goal} (cs={opt.cs:.0f})"] = ride(
             quarter_car_model(opt.params, road=True)
         ).iloc[0]
