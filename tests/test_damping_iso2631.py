@@ -175,6 +175,7 @@ def test_an_iso_objective_has_no_closed_form():
 ROTATIONS = {"a_w_ry [rad/s²]": ("ry", 0.4), "a_w_rx [rad/s²]": ("rx", 0.63)}
 
 
+@pytest.mark.filterwarnings("ignore::qc_control.ride.spectral.IndependentTracksWarning")
 @pytest.mark.parametrize(
     "params, objectives",
     [

@@ -473,6 +473,7 @@ def _a_v(values: dict) -> float:
     return float(np.sqrt(values["z"] ** 2 + rotations))
 
 
+@pytest.mark.filterwarnings("ignore::qc_control.ride.spectral.IndependentTracksWarning")
 @pytest.mark.parametrize("name", CARS)
 def test_the_spectral_sweep_gives_iso2631_metrics_as_the_single_design_lyapunov(name):
     """sweep(road=ISO8608Road) without T takes the spectral path: its batched a_w_z,
@@ -544,6 +545,7 @@ def test_a_sweep_reads_a_cars_pitch_and_roll_for_the_rotation_metrics(name):
         assert row["a_v [m/s²]"] == pytest.approx(exact.a_v, rel=1e-3)
 
 
+@pytest.mark.filterwarnings("ignore::qc_control.ride.spectral.IndependentTracksWarning")
 @pytest.mark.parametrize("name", CARS)
 def test_the_spectral_sweep_delays_each_design_by_its_own_wheelbase(name):
     """Designs of different wheelbases in one batch: each design's rear wheels meet
