@@ -99,7 +99,7 @@ def test_msdv_of_a_slow_heave_is_its_closed_form():
 
 
 def test_a_v_is_its_formula_from_the_axes():
-    """a_v = (Σ k² a_w²)^½ with §8.2.3's k (1, 1, 1; 0.63, 0.4 m/rad), to rounding."""
+    """a_v = (Σ k² a_w²)^½ with §8.2's k (1, 1, 1; 0.63, 0.4 m/rad), to rounding."""
     T = np.arange(0.0, 20.0, 0.002)
     rng = np.random.default_rng(3)
     signals = {axis: rng.standard_normal(T.size) for axis in ("x", "y", "z", "rx", "ry")}
@@ -187,7 +187,7 @@ def test_a_half_car_response_gives_its_axes_by_role():
     for axis in ("x", "z", "ry"):
         assert result[axis].a_w == pytest.approx(direct[axis].a_w, rel=1e-12)
     standing = qc.ride_assessment(resp, seat=0.6, posture="standing")
-    assert list(standing.axes) == ["x", "z"]  # §8.2.3: the floor's translations only
+    assert list(standing.axes) == ["x", "z"]  # §8.2: the floor's translations only
     assert standing.health.zone is None  # Annex B is for seated persons
     keep = [i for i, label in enumerate(labels) if label != "pitch_acc"]
     full = model.system

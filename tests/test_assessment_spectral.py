@@ -99,7 +99,7 @@ def test_full_car_every_axis_against_1200_s():
     for axis in ("x", "y", "rx", "ry"):
         value, error = sim[axis]
         assert exact[axis] == pytest.approx(value, rel=3 * error), axis
-    k = {"x": 1.0, "y": 1.0, "z": 1.0, "rx": 0.63, "ry": 0.4}  # §8.2.3, seated
+    k = {"x": 1.0, "y": 1.0, "z": 1.0, "rx": 0.63, "ry": 0.4}  # §8.2, seated
     expected = np.sqrt(sum((k[a] * exact[a]) ** 2 for a in k))
     assert spectral_a_v(exact) == pytest.approx(expected, rel=1e-12)
 

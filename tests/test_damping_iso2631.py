@@ -14,7 +14,7 @@ References, each computed here apart from the study:
 * the road-holding variance of Gobbi & Mastinu (2001), written out here.
 * a half and a full car's a_w_z, a_w_ry, a_w_rx per design from
   `spectral_axis_rms` of the car built here, and a_v from ISO 2631-1:1997
-  §6.5 with the seated factors of §8.2.3 written out (k_z = 1, k_ry = 0.4
+  §6.5 with the seated factors of §8.2 written out (k_z = 1, k_ry = 0.4
   m/rad, k_rx = 0.63 m/rad).
 """
 
@@ -106,7 +106,7 @@ def non_dominated(pts):
 
 
 def test_a_v_of_a_quarter_car_is_its_vertical():
-    """ISO 2631-1 §6.5 with k_z = 1 (§8.2.3) and no rotation: a_v = a_w_z exactly."""
+    """ISO 2631-1 §6.5 with k_z = 1 (§8.2) and no rotation: a_v = a_w_z exactly."""
     opt = qc.optimal_damping(SEED, "a_v", road=C20)
     assert opt.metrics["a_v [m/s²]"] == pytest.approx(a_w_z(opt.cs), rel=1e-12)
 

@@ -236,7 +236,7 @@ def test_iso_axes_and_a_v_of_long_sines():
     ``|W(f)| a/√2`` (the taper's missing energy, (1 - 3/8)·3 s / 400 s, is
     0.47 % of the mean square, 0.23 % of the RMS; with the filters' ringing
     measured 0.37 % at most: bound 6e-3), and a_v is ``(a_wz² + (0.4 a_wry)² +
-    (0.63 a_wrx)²)^½`` (ISO 2631-1 §8.2.3's k, typed here) to rounding. The
+    (0.63 a_wrx)²)^½`` (ISO 2631-1 §8.2's k, typed here) to rounding. The
     quarter car's roles give a_v = a_w_z and no rotation."""
     T = np.linspace(0.0, 400.0, 400 * 200 + 1)
     ramp = np.where(T < 3.0, 0.5 - 0.5 * np.cos(np.pi * np.minimum(T, 3.0) / 3.0), 1.0)

@@ -463,7 +463,7 @@ CARS = {
     "half": (qc.half_car_model, qc.HalfCarParams, ("ry",)),
     "full": (qc.full_car_model, qc.FullCarParams, ("rx", "ry")),
 }
-#: ISO 2631-1's seated comfort factors of the rotations (§8.2.3): k [m/rad].
+#: ISO 2631-1's seated comfort factors of the rotations (§8.2): k [m/rad].
 K_ROTATION = {"rx": 0.63, "ry": 0.4}
 
 
@@ -478,7 +478,7 @@ def _a_v(values: dict) -> float:
 def test_the_spectral_sweep_gives_iso2631_metrics_as_the_single_design_lyapunov(name):
     """sweep(road=ISO8608Road) without T takes the spectral path: its batched a_w_z,
     a_w_rx, a_w_ry, a_v of each design equal `spectral_axis_rms` of that design alone
-    and a_v its formula (ISO 2631-1 §6.5, k of §8.2.3), to 1e-12 (the same Lyapunov
+    and a_v its formula (ISO 2631-1 §6.5, k of §8.2), to 1e-12 (the same Lyapunov
     equations, batched or not: rounding only); a rotation the car has not is 0."""
     from qc_control.ride.iso2631_spectral import spectral_axis_rms
 

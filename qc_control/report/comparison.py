@@ -573,7 +573,7 @@ def _comfort_blocks(cmp) -> list:
         index=summary.index,
     )
     lead = (
-        "MTVV and VDV first, the additional methods being the assessment (§6.2.1, §6.3.3): each"
+        "MTVV and VDV first, the additional methods being the assessment (§6.2, §6.3.3): each"
         if comfort.additional_methods
         else "Each"
     )

@@ -9,11 +9,11 @@ reduced as §6 defines (``a_w(t)`` the weighted signal over ``[0, T]``):
     a_w = \Big(\frac1T \int_0^T a_w^2(t)\,dt\Big)^{1/2} \ \text{(§6.1, eq. 1)},
     \qquad
     a_w(t_0) = \Big(\frac1τ \int_{t_0-τ}^{t_0} a_w^2(t)\,dt\Big)^{1/2},\
-    \mathrm{MTVV} = \max_{t_0} a_w(t_0) \ \text{(§6.3.1, eqs. 2, 3)},
+    \mathrm{MTVV} = \max_{t_0} a_w(t_0) \ \text{(§6.3.1, eqs. 2, 4)},
 
 .. math::
 
-    \mathrm{VDV} = \Big(\int_0^T a_w^4(t)\,dt\Big)^{1/4} \ \text{(§6.3.2, eq. 4)},
+    \mathrm{VDV} = \Big(\int_0^T a_w^4(t)\,dt\Big)^{1/4} \ \text{(§6.3.2, eq. 5)},
     \qquad
     a_v = \Big(\sum_{axes} k^2 a_w^2\Big)^{1/2} \ \text{(§6.5)},
     \qquad
@@ -132,9 +132,9 @@ class AxisAssessment:
         ``peak / a_w`` [-] (§6.2.1).
     mtvv : float
         Maximum transient vibration value, the largest 1 s running RMS
-        (§6.3.1, eq. 3) [unit].
+        (§6.3.1, eq. 4) [unit].
     vdv : float
-        Vibration dose value (§6.3.2, eq. 4) [unit·s^0.25].
+        Vibration dose value (§6.3.2, eq. 5) [unit·s^0.25].
     duration : float
         The measured period T [s].
     k : float
@@ -157,12 +157,12 @@ class AxisAssessment:
 
     @property
     def mtvv_ratio(self) -> float:
-        """``MTVV / a_w`` (§6.3.3, eq. 5)."""
+        """``MTVV / a_w`` (§6.3.3, eq. 6)."""
         return self.mtvv / self.a_w if self.a_w > 0 else float("nan")
 
     @property
     def vdv_ratio(self) -> float:
-        """``VDV / (a_w T^¼)`` (§6.3.3, eq. 6)."""
+        """``VDV / (a_w T^¼)`` (§6.3.3, eq. 7)."""
         scale = self.a_w * self.duration**0.25
         return self.vdv / scale if scale > 0 else float("nan")
 
@@ -170,8 +170,8 @@ class AxisAssessment:
 _AXIS_CLAUSES = {
     "a_w": "ISO 2631-1:1997 §6.1, eq. (1)",
     "crest_factor": "ISO 2631-1:1997 §6.2.1",
-    "mtvv": "ISO 2631-1:1997 §6.3.1, eqs. (2), (3), τ = 1 s",
-    "vdv": "ISO 2631-1:1997 §6.3.2, eq. (4)",
+    "mtvv": "ISO 2631-1:1997 §6.3.1, eqs. (2)-(4), τ = 1 s",
+    "vdv": "ISO 2631-1:1997 §6.3.2, eq. (5)",
 }
 
 
@@ -209,7 +209,7 @@ class RideAssessment:
     posture : str
     a_v : float
         Vibration total value for comfort ``(Σ k² a_w²)^½`` over the
-        assessed axes [m/s²] (§6.5, factors of §8.2.3).
+        assessed axes [m/s²] (§6.5, factors of §8.2).
     msdv : float or None
         Motion sickness dose value of the vertical, Wf-weighted [m/s^1.5]
         (§9.2.2); None without a ``z`` axis.
@@ -219,7 +219,7 @@ class RideAssessment:
     crest_factor : float
         The largest crest factor over the axes [-].
     additional_methods : bool
-        Whether §6.2.1 / §6.3.3 call for MTVV and VDV: a crest factor over
+        Whether §6.2 / §6.3.3 call for MTVV and VDV: a crest factor over
         9, ``MTVV/a_w > 1.5`` or ``VDV/(a_w T^¼) > 1.75`` on any axis.
     triggers : tuple of str
         Which of those held, on which axis, in words.
@@ -298,7 +298,7 @@ class RideAssessment:
     def verdict(self) -> tuple[str, ...]:
         """The findings in the standard's words, one sentence each, with clauses.
 
-        Where the additional methods are the assessment (§6.2.1, §6.3.3: a
+        Where the additional methods are the assessment (§6.2, §6.3.3: a
         shock), the sentence giving MTVV and VDV comes first, the RMS-based
         a_v and comfort words after it; otherwise a_v leads."""
         c = self.clauses
@@ -339,11 +339,11 @@ class RideAssessment:
 
 
 _CLAUSES = {
-    "a_v": "ISO 2631-1:1997 §6.5, k of §8.2.3",
+    "a_v": "ISO 2631-1:1997 §6.5, k of §8.2",
     "comfort": "ISO 2631-1:1997 Annex C.2.3",
     "msdv": "ISO 2631-1:1997 §9.2.2 (Wf)",
     "illness": "ISO 2631-1:1997 Annex D, K_m = 1/3",
-    "additional_methods": "ISO 2631-1:1997 §6.2.1, §6.3.3 eqs. (5), (6)",
+    "additional_methods": "ISO 2631-1:1997 §6.2, §6.3.3 eqs. (6), (7)",
     "crest_factor": "ISO 2631-1:1997 §6.2.1",
 }
 
@@ -430,7 +430,7 @@ def ride_assessment(
         A response's seat height above the pitch and roll axes [m]: gives
         ``x`` and ``y`` of a half or full car. None: no fore-aft or lateral.
     posture : {'seated', 'standing'}
-        Selects the axes, weightings and factors (§7.2, §8.2.3).
+        Selects the axes, weightings and factors (§7.2, §8.2).
     duration : float, optional
         Daily exposure [s] for Annex B's health guidance (10 min to 24 h).
     model : VehicleModel, optional
@@ -465,9 +465,9 @@ def ride_assessment(
     else:
         raw, T, notes = axis_signals(signals_or_response, seat=seat, model=model)
         unused = [axis for axis in raw if axis not in AXIS_RULES[posture]]
-        if unused:  # a car's rotations are not assessed standing (§8.2.3)
+        if unused:  # a car's rotations are not assessed standing (§8.2)
             raw = {k: v for k, v in raw.items() if k not in unused}
-            notes += (f"{', '.join(unused)}: not assessed {posture} (ISO 2631-1 §8.2.3)",)
+            notes += (f"{', '.join(unused)}: not assessed {posture} (ISO 2631-1 §8.2)",)
     signals = _checked_signals(raw, posture)
     T, dt = _grid(T, next(iter(signals.values())).size)
     rules = AXIS_RULES[posture]
@@ -499,7 +499,7 @@ def _judged(axes, signals, T, dt, posture, duration, notes) -> RideAssessment:
 
 
 def _triggers(axes) -> tuple[str, ...]:
-    """The §6.2.1 / §6.3.3 conditions that call for the additional methods, in words."""
+    """The §6.2 / §6.3.3 conditions that call for the additional methods, in words."""
     out = []
     for a in axes:
         for what, value, limit in (

@@ -5,8 +5,8 @@ The standard's judgement, apart from the signal processing
 
 - per axis and posture, the weighting and the multiplying factors ``k``
   (§7.2 for health, §8.2 for comfort; `AXIS_RULES`);
-- the crest-factor rule (§6.2.1) and the ratios that call for the additional
-  methods (§6.3.3, eqs. 5 and 6);
+- the crest-factor rule (§6.2) and the ratios that call for the additional
+  methods (§6.3.3, eqs. 6 and 7);
 - Annex C's comfort scale (`comfort_labels`), its bands overlapping as
   printed;
 - Annex B's health guidance caution zone for a daily exposure
@@ -37,11 +37,11 @@ __all__ = [
     "RUNNING_RMS_WINDOW",
 ]
 
-#: §6.2.1: the basic (RMS) method is normally sufficient up to this crest factor.
+#: §6.2: the basic (RMS) method is normally sufficient up to this crest factor.
 CREST_FACTOR_LIMIT = 9.0
-#: §6.3.3 eq. (5): MTVV / a_w above this calls for the additional methods.
+#: §6.3.3 eq. (6): MTVV / a_w above this calls for the additional methods.
 MTVV_RATIO_LIMIT = 1.5
-#: §6.3.3 eq. (6): VDV / (a_w T^¼) above this calls for the additional methods.
+#: §6.3.3 eq. (7): VDV / (a_w T^¼) above this calls for the additional methods.
 VDV_RATIO_LIMIT = 1.75
 #: Annex D (D.2): percentage of a mixed population of unadapted adults who may
 #: vomit per unit MSDV_z: ``K_m = 1/3`` [% per m/s^1.5].
@@ -76,14 +76,14 @@ class AxisRule(NamedTuple):
     unit: str
 
 
-_FLOOR = "ISO 2631-1:1997 §8.2.3 (comfort, standing: the floor, k = 1)"
-_SEAT = "ISO 2631-1:1997 §8.2.3 (comfort, seated: the seat surface, k = 1)"
-_SEAT_ROT = "ISO 2631-1:1997 §8.2.3 (comfort, seat-surface rotations, We)"
+_FLOOR = "ISO 2631-1:1997 §8.2 (comfort, standing: the floor, k = 1)"
+_SEAT = "ISO 2631-1:1997 §8.2 (comfort, seated: the seat surface, k = 1)"
+_SEAT_ROT = "ISO 2631-1:1997 §8.2 (comfort, seat-surface rotations, We)"
 #: Per posture, the axes the standard assesses there and their rules. Seated:
 #: the seat surface, translations weighted Wd (x, y) and Wk (z) with k = 1 for
-#: comfort (§8.2.3) and k = 1.4, 1.4, 1 for health (§7.2.3); rotations
-#: weighted We with k = 0.63, 0.4, 0.2 m/rad (§8.2.3; no health rule).
-#: Standing: the floor, Wd, Wd, Wk, k = 1 (§8.2.3); Annex B is for seated
+#: comfort (§8.2) and k = 1.4, 1.4, 1 for health (§7.2.3); rotations
+#: weighted We with k = 0.63, 0.4, 0.2 m/rad (§8.2; no health rule).
+#: Standing: the floor, Wd, Wd, Wk, k = 1 (§8.2); Annex B is for seated
 #: persons, so no health rule.
 AXIS_RULES: dict[str, dict[str, AxisRule]] = {
     "seated": {

@@ -270,7 +270,7 @@ def _rotation_rms(axis: str):
 def _a_v(s, _) -> np.ndarray:
     """Seated comfort's vibration total value of the body's axes: the vertical
     (Wk) and, on a car with two axles or two sides, its pitch and roll (We,
-    k = 0.4 and 0.63 m/rad): ISO 2631-1:1997 §6.5, §8.2.3. Which rotations
+    k = 0.4 and 0.63 m/rad): ISO 2631-1:1997 §6.5, §8.2. Which rotations
     a car has is read from its corners' names (``rear``: pitch, ``left``:
     roll), so a response without the output is refused, never left out."""
     rules = AXIS_RULES["seated"]
@@ -304,14 +304,14 @@ _ALL = (
     Metric("vdv", "m/s^1.75", "vibration dose value (∫ a_w⁴ dt)^¼ (ISO 2631-1:1997, 6.3.2)",
            lambda s, _: s.quartic_integral(WEIGHTED_ACC) ** 0.25),
     Metric("a_w_z", "m/s²", "ISO 2631-1 weighted RMS of the seat's vertical, Wk "
-           "(ISO 2631-1:1997, 6.1 eq. 1, 8.2.3)",
+           "(ISO 2631-1:1997, 6.1 eq. 1, 8.2)",
            lambda s, _: np.sqrt(s.mean_square(WEIGHTED_ACC))),
     Metric("a_w_rx", "rad/s²", "ISO 2631-1 weighted RMS of the body's roll acceleration, We "
-           "(ISO 2631-1:1997, 8.2.3)", _rotation_rms("rx")),
+           "(ISO 2631-1:1997, 8.2)", _rotation_rms("rx")),
     Metric("a_w_ry", "rad/s²", "ISO 2631-1 weighted RMS of the body's pitch acceleration, We "
-           "(ISO 2631-1:1997, 8.2.3)", _rotation_rms("ry")),
+           "(ISO 2631-1:1997, 8.2)", _rotation_rms("ry")),
     Metric("a_v", "m/s²", "ISO 2631-1 vibration total value for comfort of the body's axes: "
-           "z and the rotations (ISO 2631-1:1997, 6.5, 8.2.3)", _a_v),
+           "z and the rotations (ISO 2631-1:1997, 6.5, 8.2)", _a_v),
     Metric("mtvv", "m/s²", "maximum transient vibration value: the largest 1 s running RMS "
            "of the Wk-weighted vertical (ISO 2631-1:1997, 6.3.1)", _mtvv),
     Metric("msdv", "m/s^1.5", "motion sickness dose value of the Wf-weighted vertical "

@@ -660,7 +660,7 @@ def spectral_axis_rms(
 
 def spectral_a_v(per_axis, posture: str = "seated"):
     """The vibration total value ``(Σ k² a_w²)^½`` (ISO 2631-1:1997 §6.5, k of
-    §8.2.3) of `spectral_axis_rms`' values [m/s²]."""
+    §8.2) of `spectral_axis_rms`' values [m/s²]."""
     rules = AXIS_RULES[checks.choice("posture", posture, POSTURES)]
     return np.sqrt(sum((rules[a].k_comfort * v) ** 2 for a, v in per_axis.items()))
 
@@ -691,7 +691,7 @@ def spectral_metrics(
     Lyapunov values over the unbounded band. ISO 2631-1's ``a_w_z``,
     ``a_w_rx``, ``a_w_ry`` (the body's vertical, roll and pitch, each with
     its Annex A weighting) and ``a_v = (Σ k² a_w²)^½`` over them (§6.5, k of
-    §8.2.3) come from `spectral_axis_rms` without a seat height, as the
+    §8.2) come from `spectral_axis_rms` without a seat height, as the
     time-domain metrics define them; a rotation the car does not have is 0.
 
     Parameters

@@ -34,7 +34,7 @@ vehicle other than the quarter car) are minimised by
 (`qc_control.ride.spectral`). ISO 2631-1's stationary metrics are objectives
 by their registry names (`qc_control.ride.metrics`): ``a_w_z``, the
 Wk-weighted RMS vertical acceleration, and ``a_v``, the vibration total
-value ``(Σ k² a_w²)^½`` (ISO 2631-1:1997 §6.4-6.5, §8.2.3), each the exact
+value ``(Σ k² a_w²)^½`` (ISO 2631-1:1997 §6.4-6.5, §8.2), each the exact
 weighting-augmented Lyapunov value of
 `qc_control.ride.spectral.spectral_metrics`; like every objective they enter
 the weighted sum as their squares, ``a_w² = σ²`` of the weighted signal. The
