@@ -46,6 +46,37 @@ def test_invariant_point_does_not_depend_on_damping(zeta):
     assert tr.invariant_gain == pytest.approx(p.ku / p.ms, rel=1e-12)
 
 
+def test_no_invariant_point_with_tire_damping_or_other_states():
+    """With tire damping cu the summed equations keep cu(xu' - zr'): at √(ku/mu) the
+    gain moves with the damper (94.1, 92.6 and 95.1 (m/s²)/m at ζ = 0.1, 0.5 and 1
+    with cu = 300 N·s/m, against 98.04 for all three without; 65.1 was quoted at
+    another frequency): no invariant point, NaN. A system
+    whose states are not the quarter car's (here the same car, states reordered)
+    has other matrices: NaN, where positions read as the quarter car's gave
+    numbers that mean nothing."""
+    f = np.sqrt(qc.QuarterCarParams().ku / qc.QuarterCarParams().mu) / (2 * np.pi)
+    gains = [
+        abs(transmissibility(qc.QuarterCarParams(zeta=z, cu=300.0), [f]).response["body_acc"][0])
+        for z in (0.1, 0.5)
+    ]
+    assert abs(gains[0] / gains[1] - 1) > 0.01  # not invariant: the damper moves it
+    tr = transmissibility(qc.QuarterCarParams(cu=300.0), [f])
+    assert np.isnan(tr.invariant_hz) and np.isnan(tr.invariant_gain)
+    sys = qc.quarter_car(road=True)
+    order = [2, 3, 0, 1]
+    P = np.eye(4)[order]  # x_new = P x: positions, then velocities
+    moved = control.ss(
+        P @ sys.A @ P.T, P @ sys.B, sys.C @ P.T, sys.D,
+        states=[sys.state_labels[i] for i in order],
+        inputs=sys.input_labels, outputs=sys.output_labels,
+    )  # fmt: skip
+    tr = transmissibility(moved, [f])
+    assert np.isnan(tr.invariant_hz)
+    # the responses themselves do not depend on the states' order
+    same = transmissibility(sys, [f]).response["body_acc"][0]
+    assert tr.response["body_acc"][0] == pytest.approx(same, rel=1e-12)
+
+
 def test_static_gains():
     tr = transmissibility(None, [1e-4])
     assert abs(tr.response["xs"][0]) == pytest.approx(1.0, abs=1e-7)  # body follows
@@ -139,3 +170,20 @@ def test_bad_inputs():
         ride_metrics_spectral(None, road.ISO8608Road("Q"))
     with pytest.raises(ValueError, match="speed must be a finite number > 0 m/s, got 0.0"):
         ride_metrics_spectral(None, road.ISO8608Road("C", speed=0.0))
+
+
+@pytest.mark.parametrize("cu", [0.0, 300.0])
+def test_the_transmissibility_figure_marks_an_invariant_point_only_where_there_is_one(cu):
+    """The report's figure: the circle and its legend entry with the quarter car's
+    invariant point, neither (no "nan Hz") with tire damping."""
+    from types import SimpleNamespace
+
+    from qc_control.report.figures import transmissibility_figure
+
+    p = qc.QuarterCarParams(cu=cu)
+    cmp = SimpleNamespace(transmissibility=transmissibility(p), model=None)
+    fig = transmissibility_figure(cmp)
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    marked = any("invariant point" in label for label in labels)
+    assert marked == (cu == 0.0)
+    assert not any("nan" in label for label in labels)

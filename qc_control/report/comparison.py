@@ -224,12 +224,15 @@ def _ride_figures(cmp) -> list[_FigureDraft]:
     """The transmissibility, when the comparison ran on a road and has one."""
     if cmp.ride is None or getattr(cmp, "transmissibility", None) is None:
         return []
+    invariant = (
+        "; the circle is the invariant point √(ku/mu), where |body_acc/zr| = ku/ms for every damper"
+        if np.isfinite(cmp.transmissibility.invariant_hz)
+        else ""
+    )
     return [
         _FigureDraft(
             "transmissibility.png",
-            "Transmissibility from the road height zr (magnitude and phase); the "
-            "circle is the invariant point √(ku/mu), where |body_acc/zr| = ku/ms for "
-            "every damper",
+            "Transmissibility from the road height zr (magnitude and phase)" + invariant,
             lambda: transmissibility_figure(cmp),
         )
     ]

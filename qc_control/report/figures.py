@@ -517,15 +517,9 @@ def transmissibility_figure(cmp) -> Figure:
     handles = [
         Line2D([], [], color="tab:blue", lw=1.6, label="|H| (left axis)"),
         Line2D([], [], color="tab:orange", lw=0.9, label="phase (right axis)"),
-        Line2D(
-            [],
-            [],
-            ls="none",
-            marker="o",
-            color="k",
-            mfc="none",
-            label=f"invariant point\n{tr.invariant_hz:.3g} Hz, |H| = ku/ms",
-        ),
     ]
+    if np.isfinite(tr.invariant_hz):  # none with tire damping (see transmissibility)
+        label = f"invariant point\n{tr.invariant_hz:.3g} Hz, |H| = ku/ms"
+        handles.append(Line2D([], [], ls="none", marker="o", color="k", mfc="none", label=label))
     _legend(fig, handles=handles, loc="outside lower center", ncols=3)
     return fig

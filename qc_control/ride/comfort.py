@@ -71,7 +71,7 @@ class Transmissibility:
         (and roll) acceleration and every corner's travel and tire deflection.
     invariant_hz : float
         ``√(ku/mu)/2π``: there ``|body_acc/zr| = ku/ms`` whatever the damping
-        (quarter car; NaN otherwise).
+        (a quarter car whose tire has no damping; NaN otherwise).
     invariant_gain : float
         ``ku/ms`` [1/s²] (quarter car; NaN otherwise).
     units : dict[str, str]
@@ -198,12 +198,21 @@ def transmissibility(sys_or_params=None, freqs_hz=None, *, speed=None) -> Transm
     j = sys.input_labels.index("zr")
     H = np.asarray(fr.complex)
     response = {name: H[sys.output_labels.index(name), j] for name in _SIGNALS}
+    return Transmissibility(f, response, *_invariant_point(sys, j))
+
+
+def _invariant_point(sys: control.StateSpace, j: int) -> tuple[float, float]:
+    """``(√(ku/mu)/2π, ku/ms)`` read from the quarter car's matrices, or NaNs where
+    there is no such point: a tire with damping ``cu`` adds ``cu(xu' - zr')`` to
+    the summed equations, so no frequency is the same for every damper, and a
+    system with other states (another one-wheel model) has other matrices."""
     A, B = np.asarray(sys.A), np.asarray(sys.B)
+    if list(sys.state_labels) != ["vs", "vu", "xs", "xu"] or A[1, 0] + A[1, 1] != 0.0:
+        return math.nan, math.nan  # A[1, :2] = [cs/mu, -(cs + cu)/mu]: cu = 0 only
     ku_over_mu = B[1, j]
     # body_acc row: A[0] = [-cs/ms, cs/ms, -ks/ms, ks/ms]; ku/ms = ku/mu * mu/ms and
     # mu/ms = (ks/ms)/(ks/mu) = A[0,3]/A[1,2]
-    ku_over_ms = ku_over_mu * A[0, 3] / A[1, 2]
-    return Transmissibility(f, response, math.sqrt(ku_over_mu) / (2 * math.pi), ku_over_ms)
+    return math.sqrt(ku_over_mu) / (2 * math.pi), ku_over_mu * A[0, 3] / A[1, 2]
 
 
 def _axle_transmissibility(model: VehicleModel, f: np.ndarray, speed) -> Transmissibility:
