@@ -242,6 +242,17 @@ def _road(road: Any, default: Mapping[str, Any] | None) -> Road:
     return road
 
 
+def _kind_road(kind: Any, default: Mapping[str, Any] | None) -> Mapping[str, Any] | None:
+    """The road a road table fills what it omits from: a scenario kind's run's
+    (`KINDS`: ``--scenario pothole --speed 10`` is the pothole at 10 m/s), else
+    the model's ``default``."""
+    if kind == "pothole":
+        return POTHOLE.road()
+    if kind == "stiff":
+        return STIFF_CAR.road()
+    return default
+
+
 def _warn_road_form(given: Any, road: Road) -> None:
     """A `DeprecationWarning` for a road given by its kind's name or as a table
     (``road='bump'``, ``road={'kind': 'bump', ...}``): the `Road` it makes is the
@@ -826,7 +837,7 @@ class Scenario:
             extra = {k: v for k, v in run.items() if k not in RUN_KEYS}
             if road:  # the file's table, as the Road it describes over the model's default
                 model = get_model(_model_name(fixed.get("model"), layout["vehicle"]))
-                road = _road(road, model.defaults.road)
+                road = _road(road, _kind_road(fixed.get("kind"), model.defaults.road))
             return cls(
                 vehicle=cast(Any, layout["vehicle"]),
                 road=cast(Any, road or None),
