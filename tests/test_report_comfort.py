@@ -161,6 +161,8 @@ def test_the_command_refuses_comfort_off_a_road_in_one_line(tmp_path, capsys):
                  "--out", str(tmp_path / "r")]) == 2  # fmt: skip
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("qc-control: error: --exposure")
+    # the value, and the range in Figure B.1's words (its 10 min is 0.166667 h)
+    assert "got 48.0" in err[0] and "10 min to 24 h" in err[0]
 
 
 def _report_text(tmp_path, args, part="## Ride comfort", end="## Road and ride") -> str:

@@ -464,7 +464,16 @@ class Scenario:
             low, high = EXPOSURE_HOURS
             put(
                 "exposure",
-                _checked(checks.number, "exposure", self.exposure, "h", low=low, high=high),
+                _checked(
+                    checks.number,
+                    "exposure",
+                    self.exposure,
+                    "h",
+                    low=low,
+                    high=high,
+                    # the bound 0.166667 h alone does not read as Figure B.1's 10 min
+                    description="daily hours; Annex B's Figure B.1 covers 10 min to 24 h",
+                ),
             )
 
     def comfort_request(self) -> dict[str, float] | bool:
