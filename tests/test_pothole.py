@@ -94,6 +94,19 @@ def test_a_road_option_changes_only_its_parameter_of_the_kinds_road(words, expec
     assert again == sc
 
 
+def test_a_bump_turned_down_is_described_as_a_pothole():
+    """The report said 'a -5 cm high ... bump' for the pothole; a bump of
+    negative height reads as the pothole's own words (`Pothole.describe`),
+    and a bump of positive height as before."""
+    from qc_control.ride.road import Bump
+
+    down = Bump(height=-0.05, length=0.3, speed=20.0, t0=1.0)
+    assert down.describe() == POTHOLE.describe()
+    assert down.describe() == "a 5 cm deep, 0.3 m long 1 − cos pothole met at t = 1 s at 20 m/s"
+    up = Bump(height=0.1, length=1.0, speed=15.0, t0=0.5)
+    assert up.describe() == "a 10 cm high, 1 m long 1 − cos bump met at t = 0.5 s at 15 m/s"
+
+
 def test_a_road_option_over_the_stiff_run_keeps_its_road():
     from qc_control.cli.parser import build_parser, scenario_from_args
     from qc_control.ride.road import ISO8608Road
