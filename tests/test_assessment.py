@@ -176,6 +176,20 @@ def test_comfort_labels_at_annex_c_band_edges(a_v, labels):
     assert comfort_labels(a_v) == labels
 
 
+def test_the_summary_says_which_zone_the_ride_is_in():
+    """The summary's health verdict read 'in'. A 5 Hz sine of 1 m/s² has
+    a_w = |Wk(5 Hz)|/√2 (Annex A written out here, about 0.73 m/s²), inside
+    eq. (B.1)'s 0.43-0.86 m/s² for 8 h a day and below its 1.72-3.44 m/s² for
+    half an hour (a_w T^½ constant: 4 times the 8 h zone)."""
+    T = np.arange(0.0, 10.0, 0.002)
+    z = np.sin(2 * np.pi * 5 * T)
+    a_w = annex_a("Wk", 5.0) / math.sqrt(2)
+    assert 0.43 < a_w < 0.86  # so the references below hold
+    for hours, words in ((8, "in the caution zone"), (0.5, "below the caution zone")):
+        summary = qc.ride_assessment({"z": z}, T=T, duration=hours * 3600).summary()
+        assert summary.loc["health verdict", "value"] == words
+
+
 def test_health_zone_scales_as_eq_b1():
     """Eq. (B.1): a_w T^½ constant; at 8 h the zone is 0.43-0.86 m/s², at 2 h twice that."""
     T = np.arange(0.0, 10.0, 0.002)

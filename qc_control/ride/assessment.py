@@ -280,6 +280,7 @@ class RideAssessment:
         """The whole-ride numbers, one row each: ``value``, ``unit`` and the
         ``clause`` it follows (what a report cites beside each)."""
         h = self.health
+        verdict = f"{h.rms_verdict} the caution zone" if h.rms_verdict else h.note
         rows = [
             ("a_v", self.a_v, "m/s²", self.clauses["a_v"]),
             ("comfort", " / ".join(self.comfort), "", self.clauses["comfort"]),
@@ -289,7 +290,8 @@ class RideAssessment:
             ("illness", self.illness, "%", self.clauses["illness"]),
             ("health k·a_w", h.a_w, "m/s²", h.clause),
             ("health zone", h.zone, "m/s²", h.clause),
-            ("health verdict", h.rms_verdict or h.note, "", h.clause),
+            # 'in' alone does not say in what: the caution zone of Figure B.1
+            ("health verdict", verdict, "", h.clause),
         ]
         frame = pd.DataFrame(rows, columns=["quantity", "value", "unit", "clause"])
         return frame.set_index("quantity")
