@@ -42,6 +42,8 @@ from ..numerics.methods import METHODS, get_method
 from ..numerics.stability import max_stable_step
 from ..numerics.steps import preferred_step
 from ..ride import road as roads
+from ..ride.guidance import RUNNING_RMS_WINDOW
+from ..ride.iso2631 import band_top
 
 # ROADS and ISO8608Road: 0.1's names of this module (``from qc_control.scenario import
 # ROADS``), which answers that old path; the road kinds are `qc_control.road`'s
@@ -458,6 +460,8 @@ class Scenario:
                 "scenario",
                 "comfort",
             )
+        if self.comfort:
+            self._comfort_grid()
         if self.seat_height is not None:
             put("seat_height", _checked(checks.finite, "seat_height", self.seat_height, "m"))
         if self.exposure is not None:
@@ -474,6 +478,26 @@ class Scenario:
                     # the bound 0.166667 h alone does not read as Figure B.1's 10 min
                     description="daily hours; Annex B's Figure B.1 covers 10 min to 24 h",
                 ),
+            )
+
+    def _comfort_grid(self) -> None:
+        """Refuse, before the run, a grid the assessment cannot weigh: shorter than
+        the running RMS's window (§6.3.1; the nonlinear car's 0.8 s bump run) or
+        coarser than Wk's band, the vertical every car has, reaching 12.5 Hz."""
+        window = RUNNING_RMS_WINDOW
+        if self.t_end < window * (1 - 1e-9):
+            raise ScenarioError(
+                f"t_end = {self.t_end:g} s is shorter than the {window:g} s window of ISO "
+                "2631-1's running RMS (§6.3.1), which comfort needs: give t_end >= "
+                f"{window:g} s (--t-end)",
+                "scenario",
+                "t_end",
+            )
+        top = band_top("Wk")
+        if 2 * top * self.h > 1 + 1e-12:  # Nyquist 1/(2h) below the band's top
+            why = f"ISO 2631-1's Wk reaches {top:g} Hz, so h must be <= {1 / (2 * top):g} s"
+            raise ScenarioError(
+                f"h = {self.h:g} s is too coarse for comfort: {why}", "scenario", "h"
             )
 
     def comfort_request(self) -> dict[str, float] | bool:
