@@ -195,6 +195,9 @@ def test_the_command_reports_a_half_car_on_a_class_c_road(tmp_path):
         "--comfort --seat-height 0.5 --exposure 1"
     ).split()
     section = _report_text(tmp_path, args)
+    # the note, capitalised as the report's sentences are, still names the axes in
+    # lower case (it read 'X and y are ...'), at the --seat-height given
+    assert "The seat's x and y are its motion 0.5 m above the pitch and roll axes" in section
     _, _, _, expected = _half_car_on_class_c(2.0)
     # the report prints 4 significant digits: 5e-4 relative
     assert _number(section, "z", 4) == pytest.approx(expected["z"].a_w, rel=5e-4)

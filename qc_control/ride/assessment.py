@@ -572,7 +572,7 @@ def axis_signals(response, *, seat: float | None = None, model: VehicleModel | N
             signals["x"] = h * signals["ry"]
         if "rx" in signals:
             signals["y"] = -h * signals["rx"]
-        notes.append(f"x and y are the seat's motion {h:g} m above the pitch and roll axes")
+        notes.append(f"the seat's x and y are its motion {h:g} m above the pitch and roll axes")
     elif "rx" in signals or "ry" in signals:
         notes.append("no seat height (seat=): the fore-aft and lateral axes are not assessed")
     elif seat is not None:
