@@ -130,6 +130,31 @@ def test_mtvv_of_a_burst_is_the_direct_running_rms():
     assert any("MTVV/a_w" in t for t in result.triggers)
 
 
+def test_the_verdict_quotes_the_axes_that_call_for_the_additional_methods():
+    """§6.3.3: the verdict gave MTVV and VDV of the axis of the largest crest
+    factor, which may be one whose RMS suffices. Here z is stationary noise
+    (crest factor about 4, ratios under the limits) and x a 5 Hz sine twice as
+    strong for 2 s of 10 (MTVV/a_w about 2, crest factor about 3): the verdict
+    quotes x, the one axis over the standard's limits (9, 1.5, 1.75 written out
+    here), not z."""
+    dt = 0.001
+    T = np.arange(0.0, 10.0, dt)
+    rng = np.random.default_rng(7)
+    x = np.where(T < 2.0, 1.0, 0.2) * np.sin(2 * np.pi * 5 * T)
+    result = qc.ride_assessment({"x": x, "z": rng.standard_normal(T.size)}, T=T)
+    frame = result.to_pandas()
+    over = frame[
+        (frame["crest_factor [-]"] > 9)
+        | (frame["mtvv/a_w [-]"] > 1.5)
+        | (frame["vdv/(a_w T^¼) [-]"] > 1.75)
+    ].index
+    assert list(over) == ["x"]  # the signals built as the docstring says
+    assert result["z"].crest_factor > result["x"].crest_factor
+    first = result.verdict[0]
+    assert f"x: MTVV = {result['x'].mtvv:.3g} m/s²" in first
+    assert "z: MTVV" not in first
+
+
 @pytest.mark.parametrize(
     ("a_v", "labels"),
     [
@@ -149,6 +174,20 @@ def test_comfort_labels_at_annex_c_band_edges(a_v, labels):
     """Annex C.2.3 as printed: ranges hold their ends, "less than 0,315" and
     "greater than 2" do not."""
     assert comfort_labels(a_v) == labels
+
+
+def test_the_summary_says_which_zone_the_ride_is_in():
+    """The summary's health verdict read 'in'. A 5 Hz sine of 1 m/s² has
+    a_w = |Wk(5 Hz)|/√2 (Annex A written out here, about 0.73 m/s²), inside
+    eq. (B.1)'s 0.43-0.86 m/s² for 8 h a day and below its 1.72-3.44 m/s² for
+    half an hour (a_w T^½ constant: 4 times the 8 h zone)."""
+    T = np.arange(0.0, 10.0, 0.002)
+    z = np.sin(2 * np.pi * 5 * T)
+    a_w = annex_a("Wk", 5.0) / math.sqrt(2)
+    assert 0.43 < a_w < 0.86  # so the references below hold
+    for hours, words in ((8, "in the caution zone"), (0.5, "below the caution zone")):
+        summary = qc.ride_assessment({"z": z}, T=T, duration=hours * 3600).summary()
+        assert summary.loc["health verdict", "value"] == words
 
 
 def test_health_zone_scales_as_eq_b1():

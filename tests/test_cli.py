@@ -604,6 +604,39 @@ def test_output_survives_a_terminal_that_cannot_encode_it(argv):
     assert text.strip() and b"Traceback" not in out.stderr
 
 
+@pytest.mark.parametrize(
+    "argv, spelt",
+    [(["control-report", "--help"], "Hinf"), (["modes", "--help"], "cs/(2sqrt(ks*ms))")],
+)
+def test_output_survives_the_c_locale(argv, spelt):
+    """Under the C locale without UTF-8 mode (LC_ALL=C PYTHONUTF8=0: a bare
+    container, a cron job) stdout is ASCII with surrogateescape, not strict,
+    and --help ended in a UnicodeEncodeError on its ∞. It exits 0 now, every
+    byte ASCII, H∞ and √ spelt as `SPELLED` gives them."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONIOENCODING"}
+    env.update(LC_ALL="C", PYTHONUTF8="0")
+    code = "import sys; from qc_control.cli.console import main; sys.exit(main(sys.argv[1:]))"
+    out = subprocess.run(
+        [sys.executable, "-c", code, *argv], capture_output=True, timeout=300, env=env
+    )
+    assert out.returncode == 0, out.stderr.decode("ascii", "replace")
+    assert b"Traceback" not in out.stderr
+    assert spelt in out.stdout.decode("ascii")  # every byte is ASCII
+
+
+def test_undecodable_bytes_of_a_path_are_written_back():
+    """The C locale decodes a path's non-ASCII bytes to lone surrogates: they
+    are written back as those very bytes (what ``surrogateescape`` does), so
+    'wrote .../rép/report.html' names the folder as typed."""
+    typed = "my rép".encode()  # UTF-8, as a terminal types it
+    seen = typed.decode("ascii", "surrogateescape")  # what sys.argv holds under LC_ALL=C
+    assert seen.encode("ascii", "qc-control-spell") == typed
+    # a surrogate beside a character the code page lacks, last in the line (it
+    # was read past the end: an IndexError): each by its own rule
+    assert (seen + " ∞").encode("ascii", "qc-control-spell") == typed + b" inf"
+    assert "H∞".encode("cp1252", "qc-control-spell") == b"Hinf"
+
+
 def test_characters_a_code_page_lacks_are_spelt_out():
     from qc_control.cli.console import SPELLED
 

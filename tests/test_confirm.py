@@ -31,3 +31,37 @@ def test_a_cost_beyond_the_longest_run_stays_an_estimate_under_an_input():
     assert check.verdict == "too long" and check.runs == 0
     assert check.evaluations == estimate and check.steps is None
     assert math.isnan(check.error)
+
+
+def test_no_cost_is_quoted_above_a_refinement_that_reached_it():
+    """The half car on a class C road at 20 m/s, 0-10 s at h = 5 ms: RK4's own run
+    there (8,000 evaluations) is within 1e-6 m of python-control's exact response,
+    yet the check from the estimate (about 4,860, a coarser step that resamples the
+    road) missed and climbed to 130,000 'confirmed' evaluations, 16 times the run
+    the report's convergence table showed reaching it. A refinement is a run at
+    that count against the exact response: the cost quoted is never above it."""
+    import control
+    import pandas as pd
+
+    from qc_control.studies import columns as col
+    from qc_control.studies.confirm import confirmed_costs
+
+    model = qc.half_car_model(road=True)
+    T = np.linspace(0.0, 10.0, 2001)
+    road = qc.road.ISO8608Road("C", speed=20.0, seed=0)
+    U, _ = road.wheel_inputs(T, "axles", wheelbase=model.params.a + model.params.b)
+    z = list(model.system.output_labels).index("z")
+    exact = control.forced_response(model.system, T, U, np.zeros(8)).outputs[z]
+    rk4 = qc.forced_response(model.system, T, U, np.zeros(8), method="rk4").outputs[z]
+    error = float(np.max(np.abs(rk4 - exact)))
+    assert error < 1e-6  # the run the report's convergence table holds (1.36e-7 m)
+    runs = pd.DataFrame(
+        {col.METHOD: ["rk4"], col.STEPS: [2000], col.NFEV: [8000], col.ERROR: [error]}
+    )
+    cost = pd.DataFrame({"rk4": {1e-6: 4860.0}})
+    kind = pd.DataFrame({"rk4": {1e-6: "extrapolated"}})
+    quoted, verdict, (check,) = confirmed_costs(
+        model.system, T, np.zeros(8), U, [qc.get_method("rk4")], cost, kind, "z", runs=runs
+    )
+    assert quoted.loc[1e-6, "rk4"] <= 8000 and verdict.loc[1e-6, "rk4"] == "confirmed"
+    assert check.error <= 1e-6 and check.evaluations == quoted.loc[1e-6, "rk4"]

@@ -72,6 +72,51 @@ def test_pothole_scenario_kind():
     assert Scenario(kind="pothole", t_end=2.0).t_end == 2.0
 
 
+@pytest.mark.parametrize(
+    "words, expected",
+    [
+        # the pothole (5 cm deep, 0.3 m long, met at 1 s) at 10 m/s: only the speed changes
+        (["--speed", "10"], bump(T, height=-0.05, length=0.3, speed=10.0, t0=1.0)),
+        (["--road-t0", "0.5"], bump(T, height=-0.05, length=0.3, speed=20.0, t0=0.5)),
+    ],
+)
+def test_a_road_option_changes_only_its_parameter_of_the_kinds_road(words, expected):
+    """`--scenario pothole --speed 10` was refused: the road table of --speed,
+    having no kind, was read as "no road". It is the pothole at 10 m/s, every
+    other parameter the run's; the reference is the 1 − cos bump written out."""
+    from qc_control.cli.parser import build_parser, scenario_from_args
+
+    sc = scenario_from_args(build_parser().parse_args(["report", "--scenario", "pothole", *words]))
+    assert np.array_equal(sc.road.samples(T), expected)
+    assert (sc.t_end, sc.h) == (POTHOLE.t_end, POTHOLE.h)
+    # the command it writes redoes it
+    again = scenario_from_args(build_parser().parse_args(sc.command().split()[1:]))
+    assert again == sc
+
+
+def test_a_bump_turned_down_is_described_as_a_pothole():
+    """The report said 'a -5 cm high ... bump' for the pothole; a bump of
+    negative height reads as the pothole's own words (`Pothole.describe`),
+    and a bump of positive height as before."""
+    from qc_control.ride.road import Bump
+
+    down = Bump(height=-0.05, length=0.3, speed=20.0, t0=1.0)
+    assert down.describe() == POTHOLE.describe()
+    assert down.describe() == "a 5 cm deep, 0.3 m long 1 − cos pothole met at t = 1 s at 20 m/s"
+    up = Bump(height=0.1, length=1.0, speed=15.0, t0=0.5)
+    assert up.describe() == "a 10 cm high, 1 m long 1 − cos bump met at t = 0.5 s at 15 m/s"
+
+
+def test_a_road_option_over_the_stiff_run_keeps_its_road():
+    from qc_control.cli.parser import build_parser, scenario_from_args
+    from qc_control.ride.road import ISO8608Road
+
+    argv = ["report", "--scenario", "stiff", "--road-class", "D"]
+    sc = scenario_from_args(build_parser().parse_args(argv))
+    # the stiff run's road (ISO 8608, 20 m/s, seed 0) on class D, as written out directly
+    assert sc.road == ISO8608Road("D", speed=20.0, seed=0)
+
+
 @pytest.mark.slow
 @pytest.mark.xdist_group("docs")  # the gallery's run of the example, once per suite
 def test_the_example_prints_the_peaks_and_draws_both_figures(docs_build):

@@ -122,6 +122,35 @@ def test_an_unknown_weighting_is_refused(name):
         qc.weighted(np.zeros(3), [0.0, 0.001, 0.002], name)
 
 
+@pytest.mark.parametrize(
+    ("call", "name", "value"),
+    [
+        (lambda: qc.weighting("Wx"), "weighting", "Wx"),
+        (lambda: qc.weighted(np.zeros(10), np.linspace(0.0, 2.0, 201), "Wk"), "acc", (10,)),
+        # Wk reaches 12.5 Hz: 50 ms samples (Nyquist 10 Hz) cannot hold it
+        (lambda: qc.weighted(np.zeros(3), [0.0, 0.05, 0.1], "Wk"), "T", 0.05),
+        (lambda: qc.weighted(np.zeros(4), [0.0, 0.001, 0.003, 0.004], "Wk"), "T", None),
+    ],
+)
+def test_refusals_are_the_parameter_error_naming_the_value(call, name, value):
+    """Issue 41: every bad input refused by name, through qc.ParameterError
+    (these were bare ValueErrors, with no .name for a program to read)."""
+    with pytest.raises(qc.ParameterError) as info:
+        call()
+    assert info.value.name == name
+    if isinstance(value, float):
+        assert info.value.value == pytest.approx(value, rel=1e-12)  # the grid's own step
+    elif value is not None:
+        assert info.value.value == value
+
+
+def test_a_non_finite_sample_is_the_parameter_error_naming_it():
+    nan = np.r_[0.0, 0.0, 0.0, np.nan, np.zeros(197)]
+    with pytest.raises(qc.ParameterError, match="acc is not finite at sample 3") as info:
+        qc.weighted(nan, np.linspace(0.0, 2.0, 201), "Wk")
+    assert info.value.name == "acc" and np.isnan(info.value.value)
+
+
 def test_bad_signals_are_refused_by_name():
     T = np.linspace(0.0, 2.0, 201)  # dt = 10 ms: Nyquist 50 Hz
     with pytest.raises(ValueError, match="acc is not finite at sample 3"):

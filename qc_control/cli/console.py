@@ -30,26 +30,41 @@ SPELLED = {
 _LONGEST = max(map(len, SPELLED))
 
 
-def _spell(error: UnicodeError) -> tuple[str, int]:
-    """The codec error handler ``qc-control-spell``: `SPELLED`, else '?'."""
+def _spell(error: UnicodeError) -> tuple[str | bytes, int]:
+    """The codec error handler ``qc-control-spell``: `SPELLED`, else '?'.
+
+    A lone surrogate U+DC80-U+DCFF is a byte the C locale could not decode
+    (a non-ASCII path given on the command line): it is written back as that
+    byte, as Python's own ``surrogateescape`` does, so the path prints as typed.
+    """
     if not isinstance(error, UnicodeEncodeError):
         raise error
     text = error.object
+    end = error.start
+    while end < error.end and "\udc80" <= text[end] <= "\udcff":
+        end += 1
+    if end > error.start:
+        return bytes(ord(c) - 0xDC00 for c in text[error.start : end]), end
     for size in range(_LONGEST, 0, -1):
         piece = text[error.start : error.start + size]
         if piece in SPELLED:
-            return SPELLED[piece], error.start + size
+            return SPELLED[piece], error.start + len(piece)
     return "?", error.start + 1
 
 
 codecs.register_error("qc-control-spell", _spell)
 
 
+_FAILING = ("strict", "surrogateescape", "backslashreplace")
+
+
 def _terminal_safe() -> None:
     """Let stdout and stderr write every character, whatever they encode to."""
     for stream in (sys.stdout, sys.stderr):
         reconfigure = getattr(stream, "reconfigure", None)
-        if reconfigure is not None and getattr(stream, "errors", "strict") == "strict":
+        # the C locale (LC_ALL=C, PYTHONUTF8=0) gives stdout ASCII with surrogateescape,
+        # which fails on a ∞ as strict does; stderr's backslashreplace shows \u221e
+        if reconfigure is not None and getattr(stream, "errors", "strict") in _FAILING:
             reconfigure(errors="qc-control-spell")
 
 

@@ -598,8 +598,8 @@ def _comfort_blocks(cmp) -> list:
 def _ride_blocks(cmp, figs: dict[str, Image]) -> list:
     """Under a road input: the comfort assessment (when the study made one), the
     transmissibility and the ride metrics."""
-    if cmp.ride is None:
-        return []
+    if cmp.ride is None:  # a nonlinear car: no ride table, yet its assessment is shown
+        return _comfort_blocks(cmp)
     blocks: list = [Heading("Road and ride")]
     if "transmissibility.png" in figs:
         blocks.append(figs["transmissibility.png"])

@@ -280,6 +280,7 @@ class RideAssessment:
         """The whole-ride numbers, one row each: ``value``, ``unit`` and the
         ``clause`` it follows (what a report cites beside each)."""
         h = self.health
+        verdict = f"{h.rms_verdict} the caution zone" if h.rms_verdict else h.note
         rows = [
             ("a_v", self.a_v, "m/s²", self.clauses["a_v"]),
             ("comfort", " / ".join(self.comfort), "", self.clauses["comfort"]),
@@ -289,7 +290,8 @@ class RideAssessment:
             ("illness", self.illness, "%", self.clauses["illness"]),
             ("health k·a_w", h.a_w, "m/s²", h.clause),
             ("health zone", h.zone, "m/s²", h.clause),
-            ("health verdict", h.rms_verdict or h.note, "", h.clause),
+            # 'in' alone does not say in what: the caution zone of Figure B.1
+            ("health verdict", verdict, "", h.clause),
         ]
         frame = pd.DataFrame(rows, columns=["quantity", "value", "unit", "clause"])
         return frame.set_index("quantity")
@@ -307,12 +309,16 @@ class RideAssessment:
             f"{' / '.join(self.comfort)} ({c['comfort']})"
         )
         if self.additional_methods:
-            worst = max(self.axes.values(), key=lambda a: a.crest_factor)
+            # the axes the triggers name, each with its own values: the largest crest
+            # factor may be on an axis whose RMS suffices
+            shocks = "; ".join(
+                f"{a.axis}: MTVV = {a.mtvv:.3g} {a.unit}, VDV = {a.vdv:.3g} {a.unit}·s^¼"
+                for a in self.axes.values()
+                if _exceeded(a)
+            )
             out = [
                 f"{'; '.join(self.triggers)}: the RMS underestimates the shocks, and the "
-                f"assessment is MTVV and VDV ({worst.axis}: MTVV = {worst.mtvv:.3g} "
-                f"{worst.unit}, VDV = {worst.vdv:.3g} {worst.unit}·s^¼) "
-                f"({c['additional_methods']})",
+                f"assessment is MTVV and VDV ({shocks}) ({c['additional_methods']})",
                 rms,
             ]
         else:
@@ -498,18 +504,26 @@ def _judged(axes, signals, T, dt, posture, duration, notes) -> RideAssessment:
     return RideAssessment(axes, posture, a_v, msdv, illness, *judged, notes, dict(_CLAUSES))
 
 
-def _triggers(axes) -> tuple[str, ...]:
-    """The §6.2 / §6.3.3 conditions that call for the additional methods, in words."""
-    out = []
-    for a in axes:
+def _exceeded(a: AxisAssessment) -> list[tuple[str, float, float]]:
+    """The §6.2 / §6.3.3 conditions an axis meets: ``(what, value, limit)``."""
+    return [
+        (what, value, limit)
         for what, value, limit in (
             ("crest factor", a.crest_factor, guidance.CREST_FACTOR_LIMIT),
             ("MTVV/a_w", a.mtvv_ratio, guidance.MTVV_RATIO_LIMIT),
             ("VDV/(a_w T^¼)", a.vdv_ratio, guidance.VDV_RATIO_LIMIT),
-        ):
-            if value > limit:
-                out.append(f"{what} {value:.3g} > {limit:g} on {a.axis}")
-    return tuple(out)
+        )
+        if value > limit
+    ]
+
+
+def _triggers(axes) -> tuple[str, ...]:
+    """The §6.2 / §6.3.3 conditions that call for the additional methods, in words."""
+    return tuple(
+        f"{what} {value:.3g} > {limit:g} on {a.axis}"
+        for a in axes
+        for what, value, limit in _exceeded(a)
+    )
 
 
 #: A car's angular accelerations: (output label, velocity state, ISO axis, sign).
@@ -558,7 +572,7 @@ def axis_signals(response, *, seat: float | None = None, model: VehicleModel | N
             signals["x"] = h * signals["ry"]
         if "rx" in signals:
             signals["y"] = -h * signals["rx"]
-        notes.append(f"x and y are the seat's motion {h:g} m above the pitch and roll axes")
+        notes.append(f"the seat's x and y are its motion {h:g} m above the pitch and roll axes")
     elif "rx" in signals or "ry" in signals:
         notes.append("no seat height (seat=): the fore-aft and lateral axes are not assessed")
     elif seat is not None:

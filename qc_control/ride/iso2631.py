@@ -30,6 +30,7 @@ import numpy as np
 import scipy.linalg
 import scipy.signal
 
+from ..numerics.checks import ParameterError
 from ..numerics.integrate import uniform_step
 from ..numerics.lti import affine_scan
 
@@ -86,9 +87,7 @@ USES = {
 def _name(name: str) -> str:
     key = {k.lower(): k for k in WEIGHTINGS}.get(str(name).strip().lower())
     if key is None:
-        raise ValueError(
-            f"weighting must be one of ISO 2631-1's {', '.join(WEIGHTINGS)}, got {name!r}"
-        )
+        raise ParameterError("weighting", name, f"one of ISO 2631-1's {', '.join(WEIGHTINGS)}")
     return key
 
 
@@ -231,18 +230,27 @@ def weighted(acc, T, name: str) -> np.ndarray:
     T = np.asarray(T, dtype=float)
     a = np.atleast_2d(np.asarray(acc, dtype=float))
     if T.ndim != 1 or T.size < 2 or a.shape[-1] != T.size:
-        raise ValueError(
-            f"acc must have one sample per time of T ({T.size}), got shape {np.shape(acc)}"
+        raise ParameterError(
+            "acc",
+            np.shape(acc),
+            f"one sample per time of T ({T.size})",
+            message=f"acc must have one sample per time of T ({T.size}), got shape {np.shape(acc)}",
         )
     bad = np.argwhere(~np.isfinite(a))
     if bad.size:
-        raise ValueError(f"acc is not finite at sample {int(bad[0, -1])}")
+        at = int(bad[0, -1])
+        raise ParameterError(
+            "acc", a[tuple(bad[0])], "finite samples", message=f"acc is not finite at sample {at}"
+        )
     dt = _uniform(T, key)
     top = band_top(key)
     if 1 / (2 * dt) < top:
-        raise ValueError(
-            f"dt = {dt:g} s is too coarse for {key}: its band reaches {top:g} Hz, so the "
-            f"samples must be at most {1 / (2 * top):g} s apart"
+        raise ParameterError(
+            "T",
+            dt,
+            f"samples at most {1 / (2 * top):g} s apart",
+            message=f"dt = {dt:g} s is too coarse for {key}: its band reaches {top:g} Hz, so "
+            f"the samples must be at most {1 / (2 * top):g} s apart",
         )
     return _convolved(key, a, T, dt).reshape(np.shape(acc))
 
@@ -250,7 +258,12 @@ def weighted(acc, T, name: str) -> np.ndarray:
 def _uniform(T: np.ndarray, key: str) -> float:
     dt = uniform_step(T)
     if dt is None:
-        raise ValueError(f"T must be uniform for the ISO 2631 weighting {key}")
+        raise ParameterError(
+            "T",
+            "a non-uniform grid",
+            f"uniform for the ISO 2631 weighting {key}",
+            message=f"T must be uniform for the ISO 2631 weighting {key}",
+        )
     return dt
 
 

@@ -716,10 +716,13 @@ class Bump(Road):
         return float(_bump_height(t, self.height, self.length, self.speed, self.t0))
 
     def describe(self) -> str:
-        return (
-            f"a {_length_text(self.height)} high, {self.length:g} m long 1 − cos bump "
-            f"met at t = {self.t0:g} s at {self.speed:g} m/s"
+        # a negative height is a pothole: "a -5 cm high bump" reads as a typo
+        shape = (
+            f"a {_length_text(-self.height)} deep, {self.length:g} m long 1 − cos pothole"
+            if self.height < 0
+            else f"a {_length_text(self.height)} high, {self.length:g} m long 1 − cos bump"
         )
+        return f"{shape} met at t = {self.t0:g} s at {self.speed:g} m/s"
 
     def largest_step(self) -> float:
         """The bump's duration length/speed over `BUMP_STEPS`."""

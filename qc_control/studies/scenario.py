@@ -42,6 +42,8 @@ from ..numerics.methods import METHODS, get_method
 from ..numerics.stability import max_stable_step
 from ..numerics.steps import preferred_step
 from ..ride import road as roads
+from ..ride.guidance import RUNNING_RMS_WINDOW
+from ..ride.iso2631 import band_top
 
 # ROADS and ISO8608Road: 0.1's names of this module (``from qc_control.scenario import
 # ROADS``), which answers that old path; the road kinds are `qc_control.road`'s
@@ -240,6 +242,17 @@ def _road(road: Any, default: Mapping[str, Any] | None) -> Road:
             "road",
         )
     return road
+
+
+def _kind_road(kind: Any, default: Mapping[str, Any] | None) -> Mapping[str, Any] | None:
+    """The road a road table fills what it omits from: a scenario kind's run's
+    (`KINDS`: ``--scenario pothole --speed 10`` is the pothole at 10 m/s), else
+    the model's ``default``."""
+    if kind == "pothole":
+        return POTHOLE.road()
+    if kind == "stiff":
+        return STIFF_CAR.road()
+    return default
 
 
 def _warn_road_form(given: Any, road: Road) -> None:
@@ -447,13 +460,44 @@ class Scenario:
                 "scenario",
                 "comfort",
             )
+        if self.comfort:
+            self._comfort_grid()
         if self.seat_height is not None:
             put("seat_height", _checked(checks.finite, "seat_height", self.seat_height, "m"))
         if self.exposure is not None:
             low, high = EXPOSURE_HOURS
             put(
                 "exposure",
-                _checked(checks.number, "exposure", self.exposure, "h", low=low, high=high),
+                _checked(
+                    checks.number,
+                    "exposure",
+                    self.exposure,
+                    "h",
+                    low=low,
+                    high=high,
+                    # the bound 0.166667 h alone does not read as Figure B.1's 10 min
+                    description="daily hours; Annex B's Figure B.1 covers 10 min to 24 h",
+                ),
+            )
+
+    def _comfort_grid(self) -> None:
+        """Refuse, before the run, a grid the assessment cannot weigh: shorter than
+        the running RMS's window (§6.3.1; the nonlinear car's 0.8 s bump run) or
+        coarser than Wk's band, the vertical every car has, reaching 12.5 Hz."""
+        window = RUNNING_RMS_WINDOW
+        if self.t_end < window * (1 - 1e-9):
+            raise ScenarioError(
+                f"t_end = {self.t_end:g} s is shorter than the {window:g} s window of ISO "
+                "2631-1's running RMS (§6.3.1), which comfort needs: give t_end >= "
+                f"{window:g} s (--t-end)",
+                "scenario",
+                "t_end",
+            )
+        top = band_top("Wk")
+        if 2 * top * self.h > 1 + 1e-12:  # Nyquist 1/(2h) below the band's top
+            why = f"ISO 2631-1's Wk reaches {top:g} Hz, so h must be <= {1 / (2 * top):g} s"
+            raise ScenarioError(
+                f"h = {self.h:g} s is too coarse for comfort: {why}", "scenario", "h"
             )
 
     def comfort_request(self) -> dict[str, float] | bool:
@@ -826,7 +870,7 @@ class Scenario:
             extra = {k: v for k, v in run.items() if k not in RUN_KEYS}
             if road:  # the file's table, as the Road it describes over the model's default
                 model = get_model(_model_name(fixed.get("model"), layout["vehicle"]))
-                road = _road(road, model.defaults.road)
+                road = _road(road, _kind_road(fixed.get("kind"), model.defaults.road))
             return cls(
                 vehicle=cast(Any, layout["vehicle"]),
                 road=cast(Any, road or None),

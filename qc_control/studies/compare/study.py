@@ -79,7 +79,7 @@ def _comparison(
     if isinstance(problem.system, control.StateSpace):  # an exact reference to run against
         cost, cost_kind, checks = confirmed_costs(
             problem.system, problem.T, problem.X0, problem.U, tabs, cost, cost_kind,
-            problem.model.body_disp,
+            problem.model.body_disp, runs=measured.convergence,
         )  # fmt: skip
     table = pd.concat(
         [
