@@ -29,6 +29,9 @@ from qc_control.report import (
 )
 from qc_control.report.document import fmt, table_cells, to_markdown
 
+# one worker builds the module's report fixtures, built again on each worker otherwise
+pytestmark = pytest.mark.xdist_group("test_report")
+
 PNG = b"\x89PNG\r\n\x1a\n"
 
 

@@ -41,6 +41,10 @@ from qc_control.report.figures import work_precision_figure
 from qc_control.report.findings import _cheapest, _same_work
 from qc_control.studies.scenario import Scenario
 
+# one worker builds the four reports (a module fixture is built again on every
+# worker that runs one of its tests: 22 s each)
+pytestmark = pytest.mark.xdist_group("report_consistency")
+
 #: The four reports: the seed car's free response, the seed car over a 5 cm road
 #: step, the README's half car over a bump, the nonlinear car over its bump.
 CASES = {
