@@ -28,6 +28,9 @@ import qc_control as qc
 from qc_control.ride.road import bump as road_bump
 from qc_control.studies.compare import DEFAULT_X0, nonlinear_reference
 
+# one worker builds the module's fixtures, built again on each worker otherwise
+pytestmark = pytest.mark.xdist_group("test_compare_nonlinear")
+
 P = qc.QuarterCarParams()
 G = 9.80665
 BUMP_H, BUMP_L, SPEED, T0 = 0.2, 8.0, 20.0, 0.1

@@ -25,6 +25,9 @@ from qc_control.report.figures import reference_figure
 from qc_control.report.summary import summary
 from qc_control.studies.scenario import Scenario
 
+# one worker builds the module's fixtures, built again on each worker otherwise
+pytestmark = pytest.mark.xdist_group("test_report_summary")
+
 pytestmark = pytest.mark.slow  # each builds a full comparison (seconds each)
 
 
