@@ -25,10 +25,9 @@ from qc_control.report.figures import reference_figure
 from qc_control.report.summary import summary
 from qc_control.studies.scenario import Scenario
 
-# one worker builds the module's fixtures, built again on each worker otherwise
-pytestmark = pytest.mark.xdist_group("test_report_summary")
-
-pytestmark = pytest.mark.slow  # each builds a full comparison (seconds each)
+# each builds a full comparison (seconds each); one worker builds the module's
+# fixtures, built again on each worker otherwise
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("test_report_summary")]
 
 
 def rk4_error(steps, span=10.0, x0=(0.0, 0.0, 0.05, 0.0)):
