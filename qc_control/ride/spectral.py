@@ -54,6 +54,7 @@ __all__ = [
     "rear_delay",
     "IndependentTracksWarning",
     "road_intensity",
+    "spectral_road",
     "iso8608_spelling",
     "DEFAULT_ROAD",
     "spectral_metrics",
@@ -259,14 +260,20 @@ def rear_delay(model: VehicleModel, speed, batch=None) -> tuple[tuple[tuple[int,
     if speed is None:
         return (), None
     speed = positive("speed", speed, "m/s")
-    entry = model_for_params(model.params)
-    pairs = _FOLLOWERS.get(entry.road_layout if entry is not None else "single", ())
+    pairs = _FOLLOWERS.get(_road_layout(model), ())
     if not pairs:
         return (), None
     wheelbase = model.params.a + model.params.b if batch is None else batch.wheelbase
     if wheelbase is None:
         raise ValueError("the batch has no wheelbases: build it with model.batch(designs)")
     return pairs, np.asarray(wheelbase, dtype=float) / speed
+
+
+def _road_layout(model: VehicleModel) -> str:
+    """The registered model's `ModelEntry.road_layout` (``'single'`` for a model
+    the registry does not know)."""
+    entry = model_for_params(model.params)
+    return entry.road_layout if entry is not None else "single"
 
 
 #: Per road layout, the (front, rear) pairs of its road inputs (in
@@ -352,8 +359,7 @@ def _warn_of_independent_sides(model: VehicleModel) -> None:
     take as independent: on a real road (and `ISO8608Road`'s two simulated tracks,
     an isotropic surface) they are coherent at long wavelengths, with the coherence
     ``kB K₁(kB)`` of no finite state space, so the values are not the road's."""
-    entry = model_for_params(model.params)
-    if entry is not None and entry.road_layout == "corners":
+    if _road_layout(model) == "corners":
         warnings.warn(
             f"spectral values of {model.name!r} take its left and right tracks as "
             "independent roads; an ISO 8608 road's two tracks are coherent at long "
@@ -538,10 +544,19 @@ def road_intensity(road=None, *, stacklevel: int = 2) -> float:
     >>> road_intensity(ISO8608Road("C", speed=20.0)) == iso8608_intensity("C", 20.0)
     True
     """
+    road = spectral_road(road, stacklevel=stacklevel + 1)
+    return road.intensity if isinstance(road, ISO8608Road) else road
+
+
+def spectral_road(road=None, *, stacklevel: int = 2):
+    """``road`` as a stationary study keeps it: an `ISO8608Road` (whose speed
+    delays a car's rear wheels, `rear_delay`), or the intensity ``q`` [m²/s]
+    (None: 1). The older ``(class, speed)`` pair is read as its `ISO8608Road`,
+    with the DeprecationWarning of `road_intensity`, which gives its ``q``."""
     if road is None:
         return 1.0
     if isinstance(road, ISO8608Road):
-        return road.intensity
+        return road
     if isinstance(road, tuple) and len(road) == 2:
         new = ISO8608Road(road[0], speed=road[1])  # a bad class or speed is refused by name
         warnings.warn(
@@ -550,7 +565,7 @@ def road_intensity(road=None, *, stacklevel: int = 2) -> float:
             DeprecationWarning,
             stacklevel=stacklevel + 1,
         )
-        return new.intensity
+        return new
     if isinstance(road, (bool, np.bool_)) or not isinstance(
         road, (int, float, np.integer, np.floating)
     ):

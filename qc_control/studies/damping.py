@@ -67,6 +67,7 @@ from ..ride.spectral import (
     require_linear,
     road_intensity,
     spectral_metrics,
+    spectral_road,
     white_velocity_variances,
     white_velocity_wk_variance,
 )
@@ -138,7 +139,8 @@ def spectral_ride(
         One row per design: the columns of `OBJECTIVES` (Wk only with ``wk``,
         ISO 2631-1's only as ``iso2631`` names them).
     """
-    q = road_intensity(road, stacklevel=2)
+    road = spectral_road(road, stacklevel=2)
+    q = road_intensity(road)
     # an ISO 8608 road has a speed: a car's rear wheels meet it a wheelbase later
     speed = road.speed if isinstance(road, ISO8608Road) else None
     corner = model.corners[0]
@@ -163,17 +165,6 @@ def spectral_ride(
     if iso2631:
         cols.update(spectral_metrics(model, q, list(iso2631), batch=batch, speed=speed))
     return pd.DataFrame({k: np.atleast_1d(v) for k, v in cols.items()})
-
-
-def _read_road(road):
-    """A study's road, read once (an older ``(class, speed)`` pair warns here, once):
-    an `ISO8608Road` (its speed delays a car's rear wheels), or the intensity ``q``."""
-    q = road_intensity(road, stacklevel=3)
-    if isinstance(road, ISO8608Road):
-        return road
-    if isinstance(road, tuple):
-        return ISO8608Road(road[0], speed=road[1])
-    return q
 
 
 def closed_form_terms(p: QuarterCarParams, objective: str) -> tuple[float, float]:
@@ -366,7 +357,7 @@ def optimal_damping(
     method = solver
     choice("solver", method, ("auto", "closed form", "numerical"))
     sigmas = positive("sigmas", sigmas, "")
-    road = _read_road(road)
+    road = spectral_road(road, stacklevel=2)
     model = (
         params
         if isinstance(params, VehicleModel)
@@ -518,7 +509,7 @@ def pareto_front(
     ParetoFront
     """
     p, model, vary = _pareto_car(params, vary)
-    road = _read_road(road)  # read once: every design sees the same road
+    road = spectral_road(road, stacklevel=2)  # read once: every design sees the same road
     objectives = list(objectives)
     for o in objectives:
         _refuse_rotation("objectives", objectives, o, model)
