@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from ..studies import columns as col
-from .document import Code, Heading, Image, Paragraph, Table, fmt
+from .document import Code, Heading, Image, Paragraph, Table, fmt, sentence
 from .figures import (
     convergence_figure,
     error_figure,
@@ -584,7 +584,7 @@ def _comfort_blocks(cmp) -> list:
         Heading("Ride comfort (ISO 2631-1:1997)"),
         Paragraph(
             "The exact reference's ride, assessed as ISO 2631-1:1997 does: "
-            + " ".join(f"{sentence[:1].upper()}{sentence[1:]}." for sentence in comfort.verdict)
+            + " ".join(sentence(said) for said in comfort.verdict)
         ),
         Table(
             axes,

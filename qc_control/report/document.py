@@ -23,6 +23,7 @@ __all__ = [
     "Image",
     "Code",
     "fmt",
+    "sentence",
     "table_cells",
     "caption_text",
     "to_markdown",
@@ -66,6 +67,12 @@ class Code:
 
 #: Integer-valued floats up to this size print in full (30000, not 3e+04).
 _WHOLE_LIMIT = 1e15
+
+
+def sentence(text: str) -> str:
+    """``text`` as a sentence of the report: its first letter a capital, a full stop
+    after (the verdicts are written to stand inside a sentence)."""
+    return f"{text[:1].upper()}{text[1:]}."
 
 
 def fmt(value) -> str:

@@ -6,7 +6,7 @@ import math
 
 from ..studies import columns as col
 from ..studies.timing import same_work
-from .document import fmt
+from .document import fmt, sentence
 
 __all__ = ["findings", "coincidence_groups"]
 
@@ -217,9 +217,7 @@ def _comfort(cmp) -> list[str]:
     if comfort is None:
         return []
     lead = comfort.verdict[0]
-    return [
-        f"Assessed as ISO 2631-1:1997 does (section Ride comfort): {lead[:1].upper()}{lead[1:]}."
-    ]
+    return [f"Assessed as ISO 2631-1:1997 does (section Ride comfort): {sentence(lead)}"]
 
 
 def _same_work(cmp) -> list[str]:
